@@ -1,0 +1,191 @@
+"""Floor caustics by flux ratio: each refracted surface triangle deposits its flux on the floor.
+
+The footprint of a surface triangle's refracted rays on the horizontal floor plane is the
+horizontal section of its caustic volume (Sandberg & Falemo 2005; Ernst et al. 2005). Its flux is
+spread over the footprint by exact area overlap with each texel (Sutherland–Hodgman clipping), so
+the flux deposited equals the triangle's flux to rounding, whatever the footprint's size or
+orientation (folded footprints count by their unsigned area). Texel indices wrap: the surface
+and the floor map are periodic with period L.
+
+Surface triangles: quad (ix, iy)…(ix+1, iy+1) of the periodic N×N vertex grid splits into
+``half = 0``: corners (0,0), (1,0), (1,1) and ``half = 1``: (0,0), (1,1), (0,1), both
+counter-clockwise seen from above. A corner past the last row/column wraps to index 0 shifted by L.
+"""
+
+import warp as wp
+from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
+
+wp.set_module_options({"enable_backward": False})
+
+DEGENERATE_AREA_TEXELS = 1.0e-9
+"""Footprints smaller than this [texel^2] deposit at their centroid (a focus point or line)."""
+
+
+@wp.func
+def quad_corner(ix: int, iy: int, half: int, corner: int, n: int, extent_m: float):
+    """Grid index of a triangle corner and the periodic shift [m] that makes it contiguous."""
+    dx = int(0)
+    dy = int(0)
+    if half == 0:
+        if corner >= 1:
+            dx = 1
+        if corner == 2:
+            dy = 1
+    else:
+        if corner == 1:
+            dx = 1
+        if corner >= 1:
+            dy = 1
+    cx = ix + dx
+    cy = iy + dy
+    shift = wp.vec2(0.0)
+    if cx == n:
+        cx = 0
+        shift[0] = extent_m
+    if cy == n:
+        cy = 0
+        shift[1] = extent_m
+    return cx, cy, shift
+
+
+@wp.func
+def lift(p: wp.vec3, shift: wp.vec2) -> wp.vec3:
+    return p + wp.vec3(shift[0], shift[1], 0.0)
+
+
+@wp.func
+def wrap(i: int, m: int) -> int:
+    r = i % m
+    if r < 0:
+        r += m
+    return r
+
+
+@wp.kernel
+def triangle_flux(
+    positions: wp.array2d[wp.vec3],
+    path_m: wp.array3d[wp.float32],
+    transmittance: wp.array3d[wp.float32],
+    sun_dir: wp.vec3,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    wavelengths_per_group: int,
+    extent_m: float,
+    flux_w_nm: wp.array4d[wp.float32],
+):
+    """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at each wavelength k.
+
+    ``E_sun(k) * A_perp * mean_i(T_i exp(-c(k) l_i))``, with ``A_perp`` the triangle's area
+    projected perpendicular to the sun (0 for triangles facing away from it).
+    """
+    k, iy, ix, half = wp.tid()
+    n = positions.shape[0]
+    g = k / wavelengths_per_group
+    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
+    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
+    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
+    p0 = lift(positions[y0, x0], s0)
+    p1 = lift(positions[y1, x1], s1)
+    p2 = lift(positions[y2, x2], s2)
+    a_perp = 0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir)
+    flux = float(0.0)
+    if a_perp > 0.0:
+        c = attenuation_per_m[k]
+        mean_t = (
+            transmittance[g, y0, x0] * wp.exp(-c * path_m[g, y0, x0])
+            + transmittance[g, y1, x1] * wp.exp(-c * path_m[g, y1, x1])
+            + transmittance[g, y2, x2] * wp.exp(-c * path_m[g, y2, x2])
+        ) / 3.0
+        flux = sun_irradiance[k] * a_perp * mean_t
+    flux_w_nm[k, half, iy, ix] = flux
+
+
+@wp.func
+def add_to_texel(
+    floor_irradiance: wp.array3d[wp.float32],
+    flux_w_nm: wp.array4d[wp.float32],
+    k_begin: int,
+    k_count: int,
+    iy: int,
+    ix: int,
+    half: int,
+    tx: int,
+    ty: int,
+    weight: float,
+):
+    """Add ``weight`` × the triangle's flux to texel (ty, tx) of each wavelength of its group."""
+    for j in range(k_count):
+        k = k_begin + j
+        wp.atomic_add(floor_irradiance, k, ty, tx, weight * flux_w_nm[k, half, iy, ix])
+
+
+@wp.kernel
+def deposit_footprints(
+    hit_xy: wp.array3d[wp.vec2],
+    flux_w_nm: wp.array4d[wp.float32],
+    wavelengths_per_group: int,
+    extent_m: float,
+    floor_irradiance: wp.array3d[wp.float32],
+):
+    """Spread triangle (iy, ix, half)'s flux over its floor footprint for index group g.
+
+    ``floor_irradiance`` is (K, M, M) [W m^-2 nm^-1]; texel (ty, tx) spans
+    ``[tx, tx+1] * L/M - L/2`` in x. Weight of a texel = overlap area / footprint area.
+    """
+    g, iy, ix, half = wp.tid()
+    n = hit_xy.shape[1]
+    m = floor_irradiance.shape[1]
+    k_begin = g * wavelengths_per_group
+    if flux_w_nm[k_begin, half, iy, ix] <= 0.0:
+        return  # facing away from the sun or fully reflected: nothing to spread
+    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
+    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
+    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
+    scale = float(m) / extent_m
+    origin = wp.vec2(0.5 * extent_m)
+    # Footprint in texel units.
+    q0 = (hit_xy[g, y0, x0] + s0 + origin) * scale
+    q1 = (hit_xy[g, y1, x1] + s1 + origin) * scale
+    q2 = (hit_xy[g, y2, x2] + s2 + origin) * scale
+    i_lo = int(wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0]))))
+    j_lo = int(wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1]))))
+    i_hi = int(wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0]))))
+    j_hi = int(wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1]))))
+    # Coordinates relative to the first texel keep float32 precision on large maps.
+    corner = wp.vec2(float(i_lo), float(j_lo))
+    q0 = q0 - corner
+    q1 = q1 - corner
+    q2 = q2 - corner
+    area = 0.5 * wp.abs((q1[0] - q0[0]) * (q2[1] - q0[1]) - (q2[0] - q0[0]) * (q1[1] - q0[1]))
+    inv_texel_area = (scale * scale)  # 1 / texel area [m^-2]
+    if (i_lo == i_hi and j_lo == j_hi) or area < DEGENERATE_AREA_TEXELS:
+        c = (q0 + q1 + q2) / 3.0
+        tx = wrap(i_lo + int(wp.floor(c[0])), m)
+        ty = wrap(j_lo + int(wp.floor(c[1])), m)
+        add_to_texel(floor_irradiance, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
+                     tx, ty, inv_texel_area)
+        return
+    px = vec8()
+    py = vec8()
+    px[0] = q0[0]
+    py[0] = q0[1]
+    px[1] = q1[0]
+    py[1] = q1[1]
+    px[2] = q2[0]
+    py[2] = q2[1]
+    for ci in range(i_hi - i_lo + 1):
+        cx, cy, cn = clip_to_slab(px, py, 3, 0, float(ci), float(ci + 1))
+        if cn < 3:
+            continue
+        # Only the rows this column's piece of the footprint spans.
+        y_min = cy[0]
+        y_max = cy[0]
+        for v in range(1, cn):
+            y_min = wp.min(y_min, cy[v])
+            y_max = wp.max(y_max, cy[v])
+        for cj in range(int(wp.floor(y_min)), wp.min(int(wp.floor(y_max)), j_hi - j_lo) + 1):
+            rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
+            if rn >= 3:
+                w = polygon_area(rx, ry, rn) / area * inv_texel_area
+                add_to_texel(floor_irradiance, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
+                             half, wrap(i_lo + ci, m), wrap(j_lo + cj, m), w)

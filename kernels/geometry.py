@@ -1,0 +1,89 @@
+"""Shared geometry and optics helpers (``@wp.func``) used by the stage kernels."""
+
+import warp as wp
+
+wp.set_module_options({"enable_backward": False})
+
+vec8 = wp.types.vector(length=8, dtype=wp.float32)
+"""Up to eight polygon coordinates: a triangle clipped by two slabs has at most seven vertices."""
+
+
+@wp.func
+def refract(d: wp.vec3, n: wp.vec3, eta: float) -> wp.vec3:
+    """Snell's law in vector form; ``eta = n1/n2``, ``n`` faces against ``d``. Zero vector on TIR."""
+    c = -wp.dot(n, d)
+    k = 1.0 - eta * eta * (1.0 - c * c)
+    if k < 0.0:
+        return wp.vec3(0.0)
+    return eta * d + (eta * c - wp.sqrt(k)) * n
+
+
+@wp.func
+def fresnel_transmittance(cos_i: float, eta: float) -> float:
+    """Exact unpolarised Fresnel transmittance ``1 - (Rs + Rp)/2`` (Born & Wolf §1.5.2).
+
+    ``cos_i`` is the cosine of the incidence angle, ``eta = n1/n2``. Returns 0 on total internal
+    reflection and for light arriving from behind the surface (``cos_i <= 0``).
+    """
+    if cos_i <= 0.0:
+        return 0.0
+    k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+    if k <= 0.0:
+        return 0.0
+    cos_t = wp.sqrt(k)
+    rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
+    rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
+    return 1.0 - 0.5 * (rs * rs + rp * rp)
+
+
+@wp.func
+def clip_half_plane(px: vec8, py: vec8, count: int, axis: int, bound: float, keep_above: bool):
+    """Sutherland–Hodgman step: keep the part of polygon ``(px, py)`` on one side of a line.
+
+    The line is ``x = bound`` (``axis == 0``) or ``y = bound`` (``axis == 1``); ``keep_above``
+    keeps coordinates ``>= bound``. Returns the clipped polygon and its vertex count.
+    """
+    qx = vec8()
+    qy = vec8()
+    m = int(0)
+    for j in range(count):
+        jn = (j + 1) % count
+        a = px[j]
+        b = px[jn]
+        if axis == 1:
+            a = py[j]
+            b = py[jn]
+        sa = a - bound
+        sb = b - bound
+        if not keep_above:
+            sa = -sa
+            sb = -sb
+        if sa >= 0.0:
+            qx[m] = px[j]
+            qy[m] = py[j]
+            m += 1
+        if (sa >= 0.0) != (sb >= 0.0):
+            t = sa / (sa - sb)
+            qx[m] = px[j] + t * (px[jn] - px[j])
+            qy[m] = py[j] + t * (py[jn] - py[j])
+            m += 1
+    return qx, qy, m
+
+
+@wp.func
+def clip_to_slab(px: vec8, py: vec8, count: int, axis: int, lo: float, hi: float):
+    """Clip a polygon to the slab ``lo <= coordinate <= hi`` along ``axis``."""
+    qx, qy, m = clip_half_plane(px, py, count, axis, lo, True)
+    if m == 0:
+        return qx, qy, m
+    return clip_half_plane(qx, qy, m, axis, hi, False)
+
+
+@wp.func
+def polygon_area(px: vec8, py: vec8, count: int) -> float:
+    """Unsigned shoelace area of a simple polygon."""
+    s = float(0.0)
+    for j in range(count):
+        jn = (j + 1) % count
+        s += px[j] * py[jn] - px[jn] * py[j]
+    return 0.5 * wp.abs(s)

@@ -1,0 +1,27 @@
+"""warpcaustics: sunlight under moving water, simulated with NVIDIA Warp kernels.
+
+``import warpcaustics`` stays light: Warp, colour-science and OpenEXR load on first use.
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+__all__ = ["load_scene", "render", "RenderResult", "Scene", "WarpcausticsError", "__version__"]
+
+
+def __getattr__(name: str):
+    # Lazy public surface: the config layer is cheap, the pipeline pulls in Warp.
+    if name in ("load_scene", "Scene"):
+        from warpcaustics import scene
+
+        return getattr(scene, name)
+    if name in ("render", "RenderResult"):
+        from warpcaustics import pipeline
+
+        return getattr(pipeline, name)
+    if name == "WarpcausticsError":
+        from warpcaustics.errors import WarpcausticsError
+
+        return WarpcausticsError
+    raise AttributeError(f"module 'warpcaustics' has no attribute {name!r}")

@@ -1,0 +1,5 @@
+import sys
+
+from warpcaustics.cli import main
+
+sys.exit(main())

@@ -1,0 +1,109 @@
+"""Command line: ``warpcaustics render | info``. User errors print one line and exit with 2."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from warpcaustics import __version__
+from warpcaustics.errors import WarpcausticsError
+
+EXIT_USER_ERROR = 2
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="warpcaustics",
+        description="Sunlight under moving water: caustics on the sea floor with NVIDIA Warp.")
+    p.add_argument("--version", action="version", version=f"warpcaustics {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    r = sub.add_parser("render", help="render a scene's floor caustics to EXR, PNG and run.json",
+                       description="Render CONFIG (a TOML scene) into DIR: frame_NNNN.exr (RGB + "
+                                   "spectral floor irradiance), frame_NNNN.png (preview), run.json.")
+    r.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
+    r.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
+    r.add_argument("--device", metavar="DEVICE",
+                   help="cpu, cuda, cuda:N or auto (default: $WARPCAUSTICS_DEVICE, then the config)")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
+                   help="override a config key, e.g. --set sun.elevation_deg=45 (repeatable)")
+    r.add_argument("--time", type=float, default=0.0, metavar="SECONDS",
+                   help="simulation time of the first frame [s] (default 0)")
+    r.add_argument("--frames", type=int, default=1, metavar="N", help="number of frames (default 1)")
+    r.add_argument("--fps", type=float, default=30.0, metavar="F",
+                   help="frames per second of an animation (default 30)")
+
+    sub.add_parser("info", help="versions and the devices Warp sees",
+                   description="Print package versions and the compute devices Warp can use.")
+    return p
+
+
+def _render(args: argparse.Namespace) -> int:
+    from warpcaustics.config import parse_override
+    from warpcaustics.scene import load_scene
+
+    overrides = dict(parse_override(text) for text in args.overrides)
+    scene = load_scene(args.config, overrides)  # validate everything before touching the output
+    if args.frames < 1:
+        raise WarpcausticsError(f"--frames = {args.frames} must be at least 1")
+    if args.fps <= 0:
+        raise WarpcausticsError(f"--fps = {args.fps} must be positive")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+
+    from warpcaustics.output import save_frame, write_run_json
+    from warpcaustics.pipeline import render
+
+    results = []
+    for frame in range(args.frames):
+        t0 = time.perf_counter()
+        result = render(scene, time_s=args.time + frame / args.fps, device=args.device)
+        save_frame(result, out, frame=frame)
+        results.append(result)
+        print(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
+              f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
+    write_run_json(out, results)
+    print(f"wrote {args.frames} frame(s) and run.json to {out}")
+    return 0
+
+
+def _info() -> int:
+    from warpcaustics.device import DEVICE_ENV
+    from warpcaustics.output import versions
+
+    for name, version in versions().items():
+        print(f"{name:16s}{version}")
+    import os
+
+    from warpcaustics.device import _warp
+
+    wp = _warp()
+    print("devices:")
+    for d in wp.get_devices():
+        extra = f"  {d.total_memory / 1024**3:.1f} GiB" if d.is_cuda else ""
+        print(f"  {d.alias:8s}{d.name}{extra}")
+    default = "cuda:0" if wp.get_cuda_device_count() else "cpu"
+    print(f"default device: {default}  (override: --device or ${DEVICE_ENV}="
+          f"{os.environ.get(DEVICE_ENV, '')})")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "render":
+            return _render(args)
+        return _info()
+    except WarpcausticsError as exc:
+        print(f"warpcaustics: error: {exc}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    except KeyboardInterrupt:
+        print("warpcaustics: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

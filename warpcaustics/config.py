@@ -1,0 +1,340 @@
+"""Scene configuration: TOML validated into frozen dataclasses, with dotted overrides.
+
+Every section is a frozen dataclass; a field's docstring says what it is, with its unit in
+brackets, and its ``metadata`` carries the allowed range. ``docs/config.md`` documents each key.
+Validation errors are one line naming the key, the value, what is allowed and, for unknown keys,
+the nearest valid key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import enum
+import math
+import sys
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from warpcaustics.errors import ConfigError
+
+
+def _range(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False) -> dict:
+    return {"range": (lo, hi, lo_open)}
+
+
+class WaterModel(str, enum.Enum):
+    FLAT = "flat"
+    HEIGHTFIELD = "heightfield"
+    FFT = "fft"
+
+
+class WaterSpectrum(str, enum.Enum):
+    PHILLIPS = "phillips"
+
+
+class WaterType(str, enum.Enum):
+    NONE = "none"
+    PURE = "pure"
+
+
+class CausticsMethod(str, enum.Enum):
+    FLUXRATIO = "fluxratio"
+
+
+class DeviceChoice(str, enum.Enum):
+    AUTO = "auto"
+    CPU = "cpu"
+    CUDA = "cuda"
+
+
+# Values other issues will add: named so an error can say where they stand instead of "unknown".
+PLANNED_VALUES = {
+    "caustics.method": ("photons", "beams", "both", "sunmap", "eikonal", "wave3d"),
+    "water.spectrum": ("jonswap",),
+}
+
+
+@dataclass(frozen=True)
+class WaterConfig:
+    model: WaterModel = WaterModel.FFT
+    """Surface model: ``flat``, ``heightfield`` (from ``water.file``) or ``fft`` (Tessendorf)."""
+    extent_m: float = field(default=16.0, metadata=_range(0.0, None, lo_open=True))
+    """Side L of the square, periodic water patch centred at the origin [m]."""
+    resolution: int | None = field(default=None, metadata=_range(4, 4096))
+    """Vertices per side N (default 256; a heightfield takes N from its file) [-]."""
+    file: str | None = None
+    """``.npy`` 2-D float array of heights [m], ``h[iy, ix]``, at cell centres; relative paths
+    are resolved against the config file's folder."""
+    spectrum: WaterSpectrum = WaterSpectrum.PHILLIPS
+    """Wave spectrum of the ``fft`` ocean."""
+    wind_speed_m_s: float = field(default=4.0, metadata=_range(0.0, 60.0, lo_open=True))
+    """Wind speed at 10 m [m/s]."""
+    wind_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Direction the wind blows to, from +x towards +y [deg]."""
+    phillips_amplitude: float = field(default=1.75e-3, metadata=_range(0.0, 1.0, lo_open=True))
+    """Phillips constant A (dimensionless): height variance = A·π·(V²/g)²/2 over all k."""
+    small_wave_m: float = field(default=0.0, metadata=_range(0.0, None))
+    """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
+    seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
+    """Seed of the ocean's random phases and amplitudes."""
+
+
+@dataclass(frozen=True)
+class FloorConfig:
+    depth_m: float = field(default=4.0, metadata=_range(0.0, None, lo_open=True))
+    """Depth of the flat floor below the water at rest (floor at z = -depth_m) [m]."""
+
+
+@dataclass(frozen=True)
+class SunConfig:
+    elevation_deg: float = field(default=60.0, metadata=_range(0.0, 90.0, lo_open=True))
+    """Angle of the sun above the horizon [deg]."""
+    azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Direction towards the sun, from +x towards +y [deg]."""
+
+
+@dataclass(frozen=True)
+class WavelengthConfig:
+    min_nm: float = field(default=400.0, metadata=_range(380.0, 780.0))
+    """Lower edge of the first bin [nm]."""
+    max_nm: float = field(default=700.0, metadata=_range(380.0, 780.0))
+    """Upper edge of the last bin [nm]."""
+    bins: int = field(default=16, metadata=_range(1, 400))
+    """Number K of equal bins; values are bin averages per nm."""
+
+
+@dataclass(frozen=True)
+class OpticsConfig:
+    water_type: WaterType = WaterType.PURE
+    """Water optics: ``pure`` (Pope & Fry 1997 absorption + Zhang 2009 scattering) or ``none``
+    (c = 0, for validation)."""
+    ior: float = field(default=1.333, metadata=_range(1.0, 3.0, lo_open=True))
+    """Refractive index of water, used for every wavelength [-]."""
+    wavelengths: WavelengthConfig = field(default_factory=WavelengthConfig)
+    """Spectral sampling."""
+
+
+@dataclass(frozen=True)
+class CausticsConfig:
+    method: CausticsMethod = CausticsMethod.FLUXRATIO
+    """Caustics method: ``fluxratio`` (refracted triangle footprints on the floor)."""
+    map_resolution: int = field(default=512, metadata=_range(1, 16384))
+    """Texels M per side of the floor irradiance map over the water extent [-]."""
+
+
+@dataclass(frozen=True)
+class OutputConfig:
+    spectral_exr: bool = True
+    """Write the per-band floor irradiance into the EXR (``S0.<λ>nm`` channels) besides RGB."""
+
+
+@dataclass(frozen=True)
+class Config:
+    water: WaterConfig = field(default_factory=WaterConfig)
+    """The water surface."""
+    floor: FloorConfig = field(default_factory=FloorConfig)
+    """The receiving floor."""
+    sun: SunConfig = field(default_factory=SunConfig)
+    """The sun."""
+    optics: OpticsConfig = field(default_factory=OpticsConfig)
+    """Water optics and spectral sampling."""
+    caustics: CausticsConfig = field(default_factory=CausticsConfig)
+    """Caustics method and map."""
+    output: OutputConfig = field(default_factory=OutputConfig)
+    """What is written."""
+    device: DeviceChoice = DeviceChoice.AUTO
+    """``auto`` (CUDA when available, else CPU), ``cpu`` or ``cuda``."""
+
+
+# ---------------------------------------------------------------------------------------------
+# Validation
+
+
+def _hints(cls: type) -> dict[str, Any]:
+    return typing.get_type_hints(cls)
+
+
+def _is_section(tp: Any) -> bool:
+    return dataclasses.is_dataclass(tp)
+
+
+def all_keys(cls: type = Config, prefix: str = "") -> list[str]:
+    """Every dotted key of the configuration tree (leaves only)."""
+    keys = []
+    for name, tp in _hints(cls).items():
+        if _is_section(tp):
+            keys += all_keys(tp, f"{prefix}{name}.")
+        else:
+            keys.append(f"{prefix}{name}")
+    return keys
+
+
+def _nearest(key: str) -> str:
+    keys = all_keys() + [k.rsplit(".", 1)[0] for k in all_keys() if "." in k]
+    match = difflib.get_close_matches(key, keys, n=1, cutoff=0.0)
+    return match[0] if match else ""
+
+
+def _describe(value: Any) -> str:
+    return repr(value) if isinstance(value, str) else str(value).lower() if isinstance(value, bool) \
+        else str(value)
+
+
+def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
+    """Check one leaf value against its annotated type and range; return the typed value."""
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)) and type(None) in args:
+        if value is None:
+            return None
+        tp = next(a for a in args if a is not type(None))
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        allowed = [m.value for m in tp]
+        if isinstance(value, str) and value in allowed:
+            return tp(value)
+        planned = PLANNED_VALUES.get(key, ())
+        if value in planned:
+            raise ConfigError(f"{key} = {_describe(value)} is not implemented yet; allowed now: "
+                              f"{', '.join(allowed)}")
+        raise ConfigError(f"{key} = {_describe(value)} is not allowed; allowed: {', '.join(allowed)}")
+    if tp is bool:
+        if isinstance(value, bool):
+            return value
+        raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected true or false")
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected an integer")
+    elif tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected a number")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ConfigError(f"{key} = {value} is not finite; expected a finite number")
+    elif tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected a string")
+        return value
+    lo, hi, lo_open = meta.get("range", (None, None, False))
+    if lo is not None and (value < lo or (lo_open and value == lo)):
+        raise ConfigError(f"{key} = {value} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
+    if hi is not None and value > hi:
+        raise ConfigError(f"{key} = {value} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
+    return value
+
+
+def _range_text(lo, hi, lo_open) -> str:
+    left = "" if lo is None else f"{lo} {'<' if lo_open else '<='} "
+    right = "" if hi is None else f" <= {hi}"
+    return f"{left}value{right}"
+
+
+def _build(cls: type, table: dict, prefix: str) -> Any:
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    hints = _hints(cls)
+    kwargs = {}
+    for name, value in table.items():
+        key = f"{prefix}{name}"
+        if name not in fields:
+            raise ConfigError(f"unknown key '{key}' = {_describe(value)}; nearest valid key: "
+                              f"'{_nearest(key)}' (see docs/config.md)")
+        tp = hints[name]
+        if _is_section(tp):
+            if not isinstance(value, dict):
+                raise ConfigError(f"{key} = {_describe(value)} must be a table ([{key}] or "
+                                  f"{key}.<name> = ...)")
+            kwargs[name] = _build(tp, value, f"{key}.")
+        else:
+            kwargs[name] = _convert(key, value, tp, dict(fields[name].metadata))
+    return cls(**kwargs)
+
+
+def _check_consistency(cfg: Config) -> None:
+    w = cfg.optics.wavelengths
+    if w.max_nm <= w.min_nm:
+        raise ConfigError(f"optics.wavelengths.max_nm = {w.max_nm} must exceed "
+                          f"optics.wavelengths.min_nm = {w.min_nm}")
+    if cfg.water.model is WaterModel.HEIGHTFIELD and not cfg.water.file:
+        raise ConfigError("water.file is missing; water.model = 'heightfield' needs a .npy file of "
+                          "heights (set water.file = \"path.npy\")")
+    if cfg.water.model is not WaterModel.HEIGHTFIELD and cfg.water.file:
+        raise ConfigError(f"water.file = {cfg.water.file!r} is only read by water.model = "
+                          f"'heightfield' (model is {cfg.water.model.value!r}); remove it or change the "
+                          "model")
+    n = cfg.water.resolution
+    if cfg.water.model is WaterModel.FFT and n is not None and (n & (n - 1)):
+        raise ConfigError(f"water.resolution = {n} must be a power of two for water.model = 'fft' "
+                          f"(e.g. {1 << max(2, round(math.log2(n)))})")
+
+
+def _set_dotted(table: dict, key: str, value: Any) -> None:
+    parts = key.split(".")
+    node = table
+    for i, part in enumerate(parts[:-1]):
+        child = node.setdefault(part, {})
+        if not isinstance(child, dict):
+            raise ConfigError(f"override '{key}': '{'.'.join(parts[: i + 1])}' is a value, not a table")
+        node = child
+    node[parts[-1]] = value
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """Parse ``key=value`` from the command line; the value is a TOML literal or a bare string."""
+    if "=" not in text:
+        raise ConfigError(f"--set {text!r} must look like key=value, e.g. sun.elevation_deg=45")
+    key, raw = (s.strip() for s in text.split("=", 1))
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Config:
+    """Validate a plain nested dict (as read from TOML) plus dotted overrides into a Config."""
+    table = _deepcopy(table)
+    for key, value in (overrides or {}).items():
+        _set_dotted(table, key, value)
+    cfg = _build(Config, table, "")
+    _check_consistency(cfg)
+    return cfg
+
+
+def read_toml(path: str | Path) -> dict:
+    """Read a TOML file, turning a missing or malformed file into a one-line ConfigError."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"config file {str(path)!r} does not exist; check the path") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"config file {str(path)!r} cannot be read: {exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def config_to_dict(cfg: Any) -> dict:
+    """Resolved configuration as plain TOML/JSON-compatible values."""
+    out = {}
+    for f in dataclasses.fields(cfg):
+        value = getattr(cfg, f.name)
+        if dataclasses.is_dataclass(value):
+            out[f.name] = config_to_dict(value)
+        elif isinstance(value, enum.Enum):
+            out[f.name] = value.value
+        else:
+            out[f.name] = value
+    return out
+
+
+def _deepcopy(table: dict) -> dict:
+    return {k: _deepcopy(v) if isinstance(v, dict) else v for k, v in table.items()}

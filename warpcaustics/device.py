@@ -1,0 +1,88 @@
+"""Choosing the Warp device and checking that a scene fits in its memory."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from warpcaustics.errors import DeviceError
+
+DEVICE_ENV = "WARPCAUSTICS_DEVICE"
+"""Environment variable that overrides the config's ``device`` (the CLI's --device wins over it)."""
+
+_GIB = 1024.0**3
+
+
+def _warp():
+    import warp as wp
+
+    if not os.environ.get("WARPCAUSTICS_VERBOSE"):
+        # Warp's info lines (init banner, module loads) drown our one-line messages.
+        wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
+    wp.init()
+    return wp
+
+
+def cuda_available() -> bool:
+    return _warp().get_cuda_device_count() > 0
+
+
+def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
+    """Pick a Warp device name from (in order) the argument, ``$WARPCAUSTICS_DEVICE``, the config.
+
+    ``auto`` means CUDA when available, else the CPU with a one-line notice on stderr; an explicit
+    ``cuda`` (or ``cuda:N``) where there is none is an error.
+    """
+    choice = requested or os.environ.get(DEVICE_ENV) or config_value or "auto"
+    choice = choice.strip().lower()
+    wp = _warp()
+    if choice == "cpu":
+        return "cpu"
+    if choice == "auto":
+        if wp.get_cuda_device_count() > 0:
+            return "cuda:0"
+        print("warpcaustics: no CUDA device found; running on the CPU", file=sys.stderr)
+        return "cpu"
+    if choice == "cuda" or choice.startswith("cuda:"):
+        count = wp.get_cuda_device_count()
+        if count == 0:
+            raise DeviceError(f"device = {choice!r} was asked for but no CUDA device is available "
+                              f"(driver missing or no GPU); use --device cpu or device = \"auto\"")
+        index = 0 if choice == "cuda" else _cuda_index(choice)
+        if index >= count:
+            raise DeviceError(f"device = {choice!r} does not exist; this machine has {count} CUDA "
+                              f"device(s): cuda:0..cuda:{count - 1}")
+        return f"cuda:{index}"
+    raise DeviceError(f"device = {choice!r} is not allowed; allowed: auto, cpu, cuda, cuda:N "
+                      f"(from --device, ${DEVICE_ENV} or the config's device key)")
+
+
+def _cuda_index(choice: str) -> int:
+    try:
+        return int(choice.split(":", 1)[1])
+    except ValueError:
+        raise DeviceError(f"device = {choice!r} is not allowed; use cuda:N with N an integer") from None
+
+
+def free_bytes(device: str) -> int | None:
+    """Free memory on the device in bytes, or None where it cannot be told."""
+    wp = _warp()
+    if device.startswith("cuda"):
+        return int(wp.get_device(device).free_memory)
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        return None
+
+
+def check_fits(device: str, needed_bytes: int, what: str) -> None:
+    """Fail before allocating when a scene needs more memory than the device has free."""
+    free = free_bytes(device)
+    if free is not None and needed_bytes > free:
+        raise DeviceError(f"the scene needs {needed_bytes / _GIB:.2f} GiB on {device} but only "
+                          f"{free / _GIB:.2f} GiB is free; {what}")
+
+
+def out_of_memory(device: str, needed_bytes: int, what: str) -> DeviceError:
+    return DeviceError(f"out of memory on {device}: the scene needs about {needed_bytes / _GIB:.2f} "
+                       f"GiB; {what}")

@@ -1,0 +1,34 @@
+"""Reading ``water.file`` height fields (no Warp needed, so configs validate quickly)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from warpcaustics.errors import ConfigError
+
+DEFAULT_RESOLUTION = 256
+"""Vertices per side when ``water.resolution`` is not given."""
+
+
+def load_heights(path: Path, resolution: int | None) -> np.ndarray:
+    """Read ``water.file``: a square 2-D array of finite heights [m], ``h[iy, ix]``."""
+    if not path.is_file():
+        raise ConfigError(f"water.file = {str(path)!r} does not exist; give the path of a .npy file "
+                          f"(relative paths start at the config file's folder)")
+    try:
+        heights = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise ConfigError(f"water.file = {str(path)!r} is not a readable .npy array: {exc}") from None
+    if heights.ndim != 2 or heights.shape[0] != heights.shape[1] or heights.shape[0] < 4:
+        raise ConfigError(f"water.file = {str(path)!r} has shape {heights.shape}; it must be a square "
+                          f"2-D array of heights, at least 4×4")
+    if not np.issubdtype(heights.dtype, np.number) or not np.all(np.isfinite(heights)):
+        raise ConfigError(f"water.file = {str(path)!r} must hold finite numbers (found NaN, inf or "
+                          f"non-numeric values)")
+    if resolution is not None and resolution != heights.shape[0]:
+        raise ConfigError(f"water.resolution = {resolution} disagrees with water.file, which is "
+                          f"{heights.shape[0]}×{heights.shape[0]}; remove water.resolution or set it "
+                          f"to {heights.shape[0]}")
+    return heights.astype(np.float32)

@@ -1,0 +1,145 @@
+"""Writers: OpenEXR (RGB + spectral bands), a PNG preview and run.json, each written atomically.
+
+Images are drawn as seen from above with +x to the right and +y up: image row 0 is the floor
+array's last row (largest y).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import struct
+import zlib
+from contextlib import contextmanager
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+
+from warpcaustics import __version__
+from warpcaustics.config import config_to_dict
+from warpcaustics.spectra import SpectralBins
+
+EMISSIVE_UNITS = "W.m^-2.nm^-1"
+
+
+@contextmanager
+def atomic_path(path: Path):
+    """Yield a temporary name beside ``path``; rename it onto ``path`` only if the block succeeds."""
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def spectral_channel_name(wavelength_nm: float) -> str:
+    """Fichet, Pacanowski & Wilkie (2021) spectral EXR channel: ``S0.550,000000nm``."""
+    return "S0." + f"{wavelength_nm:.6f}".replace(".", ",") + "nm"
+
+
+def write_exr(path: Path, rgb: np.ndarray, spectral: np.ndarray | None, wavelengths_nm: np.ndarray,
+              extra_header: dict[str, str]) -> None:
+    import OpenEXR
+
+    channels = {name: np.ascontiguousarray(rgb[..., i], dtype=np.float32) for i, name in enumerate("RGB")}
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    if spectral is not None:
+        for k, wl in enumerate(wavelengths_nm):
+            channels[spectral_channel_name(wl)] = np.ascontiguousarray(spectral[k], dtype=np.float32)
+        header["spectralLayoutVersion"] = "1.0"
+        header["emissiveUnits"] = EMISSIVE_UNITS
+    header.update(extra_header)
+    with atomic_path(path) as tmp, OpenEXR.File(header, channels) as exr:
+        exr.write(str(tmp))
+
+
+def write_png(path: Path, rgb8: np.ndarray) -> None:
+    """Minimal 8-bit RGB PNG writer (zlib + CRC), so previews need no imaging library."""
+    h, w, _ = rgb8.shape
+    raw = b"".join(b"\x00" + rgb8[row].tobytes() for row in range(h))
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+           + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(png)
+
+
+def write_json(path: Path, data: dict) -> None:
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(data, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+
+
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return str(value)
+
+
+def versions() -> dict[str, str]:
+    out = {"warpcaustics": __version__, "python": platform.python_version()}
+    for dist in ("warp-lang", "numpy", "colour-science", "openexr"):
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
+def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
+    """Write one frame's ``frame_NNNN.exr`` (RGB + spectral bands) and ``frame_NNNN.png``."""
+    from warpcaustics import colour_out
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    bins = SpectralBins(np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
+                                        result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2]))
+    image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
+    xyz = colour_out.spectral_to_xyz(image, bins)
+    rgb = colour_out.xyz_to_linear_srgb(xyz)
+    stem = f"frame_{frame:04d}"
+    paths = {"exr": out_dir / f"{stem}.exr", "png": out_dir / f"{stem}.png"}
+    write_exr(paths["exr"], rgb, image if result.scene.config.output.spectral_exr else None,
+              result.wavelengths_nm,
+              {"warpcaustics.quantity": "floor spectral irradiance",
+               "warpcaustics.extent_m": f"{result.extent_m:g}",
+               "warpcaustics.time_s": f"{result.time_s:g}"})
+    write_png(paths["png"], colour_out.tone_map_srgb8(rgb, xyz[..., 1]))
+    return paths
+
+
+def write_run_json(out_dir: Path, results: list) -> Path:
+    """Write ``run.json`` (resolved config, versions, device, per-frame timings and totals).
+
+    Written last, after every frame file: its presence marks a complete run.
+    """
+    first = results[0]
+    path = out_dir / "run.json"
+    write_json(path, {
+        "source": first.scene.source,
+        "config": config_to_dict(first.scene.config),
+        "device": first.device,
+        "versions": versions(),
+        "wavelengths_nm": first.wavelengths_nm,
+        "bin_widths_nm": first.bin_widths_nm,
+        "attenuation_per_m": first.attenuation_per_m,
+        "ior": first.ior,
+        "sun_irradiance_w_m2_nm": first.sun_irradiance,
+        "frames": [{
+            "frame": i,
+            "time_s": r.time_s,
+            "files": [f"frame_{i:04d}.exr", f"frame_{i:04d}.png"],
+            "timings_s": r.timings_s,
+            "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
+            "floor_flux_w_nm": r.floor_flux_w_nm,
+            "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
+        } for i, r in enumerate(results)],
+    })
+    return path

@@ -1,0 +1,147 @@
+"""One frame end to end: water → refraction → floor caustics → a RenderResult."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+from warpcaustics import caustics, spectra
+from warpcaustics import device as devices
+from warpcaustics.refraction import refract_to_floor
+from warpcaustics.scene import Scene
+from warpcaustics.water import make_water, water_bytes
+
+
+@dataclass
+class RenderResult:
+    """A rendered frame, as numpy arrays on the host."""
+
+    scene: Scene
+    time_s: float
+    device: str
+    wavelengths_nm: np.ndarray
+    """(K,) bin centres [nm]."""
+    bin_widths_nm: np.ndarray
+    """(K,) bin widths [nm]."""
+    floor_irradiance: np.ndarray
+    """(K, M, M) spectral irradiance on the floor [W m^-2 nm^-1]; row index along +y, texel
+    centres at ``(i + 0.5) L/M - L/2``."""
+    attenuation_per_m: np.ndarray
+    """(K,) beam attenuation c(λ) = a + b used [1/m]."""
+    ior: np.ndarray
+    """(K,) refractive index n(λ) used."""
+    sun_irradiance: np.ndarray
+    """(K,) solar spectral irradiance on a plane perpendicular to the beam [W m^-2 nm^-1]."""
+    transmitted_flux_w_nm: np.ndarray
+    """(K,) flux that enters the water and heads for the floor (after attenuation) [W nm^-1]."""
+    surface_positions: np.ndarray
+    """(N, N, 3) water surface vertices [m]."""
+    surface_normals: np.ndarray
+    """(N, N, 3) unit surface normals."""
+    timings_s: dict[str, float] = field(default_factory=dict)
+    """Wall time of each stage [s] (device synchronised)."""
+
+    @property
+    def extent_m(self) -> float:
+        return self.scene.config.water.extent_m
+
+    @property
+    def texel_area_m2(self) -> float:
+        return (self.extent_m / self.floor_irradiance.shape[-1]) ** 2
+
+    @property
+    def floor_flux_w_nm(self) -> np.ndarray:
+        """(K,) total flux on the floor [W nm^-1], summed in float64."""
+        return self.floor_irradiance.sum(axis=(1, 2), dtype=np.float64) * self.texel_area_m2
+
+    def save(self, out_dir: str | Path, *, frame: int = 0) -> dict[str, Path]:
+        """Write ``frame_NNNN.exr``, ``frame_NNNN.png`` and then ``run.json`` into out_dir.
+
+        Each file is written to a temporary name and renamed; run.json comes last.
+        """
+        from warpcaustics.output import save_frame, write_run_json
+
+        paths = save_frame(self, Path(out_dir), frame=frame)
+        paths["json"] = write_run_json(Path(out_dir), [self])
+        return paths
+
+
+class _Stopwatch:
+    def __init__(self, device: str):
+        self.device = device
+        self.timings: dict[str, float] = {}
+
+    def stage(self, name: str):
+        watch = self
+
+        class _Stage:
+            def __enter__(self):
+                self.t0 = time.perf_counter()
+
+            def __exit__(self, *exc):
+                wp.synchronize_device(watch.device)
+                watch.timings[name] = time.perf_counter() - self.t0
+
+        return _Stage()
+
+
+def scene_bytes(scene: Scene) -> int:
+    """Device memory one frame of this scene needs [bytes]."""
+    cfg = scene.config
+    n = scene.water_resolution
+    k = cfg.optics.wavelengths.bins
+    return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, 1)
+
+
+def render(scene: Scene, time_s: float = 0.0, device: str | None = None) -> RenderResult:
+    """Render the floor caustics of ``scene`` at ``time_s`` [s].
+
+    ``device``: ``"cpu"``, ``"cuda"``, ``"cuda:N"`` or None (``$WARPCAUSTICS_DEVICE``, then the
+    config's ``device``, then CUDA if available else CPU).
+    """
+    cfg = scene.config
+    dev = devices.resolve_device(device, config_value=cfg.device.value)
+    needed = scene_bytes(scene)
+    fix = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
+    devices.check_fits(dev, needed, fix)
+    try:
+        return _render(scene, float(time_s), dev)
+    except RuntimeError as exc:
+        if "alloc" in str(exc).lower() or "out of memory" in str(exc).lower():
+            raise devices.out_of_memory(dev, needed, fix) from None
+        raise
+
+
+def _render(scene: Scene, time_s: float, dev: str) -> RenderResult:
+    cfg = scene.config
+    watch = _Stopwatch(dev)
+    with watch.stage("setup"):
+        bins = spectra.bins_for(cfg.optics)
+        sun = spectra.sun_irradiance(bins)
+        optics = spectra.water_optics(cfg.optics.water_type, bins)
+        c = optics.attenuation_per_m
+        ior = np.full(1, cfg.optics.ior)  # one index group: no dispersion yet
+        water = make_water(cfg, dev, scene.heights)
+    sun_dir = scene.sun_direction
+    with watch.stage("water"):
+        surface = water.at(time_s)
+    with watch.stage("refraction"):
+        refracted = refract_to_floor(surface, ior, sun_dir, -cfg.floor.depth_m, dev)
+    with watch.stage("floor_caustics"):
+        floor, flux = caustics.floor_caustics(surface, refracted, sun_dir, sun, c,
+                                              cfg.caustics.map_resolution, dev)
+    with watch.stage("readback"):
+        floor_np = floor.numpy()
+        transmitted = flux.numpy().sum(axis=(1, 2, 3), dtype=np.float64)
+        positions = surface.positions.numpy()
+        normals = surface.normals.numpy()
+    k = len(bins.centres_nm)
+    return RenderResult(
+        scene=scene, time_s=time_s, device=dev, wavelengths_nm=bins.centres_nm,
+        bin_widths_nm=bins.widths_nm, floor_irradiance=floor_np, attenuation_per_m=c,
+        ior=np.full(k, cfg.optics.ior), sun_irradiance=sun, transmitted_flux_w_nm=transmitted,
+        surface_positions=positions, surface_normals=normals, timings_s=watch.timings)

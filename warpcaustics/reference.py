@@ -1,0 +1,171 @@
+"""Vectorised float64 numpy implementation of the flux-ratio floor caustics (refraction included).
+
+The same algorithm as the Warp kernels (``kernels/refract.py``, ``kernels/floor.py``), written
+independently with array operations and no Python loops over triangles or texels. It is the
+baseline of ``benchmarks/`` and a float64 cross-check in ``tests/``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+MIN_DOWNWARD_COS = 1.0e-3
+DEGENERATE_AREA_TEXELS = 1.0e-9
+_CHUNK_PAIRS = 1 << 18  # (triangle, texel) pairs clipped at once; bounds peak memory
+
+
+def fresnel_transmittance(cos_i: np.ndarray, eta: float) -> np.ndarray:
+    """Exact unpolarised Fresnel transmittance for ``eta = n1/n2`` (0 on TIR or cos_i <= 0)."""
+    cos_i = np.asarray(cos_i, dtype=np.float64)
+    k = 1.0 - eta**2 * (1.0 - cos_i**2)
+    ok = (cos_i > 0) & (k > 0)
+    cos_t = np.sqrt(np.where(ok, k, 1.0))
+    ci = np.where(ok, cos_i, 1.0)
+    rs = (eta * ci - cos_t) / (eta * ci + cos_t)
+    rp = (ci - eta * cos_t) / (ci + eta * cos_t)
+    return np.where(ok, 1.0 - 0.5 * (rs**2 + rp**2), 0.0)
+
+
+def refract(d: np.ndarray, n: np.ndarray, eta: float) -> np.ndarray:
+    """Snell's law for arrays of unit vectors (..., 3); zero vectors on TIR."""
+    c = -np.sum(n * d, axis=-1, keepdims=True)
+    k = 1.0 - eta**2 * (1.0 - c**2)
+    t = eta * d + (eta * c - np.sqrt(np.maximum(k, 0.0))) * n
+    return np.where(k >= 0, t, 0.0)
+
+
+def refract_to_floor(positions, normals, sun_dir, ior, floor_z):
+    """Per-vertex floor hit (N, N, 2), path length (N, N) and transmittance (N, N)."""
+    eta = 1.0 / ior
+    s = np.asarray(sun_dir, np.float64)
+    cos_i = normals @ s
+    d = refract(np.broadcast_to(-s, normals.shape), normals, eta)
+    ok = (cos_i > 0) & (d[..., 2] < -MIN_DOWNWARD_COS)
+    t = np.where(ok[..., None], d / np.linalg.norm(np.where(ok[..., None], d, 1.0), axis=-1,
+                                                   keepdims=True), [0.0, 0.0, -1.0])
+    ell = (floor_z - positions[..., 2]) / t[..., 2]
+    hit = positions[..., :2] + ell[..., None] * t[..., :2]
+    trans = np.where(ok, fresnel_transmittance(cos_i, eta), 0.0)
+    return hit, ell, trans
+
+
+def triangles(n: int, extent_m: float):
+    """Corner indices (T, 3) into the flattened grid and periodic shifts (T, 3, 2) [m].
+
+    Triangle order matches the kernels' ``(half, iy, ix)``: half 0 = corners (0,0),(1,0),(1,1);
+    half 1 = (0,0),(1,1),(0,1).
+    """
+    iy, ix = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    corners = {0: [(0, 0), (1, 0), (1, 1)], 1: [(0, 0), (1, 1), (0, 1)]}
+    idx, shift = [], []
+    for half in (0, 1):
+        ci, cs = [], []
+        for dx, dy in corners[half]:
+            cx, cy = ix + dx, iy + dy
+            cs.append(np.stack([(cx == n) * extent_m, (cy == n) * extent_m], axis=-1).reshape(-1, 2))
+            ci.append(((cy % n) * n + (cx % n)).reshape(-1))
+        idx.append(np.stack(ci, axis=1))
+        shift.append(np.stack(cs, axis=1))
+    return np.concatenate(idx), np.concatenate(shift).astype(np.float64)
+
+
+def _clip(px, py, count, axis, bound, keep_above):
+    """Vectorised Sutherland–Hodgman step on padded polygons (P, V) with per-row counts."""
+    p_count, v = px.shape
+    j = np.arange(v)
+    valid = j[None, :] < count[:, None]
+    jn = np.where(j[None, :] + 1 < count[:, None], j[None, :] + 1, 0)
+    nx = np.take_along_axis(px, jn, axis=1)
+    ny = np.take_along_axis(py, jn, axis=1)
+    a, b = (px, nx) if axis == 0 else (py, ny)
+    bound = bound[:, None]
+    sa, sb = (a - bound, b - bound) if keep_above else (bound - a, bound - b)
+    keep = valid & (sa >= 0)
+    cross = valid & ((sa >= 0) != (sb >= 0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(cross, sa / (sa - sb), 0.0)
+    # Two output slots per input edge: the kept vertex, then the crossing point.
+    ox = np.stack([px, px + t * (nx - px)], axis=2).reshape(p_count, 2 * v)
+    oy = np.stack([py, py + t * (ny - py)], axis=2).reshape(p_count, 2 * v)
+    om = np.stack([keep, cross], axis=2).reshape(p_count, 2 * v)
+    # Compact the kept slots to the left of each row (at most 8 survive a slab clip).
+    rows, cols = np.nonzero(om)
+    dest = (np.cumsum(om, axis=1) - 1)[rows, cols]
+    qx = np.zeros((p_count, 8))
+    qy = np.zeros((p_count, 8))
+    qx[rows, dest] = ox[rows, cols]
+    qy[rows, dest] = oy[rows, cols]
+    return qx, qy, om.sum(axis=1)
+
+
+def _area(px, py, count):
+    v = px.shape[1]
+    j = np.arange(v)
+    valid = j[None, :] < count[:, None]
+    jn = np.where(j[None, :] + 1 < count[:, None], j[None, :] + 1, 0)
+    nx = np.take_along_axis(px, jn, axis=1)
+    ny = np.take_along_axis(py, jn, axis=1)
+    return 0.5 * np.abs(np.sum(np.where(valid, px * ny - nx * py, 0.0), axis=1))
+
+
+def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradiance,
+                   attenuation_per_m, extent_m, map_resolution):
+    """Floor irradiance (K, M, M) [W m^-2 nm^-1] and per-triangle flux (K, T) [W nm^-1]."""
+    positions = np.asarray(positions, np.float64)
+    normals = np.asarray(normals, np.float64)
+    n = positions.shape[0]
+    m = map_resolution
+    hit, ell, trans = refract_to_floor(positions, normals, sun_dir, ior, -floor_depth_m)
+    idx, shift = triangles(n, extent_m)
+    p = positions.reshape(-1, 3)[idx]
+    p[..., :2] += shift
+    a_perp = 0.5 * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]) @ np.asarray(sun_dir, np.float64)
+    att = np.exp(-np.asarray(attenuation_per_m)[:, None, None] * ell.reshape(-1)[idx][None])
+    mean_t = np.mean(trans.reshape(-1)[idx][None] * att, axis=2)  # (K, T)
+    flux = np.where(a_perp > 0, np.asarray(sun_irradiance)[:, None] * a_perp * mean_t, 0.0)
+
+    q = (hit.reshape(-1, 2)[idx] + shift + 0.5 * extent_m) * (m / extent_m)  # (T, 3, 2) texels
+    lo = np.floor(q.min(axis=1)).astype(np.int64)
+    hi = np.floor(q.max(axis=1)).astype(np.int64)
+    q = q - lo[:, None, :]
+    e1, e2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    lit = np.nonzero(flux[0] > 0)[0]
+    single = (np.all(lo == hi, axis=1) | (area < DEGENERATE_AREA_TEXELS))[lit]
+
+    tri_parts, texel_parts, weight_parts = [], [], []
+    # Footprints inside one texel (or degenerate): everything to the centroid's texel.
+    t1 = lit[single]
+    c = lo[t1] + np.floor(q[t1].mean(axis=1)).astype(np.int64)
+    tri_parts.append(t1)
+    texel_parts.append((c[:, 1] % m) * m + (c[:, 0] % m))
+    weight_parts.append(np.ones(len(t1)))
+    # Larger footprints: clip against every texel of the bounding box.
+    tm = lit[~single]
+    span = hi[tm] - lo[tm] + 1
+    counts = span[:, 0] * span[:, 1]
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    # Chunk boundaries (in triangles) so that each chunk clips at most ~_CHUNK_PAIRS pairs.
+    bounds = np.unique(np.searchsorted(starts, np.arange(0, starts[-1], _CHUNK_PAIRS), side="right") - 1)
+    for b0, b1 in zip(bounds, np.append(bounds[1:], len(tm))):
+        tri = np.repeat(tm[b0:b1], counts[b0:b1])
+        local = np.arange(starts[b0], starts[b1]) - np.repeat(starts[b0:b1], counts[b0:b1])
+        w_span = np.repeat(span[b0:b1, 0], counts[b0:b1])
+        ci, cj = local % w_span, local // w_span
+        px = np.zeros((len(tri), 8))
+        py = np.zeros((len(tri), 8))
+        px[:, :3] = q[tri, :, 0]
+        py[:, :3] = q[tri, :, 1]
+        cnt = np.full(len(tri), 3)
+        for axis, b, above in ((0, ci, True), (0, ci + 1, False), (1, cj, True), (1, cj + 1, False)):
+            px, py, cnt = _clip(px, py, cnt, axis, b.astype(np.float64), above)
+        overlap = np.where(cnt >= 3, _area(px, py, cnt), 0.0)
+        tri_parts.append(tri)
+        texel_parts.append(((lo[tri, 1] + cj) % m) * m + (lo[tri, 0] + ci) % m)
+        weight_parts.append(overlap / area[tri])
+    tri = np.concatenate(tri_parts)
+    texel = np.concatenate(texel_parts)
+    weight = np.concatenate(weight_parts) * (m / extent_m) ** 2
+    floor = np.stack([np.bincount(texel, weights=weight * flux[k, tri], minlength=m * m)
+                      for k in range(flux.shape[0])]).reshape(-1, m, m)
+    return floor, flux

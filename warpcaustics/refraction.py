@@ -1,0 +1,39 @@
+"""Per-vertex refraction of the sun through the water surface (host side)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.kernels import refract as refract_kernels
+from warpcaustics.water import Surface
+
+
+@dataclass
+class Refracted:
+    """Where each vertex's refracted sun ray meets the floor, per index group g (G, N, N)."""
+
+    hit_xy: wp.array3d
+    """Floor intersection (x, y) [m]; not wrapped into the patch."""
+    path_m: wp.array3d
+    """Path length from the surface vertex to the floor [m]."""
+    transmittance: wp.array3d
+    """Exact unpolarised Fresnel transmittance (0 where the vertex is lit from behind)."""
+
+
+def refract_to_floor(surface: Surface, ior: np.ndarray, sun_dir: np.ndarray, floor_z_m: float,
+                     device: str) -> Refracted:
+    """Refract the sun at every vertex for each refractive index in ``ior`` (one per group)."""
+    n = surface.resolution
+    groups = len(ior)
+    hit = wp.empty((groups, n, n), dtype=wp.vec2, device=device)
+    path = wp.empty((groups, n, n), dtype=wp.float32, device=device)
+    trans = wp.empty((groups, n, n), dtype=wp.float32, device=device)
+    wp.launch(refract_kernels.refract_to_floor, dim=(groups, n, n),
+              inputs=[surface.positions, surface.normals,
+                      wp.array(np.asarray(ior, np.float32), dtype=wp.float32, device=device),
+                      wp.vec3(*np.asarray(sun_dir, np.float32)), float(floor_z_m)],
+              outputs=[hit, path, trans], device=device)
+    return Refracted(hit, path, trans)

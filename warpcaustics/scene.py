@@ -1,0 +1,62 @@
+"""A validated scene: the configuration plus what it refers to (a height-field file)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from warpcaustics.config import Config, WaterModel, config_from_dict, read_toml
+from warpcaustics.heights import DEFAULT_RESOLUTION, load_heights
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything a render needs besides time and device; build it with :func:`load_scene`."""
+
+    config: Config
+    base_dir: Path = field(default_factory=Path.cwd)
+    """Folder that relative paths in the config start from."""
+    heights: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``water.file``'s heights [m] for ``water.model = "heightfield"``."""
+    source: str | None = None
+    """The file the scene came from, if any."""
+
+    @property
+    def water_resolution(self) -> int:
+        return self.config.water.resolution
+
+    @property
+    def sun_direction(self) -> np.ndarray:
+        """Unit vector towards the sun (z up; azimuth from +x towards +y)."""
+        el = math.radians(self.config.sun.elevation_deg)
+        az = math.radians(self.config.sun.azimuth_deg)
+        return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+
+
+def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) -> Scene:
+    """Load what the config refers to and fill in ``water.resolution`` (file shape or default)."""
+    heights = None
+    n = cfg.water.resolution or DEFAULT_RESOLUTION
+    if cfg.water.model is WaterModel.HEIGHTFIELD:
+        path = Path(cfg.water.file)
+        heights = load_heights(path if path.is_absolute() else base_dir / path, cfg.water.resolution)
+        n = heights.shape[0]
+    cfg = dataclasses.replace(cfg, water=dataclasses.replace(cfg.water, resolution=n))
+    return Scene(cfg, base_dir, heights, source)
+
+
+def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Scene:
+    """Read and validate a TOML scene; ``overrides`` maps dotted keys to values.
+
+    ``load_scene(None, {...})`` builds a scene from the defaults and the overrides alone.
+    Raises :class:`warpcaustics.errors.ConfigError` with a one-line message on any bad input.
+    """
+    table = read_toml(path) if path is not None else {}
+    cfg = config_from_dict(table, overrides)
+    base = Path(path).resolve().parent if path is not None else Path.cwd()
+    return scene_from_config(cfg, base, str(path) if path is not None else None)

@@ -1,0 +1,203 @@
+"""Water surfaces: every model gives device arrays of vertex positions and unit normals.
+
+Vertices sit at cell centres ``(i + 0.5)·L/N − L/2`` of a periodic N×N grid, row index along +y.
+Models: ``flat`` and ``heightfield`` (a periodic height field, normals by central differences) and
+``fft`` (Tessendorf's ocean with a Phillips spectrum; heights and slopes by inverse FFT in Warp).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config, WaterModel
+from warpcaustics.heights import DEFAULT_RESOLUTION
+from warpcaustics.kernels import heightfield as hf_kernels
+from warpcaustics.kernels import ocean as ocean_kernels
+
+GRAVITY_M_S2 = 9.81
+
+
+@dataclass
+class Surface:
+    """The water surface at one instant, on the device."""
+
+    positions: wp.array2d
+    """(N, N) vertex positions [m], ``positions[iy, ix]``."""
+    normals: wp.array2d
+    """(N, N) unit normals pointing up, out of the water."""
+    extent_m: float
+    """Side L of the periodic patch [m]."""
+
+    @property
+    def resolution(self) -> int:
+        return self.positions.shape[0]
+
+
+class HeightfieldWater:
+    """A static periodic height field (``flat`` is all zeros)."""
+
+    def __init__(self, heights: np.ndarray, extent_m: float, device: str):
+        self.device = device
+        self.extent_m = extent_m
+        self.heights = wp.array(np.ascontiguousarray(heights, dtype=np.float32), dtype=wp.float32,
+                                device=device)
+
+    def at(self, time_s: float) -> Surface:
+        n = self.heights.shape[0]
+        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        wp.launch(hf_kernels.heightfield_surface, dim=(n, n),
+                  inputs=[self.heights, self.extent_m], outputs=[positions, normals],
+                  device=self.device)
+        return Surface(positions, normals, self.extent_m)
+
+
+def wavenumbers(n: int, extent_m: float) -> np.ndarray:
+    """Wavenumbers of the FFT grid, in numpy's FFT order [rad/m]."""
+    return 2.0 * np.pi * np.fft.fftfreq(n, d=extent_m / n)
+
+
+def phillips_spectrum(kx: np.ndarray, ky: np.ndarray, *, amplitude: float, wind_speed_m_s: float,
+                      wind_direction_deg: float, small_wave_m: float) -> np.ndarray:
+    """Phillips spectrum P(k) [m^4] (Tessendorf 2001, eq. 40–41), zero at k = 0.
+
+    ``P = A exp(-1/(k l)^2)/k^4 |k̂·ŵ|^2 exp(-k^2 l_small^2)`` with ``l = V^2/g``; its integral over
+    the k-plane is the height variance ``A π l^2 / 2`` (without the small-wave factor).
+    """
+    k2 = kx**2 + ky**2
+    k = np.sqrt(k2)
+    big_l = wind_speed_m_s**2 / GRAVITY_M_S2
+    w = np.radians(wind_direction_deg)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos_kw = (kx * np.cos(w) + ky * np.sin(w)) / k
+        p = amplitude * np.exp(-1.0 / (k2 * big_l**2)) / k2**2 * cos_kw**2 * np.exp(-k2 * small_wave_m**2)
+    p[k == 0.0] = 0.0
+    return p
+
+
+def initial_spectrum(n: int, extent_m: float, *, seed: int, **phillips) -> np.ndarray:
+    """h̃0(k) = ξ sqrt(P(k) Δk² / 2), ξ complex unit Gaussian (Tessendorf eq. 42), FFT order.
+
+    With this scaling the variance of h(x, t) is Σ_k P(k) Δk² ≈ ∫P d²k. The Nyquist row and column
+    are zeroed so that the spectrum shifted to cell centres stays Hermitian (real heights).
+    """
+    k = wavenumbers(n, extent_m)
+    kx, ky = np.meshgrid(k, k)
+    dk = 2.0 * np.pi / extent_m
+    rng = np.random.default_rng(seed)
+    xi = (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))) / np.sqrt(2.0)
+    h0 = xi * np.sqrt(phillips_spectrum(kx, ky, **phillips) * dk * dk / 2.0)
+    h0[n // 2, :] = 0.0
+    h0[:, n // 2] = 0.0
+    return h0
+
+
+def to_vec2(a: np.ndarray, device: str) -> wp.array:
+    c = np.ascontiguousarray(a, dtype=np.complex64)
+    return wp.array(c.view(np.float32).reshape(*c.shape, 2), dtype=wp.vec2, device=device)
+
+
+def from_vec2(a: wp.array) -> np.ndarray:
+    v = a.numpy()
+    return v[..., 0].astype(np.complex128) + 1j * v[..., 1]
+
+
+def ifft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
+    """In-place unnormalised 2-D inverse DFT of a square complex (vec2) array: Σ X e^{+2πi…}.
+
+    Equals ``numpy.fft.ifft2(x) * N**2``. Rows by ``wp.tile_ifft``, a transpose, rows again, and
+    a transpose back.
+    """
+    return _fft2(data, ocean_kernels.row_ifft_kernel(data.shape[0]), scratch)
+
+
+def fft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
+    """In-place unnormalised 2-D forward DFT of a square complex (vec2) array (= numpy.fft.fft2)."""
+    return _fft2(data, ocean_kernels.row_fft_kernel(data.shape[0]), scratch)
+
+
+def _fft2(data: wp.array2d, row_kernel, scratch: wp.array2d | None) -> wp.array2d:
+    n = data.shape[0]
+    if data.shape != (n, n) or n & (n - 1):
+        raise ValueError(f"FFT needs a square power-of-two array, got {data.shape}")
+    device = data.device
+    if scratch is None:
+        scratch = wp.empty_like(data)
+    wp.launch_tiled(row_kernel, dim=[n], inputs=[data], block_dim=64, device=device)
+    wp.launch(ocean_kernels.transpose, dim=(n, n), inputs=[data, scratch], device=device)
+    wp.launch_tiled(row_kernel, dim=[n], inputs=[scratch], block_dim=64, device=device)
+    wp.launch(ocean_kernels.transpose, dim=(n, n), inputs=[scratch, data], device=device)
+    return data
+
+
+class FFTOcean:
+    """Tessendorf FFT ocean with a Phillips spectrum; deep-or-finite-depth dispersion."""
+
+    def __init__(self, n: int, extent_m: float, depth_m: float, device: str, *, seed: int,
+                 **phillips):
+        self.device = device
+        self.extent_m = extent_m
+        k = wavenumbers(n, extent_m)
+        kx, ky = np.meshgrid(k, k)
+        kmag = np.hypot(kx, ky)
+        # Dispersion over a floor at depth h: ω² = g k tanh(k h) (Tessendorf eq. 19).
+        omega = np.sqrt(GRAVITY_M_S2 * kmag * np.tanh(kmag * depth_m))
+        h0 = initial_spectrum(n, extent_m, seed=seed, **phillips)
+        h0_minus = h0[(-np.arange(n)) % n][:, (-np.arange(n)) % n]
+        # Vertex (ix, iy) is at x0 + ix L/N with x0 = -L/2 + L/(2N): fold e^{i k·x0} into h̃0.
+        x0 = -0.5 * extent_m + 0.5 * extent_m / n
+        shift = np.exp(1j * (kx + ky) * x0)
+        self.h0 = to_vec2(h0 * shift, device)
+        self.h0_minus_conj = to_vec2(np.conj(h0_minus) * shift, device)
+        self.omega = wp.array(omega.astype(np.float32), dtype=wp.float32, device=device)
+        self.k_axis = wp.array(k.astype(np.float32), dtype=wp.float32, device=device)
+        self._a = wp.empty((n, n), dtype=wp.vec2, device=device)
+        self._b = wp.empty((n, n), dtype=wp.vec2, device=device)
+        self._scratch = wp.empty((n, n), dtype=wp.vec2, device=device)
+
+    @property
+    def resolution(self) -> int:
+        return self.h0.shape[0]
+
+    def spectra_at(self, time_s: float) -> tuple[wp.array2d, wp.array2d]:
+        """Device spectra (H + i·i kx H, i ky H) at time t (before the inverse FFT)."""
+        n = self.resolution
+        wp.launch(ocean_kernels.evolve_spectrum, dim=(n, n),
+                  inputs=[self.h0, self.h0_minus_conj, self.omega, self.k_axis, float(time_s)],
+                  outputs=[self._a, self._b], device=self.device)
+        return self._a, self._b
+
+    def at(self, time_s: float) -> Surface:
+        n = self.resolution
+        a, b = self.spectra_at(time_s)
+        ifft2(a, self._scratch)
+        ifft2(b, self._scratch)
+        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        wp.launch(ocean_kernels.assemble_surface, dim=(n, n), inputs=[a, b, self.extent_m],
+                  outputs=[positions, normals], device=self.device)
+        return Surface(positions, normals, self.extent_m)
+
+
+def water_bytes(cfg: Config, n: int) -> int:
+    """Device memory the water model holds for an N×N grid [bytes]."""
+    surface = n * n * 24  # positions + normals (vec3f)
+    if cfg.water.model is WaterModel.FFT:
+        return surface + n * n * (8 * 5 + 4)  # h0, h0-, two spectra, scratch (vec2f) + omega
+    return surface + n * n * 4
+
+
+def make_water(cfg: Config, device: str, heights: np.ndarray | None):
+    """Build the surface model named by ``water.model``."""
+    w = cfg.water
+    if w.model is WaterModel.FFT:
+        return FFTOcean(w.resolution or DEFAULT_RESOLUTION, w.extent_m, cfg.floor.depth_m, device,
+                        seed=w.seed, amplitude=w.phillips_amplitude, wind_speed_m_s=w.wind_speed_m_s,
+                        wind_direction_deg=w.wind_direction_deg, small_wave_m=w.small_wave_m)
+    if w.model is WaterModel.HEIGHTFIELD:
+        return HeightfieldWater(heights, w.extent_m, device)
+    n = w.resolution or DEFAULT_RESOLUTION
+    return HeightfieldWater(np.zeros((n, n), np.float32), w.extent_m, device)
