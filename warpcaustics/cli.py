@@ -55,12 +55,13 @@ def _render(args: argparse.Namespace) -> int:
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
 
     from warpcaustics.output import save_frame, write_run_json
-    from warpcaustics.pipeline import render
+    from warpcaustics.pipeline import Renderer
 
+    renderer = Renderer(scene, args.device)
     results = []
     for frame in range(args.frames):
         t0 = time.perf_counter()
-        result = render(scene, time_s=args.time + frame / args.fps, device=args.device)
+        result = renderer.render(args.time + frame / args.fps)
         save_frame(result, out, frame=frame)
         results.append(result)
         print(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "

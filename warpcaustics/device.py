@@ -11,6 +11,7 @@ DEVICE_ENV = "WARPCAUSTICS_DEVICE"
 """Environment variable that overrides the config's ``device`` (the CLI's --device wins over it)."""
 
 _GIB = 1024.0**3
+_notice_given = False
 
 
 def _warp():
@@ -41,7 +42,10 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
     if choice == "auto":
         if wp.get_cuda_device_count() > 0:
             return "cuda:0"
-        print("warpcaustics: no CUDA device found; running on the CPU", file=sys.stderr)
+        global _notice_given
+        if not _notice_given:
+            print("warpcaustics: no CUDA device found; running on the CPU", file=sys.stderr)
+            _notice_given = True
         return "cpu"
     if choice == "cuda" or choice.startswith("cuda:"):
         count = wp.get_cuda_device_count()

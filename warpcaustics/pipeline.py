@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -97,51 +98,77 @@ def scene_bytes(scene: Scene) -> int:
     return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, 1)
 
 
+class Renderer:
+    """Renders frames of one scene on one device; holds the water model and spectral tables.
+
+    Use one Renderer for an animation so the ocean spectrum is built once (and, for the stateful
+    pools of later models, so state carries over between frames).
+    """
+
+    def __init__(self, scene: Scene, device: str | None = None):
+        cfg = scene.config
+        self.scene = scene
+        self.device = devices.resolve_device(device, config_value=cfg.device.value)
+        self.bytes_needed = scene_bytes(scene)
+        devices.check_fits(self.device, self.bytes_needed, _MEMORY_FIX)
+        self.bins = spectra.bins_for(cfg.optics)
+        self.sun_irradiance = spectra.sun_irradiance(self.bins)
+        self.attenuation_per_m = spectra.water_optics(cfg.optics.water_type, self.bins).attenuation_per_m
+        self.group_ior = np.full(1, cfg.optics.ior)  # one index group: no dispersion yet
+        with _memory_errors(self.device, self.bytes_needed):
+            self.water = make_water(cfg, self.device, scene.heights)
+
+    def render(self, time_s: float = 0.0) -> RenderResult:
+        """Render the floor caustics at ``time_s`` [s]."""
+        with _memory_errors(self.device, self.bytes_needed):
+            return self._render(float(time_s))
+
+    def _render(self, time_s: float) -> RenderResult:
+        cfg = self.scene.config
+        dev = self.device
+        sun_dir = self.scene.sun_direction
+        watch = _Stopwatch(dev)
+        with watch.stage("water"):
+            surface = self.water.at(time_s)
+        with watch.stage("refraction"):
+            refracted = refract_to_floor(surface, self.group_ior, sun_dir, -cfg.floor.depth_m, dev)
+        with watch.stage("floor_caustics"):
+            floor, flux = caustics.floor_caustics(surface, refracted, sun_dir, self.sun_irradiance,
+                                                  self.attenuation_per_m, cfg.caustics.map_resolution,
+                                                  dev)
+        with watch.stage("readback"):
+            floor_np = floor.numpy()
+            transmitted = flux.numpy().sum(axis=(1, 2, 3), dtype=np.float64)
+            positions = surface.positions.numpy()
+            normals = surface.normals.numpy()
+        k = len(self.bins.centres_nm)
+        return RenderResult(
+            scene=self.scene, time_s=time_s, device=dev, wavelengths_nm=self.bins.centres_nm,
+            bin_widths_nm=self.bins.widths_nm, floor_irradiance=floor_np,
+            attenuation_per_m=self.attenuation_per_m, ior=np.full(k, cfg.optics.ior),
+            sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
+            surface_positions=positions, surface_normals=normals, timings_s=watch.timings)
+
+
+_MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
+
+
+@contextmanager
+def _memory_errors(device: str, needed: int):
+    """Turn Warp's allocation failures into a one-line DeviceError that states the need."""
+    try:
+        yield
+    except RuntimeError as exc:
+        text = str(exc).lower()
+        if "alloc" in text or "out of memory" in text:
+            raise devices.out_of_memory(device, needed, _MEMORY_FIX) from None
+        raise
+
+
 def render(scene: Scene, time_s: float = 0.0, device: str | None = None) -> RenderResult:
     """Render the floor caustics of ``scene`` at ``time_s`` [s].
 
     ``device``: ``"cpu"``, ``"cuda"``, ``"cuda:N"`` or None (``$WARPCAUSTICS_DEVICE``, then the
-    config's ``device``, then CUDA if available else CPU).
+    config's ``device``, then CUDA if available else CPU). For many frames use :class:`Renderer`.
     """
-    cfg = scene.config
-    dev = devices.resolve_device(device, config_value=cfg.device.value)
-    needed = scene_bytes(scene)
-    fix = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
-    devices.check_fits(dev, needed, fix)
-    try:
-        return _render(scene, float(time_s), dev)
-    except RuntimeError as exc:
-        if "alloc" in str(exc).lower() or "out of memory" in str(exc).lower():
-            raise devices.out_of_memory(dev, needed, fix) from None
-        raise
-
-
-def _render(scene: Scene, time_s: float, dev: str) -> RenderResult:
-    cfg = scene.config
-    watch = _Stopwatch(dev)
-    with watch.stage("setup"):
-        bins = spectra.bins_for(cfg.optics)
-        sun = spectra.sun_irradiance(bins)
-        optics = spectra.water_optics(cfg.optics.water_type, bins)
-        c = optics.attenuation_per_m
-        ior = np.full(1, cfg.optics.ior)  # one index group: no dispersion yet
-        water = make_water(cfg, dev, scene.heights)
-    sun_dir = scene.sun_direction
-    with watch.stage("water"):
-        surface = water.at(time_s)
-    with watch.stage("refraction"):
-        refracted = refract_to_floor(surface, ior, sun_dir, -cfg.floor.depth_m, dev)
-    with watch.stage("floor_caustics"):
-        floor, flux = caustics.floor_caustics(surface, refracted, sun_dir, sun, c,
-                                              cfg.caustics.map_resolution, dev)
-    with watch.stage("readback"):
-        floor_np = floor.numpy()
-        transmitted = flux.numpy().sum(axis=(1, 2, 3), dtype=np.float64)
-        positions = surface.positions.numpy()
-        normals = surface.normals.numpy()
-    k = len(bins.centres_nm)
-    return RenderResult(
-        scene=scene, time_s=time_s, device=dev, wavelengths_nm=bins.centres_nm,
-        bin_widths_nm=bins.widths_nm, floor_irradiance=floor_np, attenuation_per_m=c,
-        ior=np.full(k, cfg.optics.ior), sun_irradiance=sun, transmitted_flux_w_nm=transmitted,
-        surface_positions=positions, surface_normals=normals, timings_s=watch.timings)
+    return Renderer(scene, device).render(time_s)

@@ -1,0 +1,180 @@
+"""Bad input gives one clear line and no output; good input writes complete, readable files."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import warpcaustics as wc
+from warpcaustics.cli import main
+from warpcaustics.errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = ["--set", "water.resolution=32", "--set", "caustics.map_resolution=32",
+         "--set", "optics.wavelengths.bins=4"]
+
+
+def _fails_cleanly(capsys, tmp_path, args, *needles):
+    out_dir = tmp_path / "out"
+    code = main(["render", *args, "--out", str(out_dir), "--device", "cpu"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith("warpcaustics: error: "), err
+    assert "Traceback" not in err[0]
+    for needle in needles:
+        assert needle in err[0], err[0]
+    assert not out_dir.exists(), "a failed run must leave no output behind"
+    return err[0]
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_malformed_toml(capsys, tmp_path):
+    """A file that is not TOML names the file and the parse position."""
+    _fails_cleanly(capsys, tmp_path, [_write(tmp_path, "[water\nmodel = 'fft'\n")], "not valid TOML",
+                   "line 1")
+
+
+def test_missing_file(capsys, tmp_path):
+    """A config path that does not exist says so."""
+    _fails_cleanly(capsys, tmp_path, [str(tmp_path / "nope.toml")], "does not exist")
+
+
+def test_unknown_key_names_nearest(capsys, tmp_path):
+    """An unknown key is named with its value and the nearest valid key."""
+    _fails_cleanly(capsys, tmp_path, [_write(tmp_path, "[sun]\nelevaton_deg = 30\n")],
+                   "sun.elevaton_deg", "nearest valid key: 'sun.elevation_deg'")
+
+
+def test_unknown_key_in_override(capsys, tmp_path):
+    """The same check applies to --set overrides."""
+    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "floor.dept_m=3"],
+                   "floor.dept_m", "'floor.depth_m'")
+
+
+def test_wrong_type(capsys, tmp_path):
+    """A value of the wrong type names the key, the value and the expected type."""
+    _fails_cleanly(capsys, tmp_path, [_write(tmp_path, "[floor]\ndepth_m = \"deep\"\n")],
+                   "floor.depth_m", "'deep'", "expected a number")
+
+
+def test_out_of_range(capsys, tmp_path):
+    """An out-of-range value names the key, the value and the allowed range."""
+    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "sun.elevation_deg=95"],
+                   "sun.elevation_deg = 95.0", "0.0 < value <= 90.0")
+
+
+def test_bad_enum_value(capsys, tmp_path):
+    """A value outside a closed set lists what is allowed."""
+    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "water.model=wavy"],
+                   "water.model = 'wavy'", "flat, heightfield, fft")
+
+
+def test_heightfield_resolution_disagreement(capsys, tmp_path):
+    """water.resolution that disagrees with water.file names both numbers."""
+    np.save(tmp_path / "h.npy", np.zeros((16, 16)))
+    cfg = _write(tmp_path, "[water]\nmodel = 'heightfield'\nfile = 'h.npy'\nresolution = 32\n")
+    _fails_cleanly(capsys, tmp_path, [cfg], "water.resolution = 32", "16×16")
+
+
+@pytest.mark.parametrize(("array", "needle"), [(np.zeros((8, 12)), "square"),
+                                              (np.full((8, 8), np.nan), "finite")])
+def test_heightfield_bad_arrays(capsys, tmp_path, array, needle):
+    """Non-square or non-finite height files are rejected naming water.file."""
+    np.save(tmp_path / "h.npy", array)
+    cfg = _write(tmp_path, "[water]\nmodel = 'heightfield'\nfile = 'h.npy'\n")
+    _fails_cleanly(capsys, tmp_path, [cfg], "water.file", needle)
+
+
+def test_scene_too_big_for_memory(capsys, tmp_path):
+    """A scene that cannot fit says how much it needs and which keys to lower."""
+    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set",
+                                      "caustics.map_resolution=16384", "--set", "optics.wavelengths.bins=400"],
+                   "needs 400.", "GiB", "caustics.map_resolution")
+
+
+def test_cuda_requested_without_cuda(capsys, tmp_path):
+    """Asking for CUDA where there is none is a one-line error, not a Warp traceback."""
+    import warp as wp
+
+    if wp.get_cuda_device_count() > 0:
+        pytest.skip("this machine has CUDA")
+    out_dir = tmp_path / "out"
+    code = main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out_dir),
+                 "--device", "cuda"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "no CUDA device is available" in err[0]
+    assert not out_dir.exists()
+
+
+def test_python_overrides_and_errors():
+    """Python overrides use the same dotted keys and raise ConfigError with the same message."""
+    scene = wc.load_scene(ROOT / "configs/ocean.toml", overrides={"sun.elevation_deg": 45.0})
+    assert scene.config.sun.elevation_deg == 45.0
+    with pytest.raises(ConfigError, match="nearest valid key: 'sun.elevation_deg'"):
+        wc.load_scene(ROOT / "configs/ocean.toml", overrides={"sun.elevation": 45.0})
+
+
+def test_render_writes_complete_outputs(tmp_path, capsys):
+    """render writes an EXR whose bands are the floor map (image row 0 = largest y), a PNG and run.json."""
+    import OpenEXR
+
+    out = tmp_path / "out"
+    assert main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out),
+                 "--device", "cpu"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["frame_0000.exr", "frame_0000.png", "run.json"]
+    run = json.loads((out / "run.json").read_text())
+    assert run["config"]["water"]["resolution"] == 32 and run["device"] == "cpu"
+    assert {"warp-lang", "numpy", "warpcaustics"} <= set(run["versions"])
+    assert {"water", "refraction", "floor_caustics"} <= set(run["frames"][0]["timings_s"])
+
+    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32,
+                                                        "caustics.map_resolution": 32,
+                                                        "optics.wavelengths.bins": 4})
+    result = wc.render(scene, device="cpu")
+    with OpenEXR.File(str(out / "frame_0000.exr"), separate_channels=True) as exr:
+        channels = {name: np.array(ch.pixels) for name, ch in exr.channels().items()}
+        header = dict(exr.header())
+    names = [f"S0.{w:.6f}".replace(".", ",").replace("S0,", "S0.") + "nm" for w in result.wavelengths_nm]
+    assert names[0] == "S0.437,500000nm"
+    assert {"R", "G", "B", *names} <= set(channels)
+    assert header["spectralLayoutVersion"] == "1.0"
+    for k, name in enumerate(names):
+        np.testing.assert_allclose(channels[name], result.floor_irradiance[k, ::-1], rtol=1e-6)
+    assert (out / "frame_0000.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_device_environment_variable(tmp_path, monkeypatch):
+    """$WARPCAUSTICS_DEVICE picks the device when --device is not given."""
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "cpu")
+    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32,
+                                                        "caustics.map_resolution": 16,
+                                                        "optics.wavelengths.bins": 2})
+    assert wc.render(scene).device == "cpu"
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "tpu")
+    with pytest.raises(wc.WarpcausticsError, match="WARPCAUSTICS_DEVICE"):
+        wc.render(scene)
+
+
+def test_cli_help_and_entry_point():
+    """The installed console script answers --help for itself and each command."""
+    for args in ([], ["render"], ["info"]):
+        proc = subprocess.run([sys.executable, "-m", "warpcaustics", *args, "--help"],
+                              capture_output=True, text=True, cwd=ROOT, env=os.environ.copy())
+        assert proc.returncode == 0 and "usage:" in proc.stdout
+
+
+def test_import_is_light():
+    """``import warpcaustics`` does not pull in Warp, colour-science, OpenEXR or pyvista."""
+    code = ("import sys, warpcaustics; heavy = {'warp', 'colour', 'OpenEXR', 'pyvista'} & set(sys.modules);"
+            "print(sorted(heavy))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert proc.stdout.strip() == "[]"
