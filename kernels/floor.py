@@ -13,6 +13,7 @@ counter-clockwise seen from above. A corner past the last row/column wraps to in
 """
 
 import warp as wp
+
 from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
 
 wp.set_module_options({"enable_backward": False})
@@ -73,36 +74,36 @@ def triangle_flux(
     extent_m: float,
     flux_w_nm: wp.array4d[wp.float32],
 ):
-    """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at each wavelength k.
+    """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at every wavelength k.
+
+    ``flux_w_nm`` is (N, N, 2, K): a triangle's wavelengths are contiguous for the deposit.
 
     ``E_sun(k) * A_perp * mean_i(T_i exp(-c(k) l_i))``, with ``A_perp`` the triangle's area
     projected perpendicular to the sun (0 for triangles facing away from it).
     """
-    k, iy, ix, half = wp.tid()
+    iy, ix, half = wp.tid()
     n = positions.shape[0]
-    g = k / wavelengths_per_group
     x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
     x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
     p0 = lift(positions[y0, x0], s0)
     p1 = lift(positions[y1, x1], s1)
     p2 = lift(positions[y2, x2], s2)
-    a_perp = 0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir)
-    flux = float(0.0)
-    if a_perp > 0.0:
+    a_perp = wp.max(0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir), 0.0)
+    for k in range(sun_irradiance.shape[0]):
+        g = k / wavelengths_per_group
         c = attenuation_per_m[k]
         mean_t = (
             transmittance[g, y0, x0] * wp.exp(-c * path_m[g, y0, x0])
             + transmittance[g, y1, x1] * wp.exp(-c * path_m[g, y1, x1])
             + transmittance[g, y2, x2] * wp.exp(-c * path_m[g, y2, x2])
         ) / 3.0
-        flux = sun_irradiance[k] * a_perp * mean_t
-    flux_w_nm[k, half, iy, ix] = flux
+        flux_w_nm[iy, ix, half, k] = sun_irradiance[k] * a_perp * mean_t
 
 
 @wp.func
 def add_to_texel(
-    floor_irradiance: wp.array3d[wp.float32],
+    floor_texels: wp.array3d[wp.float32],
     flux_w_nm: wp.array4d[wp.float32],
     k_begin: int,
     k_count: int,
@@ -116,7 +117,7 @@ def add_to_texel(
     """Add ``weight`` × the triangle's flux to texel (ty, tx) of each wavelength of its group."""
     for j in range(k_count):
         k = k_begin + j
-        wp.atomic_add(floor_irradiance, k, ty, tx, weight * flux_w_nm[k, half, iy, ix])
+        wp.atomic_add(floor_texels, ty, tx, k, weight * flux_w_nm[iy, ix, half, k])
 
 
 @wp.kernel
@@ -125,18 +126,19 @@ def deposit_footprints(
     flux_w_nm: wp.array4d[wp.float32],
     wavelengths_per_group: int,
     extent_m: float,
-    floor_irradiance: wp.array3d[wp.float32],
+    floor_texels: wp.array3d[wp.float32],
 ):
     """Spread triangle (iy, ix, half)'s flux over its floor footprint for index group g.
 
-    ``floor_irradiance`` is (K, M, M) [W m^-2 nm^-1]; texel (ty, tx) spans
-    ``[tx, tx+1] * L/M - L/2`` in x. Weight of a texel = overlap area / footprint area.
+    ``floor_texels`` is (M, M, K) [W m^-2 nm^-1] (wavelengths contiguous: one cache line per
+    texel); texel (ty, tx) spans ``[tx, tx+1] * L/M - L/2`` in x. Weight of a texel = overlap area
+    / footprint area.
     """
     g, iy, ix, half = wp.tid()
     n = hit_xy.shape[1]
-    m = floor_irradiance.shape[1]
+    m = floor_texels.shape[0]
     k_begin = g * wavelengths_per_group
-    if flux_w_nm[k_begin, half, iy, ix] <= 0.0:
+    if flux_w_nm[iy, ix, half, k_begin] <= 0.0:
         return  # facing away from the sun or fully reflected: nothing to spread
     x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
@@ -162,7 +164,7 @@ def deposit_footprints(
         c = (q0 + q1 + q2) / 3.0
         tx = wrap(i_lo + int(wp.floor(c[0])), m)
         ty = wrap(j_lo + int(wp.floor(c[1])), m)
-        add_to_texel(floor_irradiance, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
+        add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
                      tx, ty, inv_texel_area)
         return
     px = vec8()
@@ -187,5 +189,13 @@ def deposit_footprints(
             rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
             if rn >= 3:
                 w = polygon_area(rx, ry, rn) / area * inv_texel_area
-                add_to_texel(floor_irradiance, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
+                add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
                              half, wrap(i_lo + ci, m), wrap(j_lo + cj, m), w)
+
+
+@wp.kernel
+def texels_to_bands(floor_texels: wp.array3d[wp.float32], floor_irradiance: wp.array3d[wp.float32]):
+    """(M, M, K) accumulation layout → (K, M, M) band images."""
+    ty, tx = wp.tid()
+    for k in range(floor_texels.shape[2]):
+        floor_irradiance[k, ty, tx] = floor_texels[ty, tx, k]

@@ -1,6 +1,7 @@
 """Per-vertex refraction of the sun into the water (Snell + exact Fresnel), one kernel."""
 
 import warp as wp
+
 from warpcaustics.kernels.geometry import fresnel_transmittance, refract
 
 wp.set_module_options({"enable_backward": False})

@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
-from conftest import fresnel_t_angles
 
 import warpcaustics as wc
 from warpcaustics import reference
+
+from conftest import fresnel_t_angles
 
 
 def _flat_scene(elevation_deg, depth_m, water_type="pure", **extra):
@@ -37,7 +38,8 @@ def test_flat_nonabsorbing_water_keeps_all_transmitted_flux(device):
     """water_type = none: floor flux = E_sun cosθ T(θ) L² exactly (nothing lost on the way down)."""
     result = wc.render(_flat_scene(50.0, 3.0, "none"), device=device)
     theta = np.radians(40.0)
-    expected = result.sun_irradiance * np.cos(theta) * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0] * 64.0
+    t_fresnel = fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
+    expected = result.sun_irradiance * np.cos(theta) * t_fresnel * 8.0**2  # L = 8 m
     np.testing.assert_allclose(result.floor_flux_w_nm, expected, rtol=1e-5)
 
 

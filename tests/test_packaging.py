@@ -19,11 +19,11 @@ def test_every_subpackage_is_listed():
     """An unlisted subpackage would silently drop out of the wheel."""
     setup = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     listed = set(setup["packages"])
-    found = {"warpcaustics." + ".".join(p.parent.relative_to(ROOT / "warpcaustics").parts)
-             for p in (ROOT / "warpcaustics").rglob("__init__.py")}
-    found = {name.rstrip(".") for name in found}
-    found |= {"warpcaustics.kernels" + "".join("." + part for part in p.parent.relative_to(ROOT / "kernels").parts)
-              for p in (ROOT / "kernels").rglob("__init__.py")}
+    def packages(folder: Path, name: str) -> set[str]:
+        return {".".join([name, *p.parent.relative_to(folder).parts]) for p in folder.rglob("__init__.py")}
+
+    found = packages(ROOT / "warpcaustics", "warpcaustics")
+    found |= packages(ROOT / "kernels", "warpcaustics.kernels")
     assert found == listed
     assert setup["package-dir"]["warpcaustics.kernels"] == "kernels"
 

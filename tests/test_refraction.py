@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 import warp as wp
-from conftest import fresnel_t_angles
 
 from warpcaustics.kernels import geometry
+
+from conftest import fresnel_t_angles
 
 
 @wp.kernel

@@ -14,31 +14,44 @@ def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4)
     triangle_flux = k * 2 * n * n * 4
-    return refraction + triangle_flux + k * m * m * 4
+    return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
 
 
-def floor_caustics(surface: Surface, refracted: Refracted, sun_dir: np.ndarray,
-                   sun_irradiance: np.ndarray, attenuation_per_m: np.ndarray, map_resolution: int,
-                   device: str) -> tuple[wp.array3d, wp.array4d]:
-    """Floor irradiance (K, M, M) [W m^-2 nm^-1] and the triangle fluxes (K, 2, N, N) [W nm^-1].
+class FloorCaustics:
+    """Owns the floor stage's device buffers, reused from frame to frame."""
 
-    Every triangle's flux lands on the floor: ``sum(floor) * texel_area == sum(flux)`` per band.
-    """
-    n = surface.resolution
-    k = len(sun_irradiance)
-    groups = refracted.hit_xy.shape[0]
-    per_group = k // groups
-    flux = wp.empty((k, 2, n, n), dtype=wp.float32, device=device)
-    wp.launch(floor_kernels.triangle_flux, dim=(k, n, n, 2),
-              inputs=[surface.positions, refracted.path_m, refracted.transmittance,
-                      wp.vec3(*np.asarray(sun_dir, np.float32)),
-                      wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device),
-                      wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
-                               device=device),
-                      per_group, float(surface.extent_m)],
-              outputs=[flux], device=device)
-    floor = wp.zeros((k, map_resolution, map_resolution), dtype=wp.float32, device=device)
-    wp.launch(floor_kernels.deposit_footprints, dim=(groups, n, n, 2),
-              inputs=[refracted.hit_xy, flux, per_group, float(surface.extent_m)],
-              outputs=[floor], device=device)
-    return floor, flux
+    def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
+                 attenuation_per_m: np.ndarray, device: str):
+        k = len(sun_irradiance)
+        m = map_resolution
+        self.device = device
+        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32,
+                                       device=device)
+        self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
+                                          device=device)
+        self.flux = wp.empty((n, n, 2, k), dtype=wp.float32, device=device)
+        """Flux per triangle and wavelength (N, N, 2, K) [W nm^-1]."""
+        self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
+        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
+
+    def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray) -> wp.array3d:
+        """Fill :attr:`irradiance`; every triangle's flux lands on the floor, so per band
+        ``sum(irradiance) * texel_area == sum(flux)`` to rounding."""
+        n = surface.resolution
+        k = self.sun_irradiance.shape[0]
+        m = self.texels.shape[0]
+        groups = refracted.hit_xy.shape[0]
+        per_group = k // groups
+        wp.launch(floor_kernels.triangle_flux, dim=(n, n, 2),
+                  inputs=[surface.positions, refracted.path_m, refracted.transmittance,
+                          wp.vec3(*np.asarray(sun_dir, np.float32)), self.sun_irradiance,
+                          self.attenuation_per_m, per_group, float(surface.extent_m)],
+                  outputs=[self.flux], device=self.device)
+        self.texels.zero_()
+        wp.launch(floor_kernels.deposit_footprints, dim=(groups, n, n, 2),
+                  inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m)],
+                  outputs=[self.texels], device=self.device)
+        wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
+                  outputs=[self.irradiance], device=self.device)
+        return self.irradiance

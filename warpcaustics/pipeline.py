@@ -12,7 +12,7 @@ import warp as wp
 
 from warpcaustics import caustics, spectra
 from warpcaustics import device as devices
-from warpcaustics.refraction import refract_to_floor
+from warpcaustics.refraction import Refracted, refract_to_floor
 from warpcaustics.scene import Scene
 from warpcaustics.water import make_water, water_bytes
 
@@ -117,6 +117,10 @@ class Renderer:
         self.group_ior = np.full(1, cfg.optics.ior)  # one index group: no dispersion yet
         with _memory_errors(self.device, self.bytes_needed):
             self.water = make_water(cfg, self.device, scene.heights)
+            n = scene.water_resolution
+            self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
+            self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
+                                                self.attenuation_per_m, self.device)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
@@ -131,14 +135,13 @@ class Renderer:
         with watch.stage("water"):
             surface = self.water.at(time_s)
         with watch.stage("refraction"):
-            refracted = refract_to_floor(surface, self.group_ior, sun_dir, -cfg.floor.depth_m, dev)
+            refracted = refract_to_floor(surface, self.group_ior, sun_dir, -cfg.floor.depth_m, dev,
+                                         out=self.refracted)
         with watch.stage("floor_caustics"):
-            floor, flux = caustics.floor_caustics(surface, refracted, sun_dir, self.sun_irradiance,
-                                                  self.attenuation_per_m, cfg.caustics.map_resolution,
-                                                  dev)
+            floor = self.floor.run(surface, refracted, sun_dir)
         with watch.stage("readback"):
             floor_np = floor.numpy()
-            transmitted = flux.numpy().sum(axis=(1, 2, 3), dtype=np.float64)
+            transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
         k = len(self.bins.centres_nm)

@@ -22,18 +22,22 @@ class Refracted:
     transmittance: wp.array3d
     """Exact unpolarised Fresnel transmittance (0 where the vertex is lit from behind)."""
 
+    @classmethod
+    def allocate(cls, groups: int, n: int, device: str) -> Refracted:
+        return cls(wp.empty((groups, n, n), dtype=wp.vec2, device=device),
+                   wp.empty((groups, n, n), dtype=wp.float32, device=device),
+                   wp.empty((groups, n, n), dtype=wp.float32, device=device))
+
 
 def refract_to_floor(surface: Surface, ior: np.ndarray, sun_dir: np.ndarray, floor_z_m: float,
-                     device: str) -> Refracted:
+                     device: str, out: Refracted | None = None) -> Refracted:
     """Refract the sun at every vertex for each refractive index in ``ior`` (one per group)."""
     n = surface.resolution
     groups = len(ior)
-    hit = wp.empty((groups, n, n), dtype=wp.vec2, device=device)
-    path = wp.empty((groups, n, n), dtype=wp.float32, device=device)
-    trans = wp.empty((groups, n, n), dtype=wp.float32, device=device)
+    out = out or Refracted.allocate(groups, n, device)
     wp.launch(refract_kernels.refract_to_floor, dim=(groups, n, n),
               inputs=[surface.positions, surface.normals,
                       wp.array(np.asarray(ior, np.float32), dtype=wp.float32, device=device),
                       wp.vec3(*np.asarray(sun_dir, np.float32)), float(floor_z_m)],
-              outputs=[hit, path, trans], device=device)
-    return Refracted(hit, path, trans)
+              outputs=[out.hit_xy, out.path_m, out.transmittance], device=device)
+    return out

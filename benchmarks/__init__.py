@@ -1,0 +1,1 @@
+"""Timed benchmarks of warpcaustics; run ``python -m benchmarks.run --help``."""

@@ -1,0 +1,91 @@
+"""Benchmark runner: ``python -m benchmarks.run [--quick] [--device cpu] [--out FILE]``.
+
+Prints a table and writes JSON (device, sizes, Warp version, timings, baselines measured in the
+same run, peak memory). Nothing here asserts a time: the quick mode only keeps the suite alive in CI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import platform
+import sys
+import time
+from importlib import metadata
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
+FULL = [(256, 512, 16, True), (512, 1024, 16, False), (1024, 2048, 16, False)]
+QUICK = [(128, 256, 8, True)]
+
+
+def _in_child(func_name: str, *args):
+    """Run benchmarks.frame.<func_name>(*args) in a fresh spawned process (own peak memory)."""
+    ctx = mp.get_context("spawn")
+    with ctx.Pool(1) as pool:
+        return pool.apply(_call, (func_name, args))
+
+
+def _call(func_name, args):
+    import os
+
+    os.chdir(ROOT)
+    sys.path.insert(0, str(ROOT))
+    from warpcaustics.device import _warp
+
+    _warp()
+    from benchmarks import frame
+
+    return getattr(frame, func_name)(*args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m benchmarks.run", description=__doc__.splitlines()[0])
+    p.add_argument("--quick", action="store_true", help="small sizes, one repeat (CI keeps it alive)")
+    p.add_argument("--device", default="cpu", help="Warp device for the Warp side (default cpu)")
+    p.add_argument("--repeats", type=int, default=None, help="timed repeats (default 5, quick 2)")
+    p.add_argument("--out", type=Path, default=None, help="JSON file (default benchmarks/results/...)")
+    args = p.parse_args(argv)
+    cases = QUICK if args.quick else FULL
+    repeats = args.repeats or (2 if args.quick else 5)
+
+    rows = []
+    for n, m, bins, with_numpy in cases:
+        warp_res = _in_child("measure_warp", n, m, bins, args.device, repeats)
+        numpy_res = _in_child("measure_numpy", n, m, bins, max(1, repeats // 2)) if with_numpy else None
+        row = {"water_n": n, "map_m": m, "bins": bins, "warp": warp_res, "numpy": numpy_res}
+        if numpy_res:
+            row["speedup_warp_vs_numpy"] = numpy_res["stages_s"] / warp_res["stages_s"]
+        rows.append(row)
+        speed = f"{row['speedup_warp_vs_numpy']:8.1f}x" if numpy_res else "       -"
+        np_time = f"{numpy_res['stages_s']:9.3f}" if numpy_res else "        -"
+        print(f"ocean frame  N={n:5d} M={m:5d} K={bins:3d} | warp[{args.device}] stages "
+              f"{warp_res['stages_s']:8.3f} s frame {warp_res['frame_s']:8.3f} s "
+              f"peak {warp_res['peak_rss_mib']:7.0f} MiB | numpy {np_time} s | ratio {speed}",
+              flush=True)
+
+    record = {
+        "benchmark": "ocean_frame_floor_caustics",
+        "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
+                   + f" --device {args.device}",
+        "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "machine": {"platform": platform.platform(), "processor": platform.processor(),
+                    "python": platform.python_version()},
+        "versions": {d: metadata.version(d) for d in ("warp-lang", "numpy")},
+        "repeats": repeats,
+        "timing": "median wall time; Warp after one warm-up frame, device synchronised",
+        "results": rows,
+    }
+    out = args.out or ROOT / "benchmarks" / "results" / (
+        f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(record, indent=2) + "\n")
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
