@@ -18,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 # (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
-FULL = [(256, 512, 16, True), (512, 1024, 16, False), (1024, 2048, 16, False)]
+FULL = [(256, 512, 16, True), (512, 1024, 16, True), (1024, 2048, 16, False)]
 QUICK = [(128, 256, 8, True)]
 
 
@@ -40,6 +40,16 @@ def _call(func_name, args):
     from benchmarks import frame
 
     return getattr(frame, func_name)(*args)
+
+
+def _cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -72,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
         "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
                    + f" --device {args.device}",
         "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "machine": {"platform": platform.platform(), "processor": platform.processor(),
+        "machine": {"platform": platform.platform(), "processor": _cpu_name(),
                     "python": platform.python_version()},
         "versions": {d: metadata.version(d) for d in ("warp-lang", "numpy")},
         "repeats": repeats,

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-__all__ = ["load_scene", "render", "RenderResult", "Scene", "WarpcausticsError", "__version__"]
+__all__ = ["load_scene", "render", "Renderer", "RenderResult", "Scene", "WarpcausticsError", "__version__"]
 
 
 def __getattr__(name: str):
@@ -16,7 +16,7 @@ def __getattr__(name: str):
         from warpcaustics import scene
 
         return getattr(scene, name)
-    if name in ("render", "RenderResult"):
+    if name in ("render", "Renderer", "RenderResult"):
         from warpcaustics import pipeline
 
         return getattr(pipeline, name)
