@@ -179,3 +179,26 @@ def test_import_is_light():
             "print(sorted(heavy))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert proc.stdout.strip() == "[]"
+
+
+def test_animation_writes_numbered_frames(tmp_path):
+    """--frames N --fps F writes N numbered frames at t = k/F and lists them in run.json."""
+    out = tmp_path / "anim"
+    assert main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out),
+                 "--device", "cpu", "--frames", "3", "--fps", "4"]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert [f["time_s"] for f in run["frames"]] == [0.0, 0.25, 0.5]
+    assert {f"frame_{k:04d}.exr" for k in range(3)} <= {p.name for p in out.iterdir()}
+    # The ocean moves: consecutive frames differ.
+    assert (out / "frame_0000.png").read_bytes() != (out / "frame_0001.png").read_bytes()
+
+
+def test_failed_write_leaves_nothing(tmp_path):
+    """A write that fails half-way leaves neither the file nor its temporary behind."""
+    from warpcaustics.output import atomic_path
+
+    target = tmp_path / "frame_0000.exr"
+    with pytest.raises(RuntimeError), atomic_path(target) as tmp:
+        tmp.write_bytes(b"half")
+        raise RuntimeError("disk full")
+    assert list(tmp_path.iterdir()) == []

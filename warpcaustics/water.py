@@ -119,6 +119,15 @@ def fft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
     return _fft2(data, ocean_kernels.row_fft_kernel(data.shape[0]), scratch)
 
 
+def fft_block_dim(n: int, device) -> int:
+    """Threads per row transform: 1 (the sequential path) on the CPU; on CUDA a power of two
+    that divides N and leaves each thread at least two elements, as cuFFTDx and Warp's scalar
+    GPU path require."""
+    if not wp.get_device(device).is_cuda:
+        return 1
+    return max(1, min(64, n // 2))
+
+
 def _fft2(data: wp.array2d, row_kernel, scratch: wp.array2d | None) -> wp.array2d:
     n = data.shape[0]
     if data.shape != (n, n) or n & (n - 1):
@@ -126,9 +135,10 @@ def _fft2(data: wp.array2d, row_kernel, scratch: wp.array2d | None) -> wp.array2
     device = data.device
     if scratch is None:
         scratch = wp.empty_like(data)
-    wp.launch_tiled(row_kernel, dim=[n], inputs=[data], block_dim=64, device=device)
+    block_dim = fft_block_dim(n, device)
+    wp.launch_tiled(row_kernel, dim=[n], inputs=[data], block_dim=block_dim, device=device)
     wp.launch(ocean_kernels.transpose, dim=(n, n), inputs=[data, scratch], device=device)
-    wp.launch_tiled(row_kernel, dim=[n], inputs=[scratch], block_dim=64, device=device)
+    wp.launch_tiled(row_kernel, dim=[n], inputs=[scratch], block_dim=block_dim, device=device)
     wp.launch(ocean_kernels.transpose, dim=(n, n), inputs=[scratch, data], device=device)
     return data
 
