@@ -9,6 +9,19 @@ vec8 = wp.types.vector(length=8, dtype=wp.float32)
 
 
 @wp.func
+def cell_centre(ix: int, iy: int, n: int, extent_m: float) -> wp.vec2:
+    """(x, y) [m] of cell (ix, iy) of an n×n grid over the patch: ``(i + 0.5) L/n - L/2``."""
+    cell = extent_m / float(n)
+    return wp.vec2((float(ix) + 0.5) * cell - 0.5 * extent_m, (float(iy) + 0.5) * cell - 0.5 * extent_m)
+
+
+@wp.func
+def normal_from_slopes(dh_dx: float, dh_dy: float) -> wp.vec3:
+    """Unit upward normal of a height field z = h(x, y) with the given slopes."""
+    return wp.normalize(wp.vec3(-dh_dx, -dh_dy, 1.0))
+
+
+@wp.func
 def refract(d: wp.vec3, n: wp.vec3, eta: float) -> wp.vec3:
     """Snell's law in vector form; ``eta = n1/n2``, ``n`` faces against ``d``. Zero vector on TIR."""
     c = -wp.dot(n, d)

@@ -2,6 +2,8 @@
 
 import warp as wp
 
+from warpcaustics.kernels.geometry import cell_centre, normal_from_slopes
+
 wp.set_module_options({"enable_backward": False})
 
 
@@ -18,10 +20,9 @@ def heightfield_surface(
     cell = extent_m / float(n)
     hx = (heights[iy, (ix + 1) % n] - heights[iy, (ix + n - 1) % n]) / (2.0 * cell)
     hy = (heights[(iy + 1) % n, ix] - heights[(iy + n - 1) % n, ix]) / (2.0 * cell)
-    x = (float(ix) + 0.5) * cell - 0.5 * extent_m
-    y = (float(iy) + 0.5) * cell - 0.5 * extent_m
-    positions[iy, ix] = wp.vec3(x, y, heights[iy, ix])
-    normals[iy, ix] = wp.normalize(wp.vec3(-hx, -hy, 1.0))
+    xy = cell_centre(ix, iy, n, extent_m)
+    positions[iy, ix] = wp.vec3(xy[0], xy[1], heights[iy, ix])
+    normals[iy, ix] = normal_from_slopes(hx, hy)
 
 
 @wp.func

@@ -9,6 +9,8 @@ import functools
 
 import warp as wp
 
+from warpcaustics.kernels.geometry import cell_centre, normal_from_slopes
+
 wp.set_module_options({"enable_backward": False})
 
 
@@ -48,28 +50,18 @@ def evolve_spectrum(
 
 
 @functools.cache
-def row_ifft_kernel(n: int):
-    """Unnormalised inverse DFT of every row of an (n, n) complex array, in place (wp.tile_ifft)."""
-
-    @wp.kernel(module="unique")
-    def row_ifft(data: wp.array2d[wp.vec2]):
-        row = wp.tid()
-        t = wp.tile_load(data, shape=(1, n), offset=(row, 0), storage="register")
-        wp.tile_ifft(t)
-        wp.tile_store(data, t, offset=(row, 0))
-
-    return row_ifft
-
-
-@functools.cache
-def row_fft_kernel(n: int):
-    """Unnormalised forward DFT of every row of an (n, n) complex array, in place (wp.tile_fft)."""
+def row_fft_kernel(n: int, inverse: bool):
+    """Unnormalised DFT (forward, or inverse with e^{+i…}) of every row of an (n, n) complex
+    array, in place, by ``wp.tile_fft`` / ``wp.tile_ifft``; n is fixed at compile time."""
 
     @wp.kernel(module="unique")
     def row_fft(data: wp.array2d[wp.vec2]):
         row = wp.tid()
         t = wp.tile_load(data, shape=(1, n), offset=(row, 0), storage="register")
-        wp.tile_fft(t)
+        if wp.static(inverse):
+            wp.tile_ifft(t)
+        else:
+            wp.tile_fft(t)
         wp.tile_store(data, t, offset=(row, 0))
 
     return row_fft
@@ -91,11 +83,7 @@ def assemble_surface(
 ):
     """Vertices at cell centres ``(i + 0.5) L/N - L/2`` with height h and normal ∝ (-h_x, -h_y, 1)."""
     iy, ix = wp.tid()
-    n = positions.shape[0]
-    cell = extent_m / float(n)
     a = height_and_slope_x[iy, ix]
-    hy = slope_y[iy, ix][0]
-    x = (float(ix) + 0.5) * cell - 0.5 * extent_m
-    y = (float(iy) + 0.5) * cell - 0.5 * extent_m
-    positions[iy, ix] = wp.vec3(x, y, a[0])
-    normals[iy, ix] = wp.normalize(wp.vec3(-a[1], -hy, 1.0))
+    xy = cell_centre(ix, iy, positions.shape[0], extent_m)
+    positions[iy, ix] = wp.vec3(xy[0], xy[1], a[0])
+    normals[iy, ix] = normal_from_slopes(a[1], slope_y[iy, ix][0])

@@ -111,12 +111,12 @@ def ifft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
     Equals ``numpy.fft.ifft2(x) * N**2``. Rows by ``wp.tile_ifft``, a transpose, rows again, and
     a transpose back.
     """
-    return _fft2(data, ocean_kernels.row_ifft_kernel(data.shape[0]), scratch)
+    return _fft2(data, ocean_kernels.row_fft_kernel(data.shape[0], True), scratch)
 
 
 def fft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
     """In-place unnormalised 2-D forward DFT of a square complex (vec2) array (= numpy.fft.fft2)."""
-    return _fft2(data, ocean_kernels.row_fft_kernel(data.shape[0]), scratch)
+    return _fft2(data, ocean_kernels.row_fft_kernel(data.shape[0], False), scratch)
 
 
 def fft_block_dim(n: int, device) -> int:
