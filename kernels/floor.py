@@ -138,8 +138,11 @@ def deposit_footprints(
     n = hit_xy.shape[1]
     m = floor_texels.shape[0]
     k_begin = g * wavelengths_per_group
-    if flux_w_nm[iy, ix, half, k_begin] <= 0.0:
-        return  # facing away from the sun or fully reflected: nothing to spread
+    group_flux = float(0.0)
+    for j in range(wavelengths_per_group):
+        group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
+    if group_flux <= 0.0:
+        return  # facing away from the sun, fully reflected or fully absorbed: nothing to spread
     x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
     x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
@@ -153,7 +156,7 @@ def deposit_footprints(
     j_lo = int(wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1]))))
     i_hi = int(wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0]))))
     j_hi = int(wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1]))))
-    # Coordinates relative to the first texel keep float32 precision on large maps.
+    # Coordinates relative to the footprint's first texel keep the clipping arithmetic small.
     corner = wp.vec2(float(i_lo), float(j_lo))
     q0 = q0 - corner
     q1 = q1 - corner

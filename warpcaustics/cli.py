@@ -57,12 +57,20 @@ def _render(args: argparse.Namespace) -> int:
     from warpcaustics.output import save_frame, write_run_json
     from warpcaustics.pipeline import Renderer
 
-    renderer = Renderer(scene, args.device)
+    renderer = Renderer(scene, args.device)  # device and memory checks before any output
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
     results = []
     for frame in range(args.frames):
         t0 = time.perf_counter()
         result = renderer.render(args.time + frame / args.fps)
-        save_frame(result, out, frame=frame)
+        try:
+            save_frame(result, out, frame=frame)
+        except OSError as exc:
+            raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
+                                    f"{exc.strerror or exc}") from None
         results.append(result)
         print(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
               f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
