@@ -17,11 +17,35 @@ _notice_given = False
 def _warp():
     import warp as wp
 
-    if not os.environ.get("WARPCAUSTICS_VERBOSE"):
-        # Warp's info lines (init banner, module loads) drown our one-line messages.
-        wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
-    wp.init()
+    if os.environ.get("WARPCAUSTICS_VERBOSE"):
+        wp.init()
+        return wp
+    # Warp's info lines (init banner, module loads) drown our one-line messages, and on a machine
+    # without a GPU its native library prints a driver warning on every start; our own notice
+    # (see resolve_device) says the same once. Anything else it prints is passed on.
+    wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
+    _init_filtering_stderr(wp)  # later calls are cheap: wp.init() runs once
     return wp
+
+
+def _init_filtering_stderr(wp) -> None:
+    """``wp.init()`` with the native 'no CUDA driver' warning removed from stderr."""
+    import tempfile
+
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+b") as capture:
+        os.dup2(capture.fileno(), 2)
+        try:
+            wp.init()
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        capture.seek(0)
+        for line in capture.read().decode(errors="replace").splitlines(keepends=True):
+            if "Could not find or load the NVIDIA CUDA driver" not in line:
+                sys.stderr.write(line)
+    sys.stderr.flush()
 
 
 def cuda_available() -> bool:
