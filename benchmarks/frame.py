@@ -28,7 +28,7 @@ def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
     import warp as wp
 
     from warpcaustics.pipeline import Renderer, scene_bytes
-    from warpcaustics.refraction import refract_to_floor
+    from warpcaustics.refraction import height_range, refract_to_floor, sun_visibility
 
     scene = _scene(n, m, bins)
     renderer = Renderer(scene, device)
@@ -38,8 +38,10 @@ def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
     cfg = scene.config
 
     def stages():
-        r = refract_to_floor(surface, renderer.group_ior, scene.sun_direction, -cfg.floor.depth_m,
-                             device, out=renderer.refracted)
+        _, highest = height_range(surface, device)
+        visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
+        r = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction,
+                             -cfg.floor.depth_m, device, out=renderer.refracted)
         renderer.floor.run(surface, r, scene.sun_direction)
         wp.synchronize_device(device)
 

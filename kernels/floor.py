@@ -21,6 +21,13 @@ wp.set_module_options({"enable_backward": False})
 DEGENERATE_AREA_TEXELS = 1.0e-9
 """Footprints smaller than this [texel^2] deposit at their centroid (a focus point or line)."""
 
+MAX_CLIPPED_TEXELS = 4096
+"""Footprints whose bounding box holds more texels are deposited by area samples (bounded work)."""
+
+SAMPLE_SUBDIVISIONS = 32
+"""Such a footprint is cut into SAMPLE_SUBDIVISIONS² congruent triangles; each centroid gets an
+equal share of the flux."""
+
 
 @wp.func
 def quad_corner(ix: int, iy: int, half: int, corner: int, n: int, extent_m: float):
@@ -47,6 +54,16 @@ def quad_corner(ix: int, iy: int, half: int, corner: int, n: int, extent_m: floa
         cy = 0
         shift[1] = extent_m
     return cx, cy, shift
+
+
+@wp.func
+def wrap_coord(x: float, m: int) -> float:
+    """x reduced into [0, m), in floating point (safe for coordinates beyond the int range)."""
+    fm = float(m)
+    r = x - fm * wp.floor(x / fm)
+    if r >= fm:
+        r = 0.0
+    return r
 
 
 @wp.func
@@ -120,6 +137,36 @@ def add_to_texel(
         wp.atomic_add(floor_texels, ty, tx, k, weight * flux_w_nm[iy, ix, half, k])
 
 
+@wp.func
+def deposit_by_samples(
+    floor_texels: wp.array3d[wp.float32],
+    flux_w_nm: wp.array4d[wp.float32],
+    k_begin: int,
+    k_count: int,
+    iy: int,
+    ix: int,
+    half: int,
+    q0: wp.vec2,
+    e1: wp.vec2,
+    e2: wp.vec2,
+    m: int,
+    inv_texel_area: float,
+):
+    """Deposit a footprint (q0, q0 + e1, q0 + e2) [texels] through the centroids of its
+    SAMPLE_SUBDIVISIONS² congruent sub-triangles, each carrying an equal share of the flux."""
+    s = SAMPLE_SUBDIVISIONS
+    weight = inv_texel_area / float(s * s)
+    for a in range(s):
+        for b in range(s - a):
+            for flip in range(2):
+                if flip == 1 and b == s - a - 1:
+                    continue  # the last row has no downward sub-triangle
+                off = 1.0 / 3.0 + float(flip) / 3.0
+                p = q0 + ((float(a) + off) / float(s)) * e1 + ((float(b) + off) / float(s)) * e2
+                add_to_texel(floor_texels, flux_w_nm, k_begin, k_count, iy, ix, half,
+                             int(wrap_coord(p[0], m)), int(wrap_coord(p[1], m)), weight)
+
+
 @wp.kernel
 def deposit_footprints(
     hit_xy: wp.array3d[wp.vec2],
@@ -127,12 +174,14 @@ def deposit_footprints(
     wavelengths_per_group: int,
     extent_m: float,
     floor_texels: wp.array3d[wp.float32],
+    coarse_count: wp.array[wp.int32],
 ):
     """Spread triangle (iy, ix, half)'s flux over its floor footprint for index group g.
 
     ``floor_texels`` is (M, M, K) [W m^-2 nm^-1] (wavelengths contiguous: one cache line per
     texel); texel (ty, tx) spans ``[tx, tx+1] * L/M - L/2`` in x. Weight of a texel = overlap area
-    / footprint area.
+    / footprint area. Footprints whose bounding box exceeds ``MAX_CLIPPED_TEXELS`` are deposited by
+    area samples instead and counted in ``coarse_count``.
     """
     g, iy, ix, half = wp.tid()
     n = hit_xy.shape[1]
@@ -147,22 +196,37 @@ def deposit_footprints(
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
     x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
     scale = float(m) / extent_m
-    origin = wp.vec2(0.5 * extent_m)
-    # Footprint in texel units.
-    q0 = (hit_xy[g, y0, x0] + s0 + origin) * scale
-    q1 = (hit_xy[g, y1, x1] + s1 + origin) * scale
-    q2 = (hit_xy[g, y2, x2] + s2 + origin) * scale
-    i_lo = int(wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0]))))
-    j_lo = int(wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1]))))
-    i_hi = int(wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0]))))
-    j_hi = int(wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1]))))
+    # Footprint in texel units: corner 0 wrapped into [0, M) (a whole-period shift leaves the
+    # periodic deposit unchanged and keeps indices small), edges taken in metres first so their
+    # precision does not depend on where the footprint lies.
+    a = hit_xy[g, y0, x0] + s0
+    e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
+    e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
+    q0 = (a + wp.vec2(0.5 * extent_m)) * scale
+    q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
+    q1 = q0 + e1
+    q2 = q0 + e2
+    inv_texel_area = scale * scale  # 1 / texel area [m^-2]
+    u_lo = wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0])))
+    v_lo = wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1])))
+    u_hi = wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0])))
+    v_hi = wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1])))
+    if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(MAX_CLIPPED_TEXELS):
+        # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
+        wp.atomic_add(coarse_count, 0, 1)
+        deposit_by_samples(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
+                           q0, e1, e2, m, inv_texel_area)
+        return
+    i_lo = int(u_lo)
+    j_lo = int(v_lo)
+    i_hi = int(u_hi)
+    j_hi = int(v_hi)
     # Coordinates relative to the footprint's first texel keep the clipping arithmetic small.
-    corner = wp.vec2(float(i_lo), float(j_lo))
+    corner = wp.vec2(u_lo, v_lo)
     q0 = q0 - corner
     q1 = q1 - corner
     q2 = q2 - corner
-    area = 0.5 * wp.abs((q1[0] - q0[0]) * (q2[1] - q0[1]) - (q2[0] - q0[0]) * (q1[1] - q0[1]))
-    inv_texel_area = (scale * scale)  # 1 / texel area [m^-2]
+    area = 0.5 * wp.abs(e1[0] * e2[1] - e2[0] * e1[1])
     if (i_lo == i_hi and j_lo == j_hi) or area < DEGENERATE_AREA_TEXELS:
         c = (q0 + q1 + q2) / 3.0
         tx = wrap(i_lo + int(wp.floor(c[0])), m)

@@ -22,6 +22,25 @@ def normal_from_slopes(dh_dx: float, dh_dy: float) -> wp.vec3:
 
 
 @wp.func
+def bilinear_cell(n: int, extent_m: float, x: float, y: float):
+    """Periodic bilinear lookup on an n×n cell-centre grid: corner indices (i0, j0, i1, j1) and
+    fractions (tu, tv) for the point (x, y) [m]."""
+    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    fu = wp.floor(u)
+    fv = wp.floor(v)
+    i0 = ((int(fu) % n) + n) % n
+    j0 = ((int(fv) % n) + n) % n
+    return i0, j0, (i0 + 1) % n, (j0 + 1) % n, u - fu, v - fv
+
+
+@wp.func
+def bilerp(a: float, b: float, c: float, d: float, tu: float, tv: float) -> float:
+    """(1-tv)((1-tu) a + tu b) + tv((1-tu) c + tu d): a, b on row j0; c, d on row j1."""
+    return (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)
+
+
+@wp.func
 def refract(d: wp.vec3, n: wp.vec3, eta: float) -> wp.vec3:
     """Snell's law in vector form; ``eta = n1/n2``, ``n`` faces against ``d``. Zero vector on TIR."""
     c = -wp.dot(n, d)

@@ -2,7 +2,7 @@
 
 import warp as wp
 
-from warpcaustics.kernels.geometry import cell_centre, normal_from_slopes
+from warpcaustics.kernels.geometry import bilerp, bilinear_cell, cell_centre, normal_from_slopes
 
 wp.set_module_options({"enable_backward": False})
 
@@ -28,19 +28,8 @@ def heightfield_surface(
 @wp.func
 def sample_periodic_bilinear(heights: wp.array2d[wp.float32], extent_m: float, x: float, y: float) -> float:
     """Height at (x, y) [m] by periodic bilinear interpolation between cell-centre samples."""
-    n = heights.shape[0]
-    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    fu = wp.floor(u)
-    fv = wp.floor(v)
-    tu = u - fu
-    tv = v - fv
-    i0 = ((int(fu) % n) + n) % n
-    j0 = ((int(fv) % n) + n) % n
-    i1 = (i0 + 1) % n
-    j1 = (j0 + 1) % n
-    return (1.0 - tv) * ((1.0 - tu) * heights[j0, i0] + tu * heights[j0, i1]) + tv * (
-        (1.0 - tu) * heights[j1, i0] + tu * heights[j1, i1])
+    i0, j0, i1, j1, tu, tv = bilinear_cell(heights.shape[0], extent_m, x, y)
+    return bilerp(heights[j0, i0], heights[j0, i1], heights[j1, i0], heights[j1, i1], tu, tv)
 
 
 @wp.kernel

@@ -202,3 +202,32 @@ def test_failed_write_leaves_nothing(tmp_path):
         tmp.write_bytes(b"half")
         raise RuntimeError("disk full")
     assert list(tmp_path.iterdir()) == []
+
+
+def _npz_named_npy(path):
+    np.savez(path.with_suffix(".npz"), a=np.zeros((8, 8)))
+    path.with_suffix(".npz").rename(path)
+
+
+@pytest.mark.parametrize(("writer", "needle"), [
+    (lambda p: p.write_bytes(b""), "not a readable .npy"),
+    (_npz_named_npy, ".npz"),
+    (lambda p: np.save(p, np.zeros((8, 8), complex)), "real numbers"),
+])
+def test_heightfield_unreadable_files(capsys, tmp_path, writer, needle):
+    """An empty file, an .npz archive or complex heights are one-line errors, not tracebacks."""
+    writer(tmp_path / "h.npy")
+    cfg = _write(tmp_path, "[water]\nmodel = 'heightfield'\nfile = 'h.npy'\n")
+    _fails_cleanly(capsys, tmp_path, [cfg], "water.file", needle)
+
+
+@pytest.mark.parametrize("time_arg", ["nan", "inf"])
+def test_non_finite_time_is_refused(capsys, tmp_path, time_arg):
+    """--time must be a finite number of seconds."""
+    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--time", time_arg], "--time")
+
+
+def test_wavelengths_outside_the_data_fail_at_load():
+    """Bins beyond the optical data's range are refused when the scene is loaded, naming the range."""
+    with pytest.raises(ConfigError, match="outside the Pope & Fry 1997 absorption data"):
+        wc.load_scene(None, {"optics.wavelengths.max_nm": 760.0})

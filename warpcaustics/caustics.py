@@ -34,6 +34,8 @@ class FloorCaustics:
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
+        self.coarse_count = wp.zeros(1, dtype=wp.int32, device=device)
+        """Footprints of the last run deposited by area samples (too large to clip texel by texel)."""
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray) -> wp.array3d:
         """Fill :attr:`irradiance`; every triangle's flux lands on the floor, so per band
@@ -49,9 +51,10 @@ class FloorCaustics:
                           self.attenuation_per_m, per_group, float(surface.extent_m)],
                   outputs=[self.flux], device=self.device)
         self.texels.zero_()
+        self.coarse_count.zero_()
         wp.launch(floor_kernels.deposit_footprints, dim=(groups, n, n, 2),
                   inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m)],
-                  outputs=[self.texels], device=self.device)
+                  outputs=[self.texels, self.coarse_count], device=self.device)
         wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
                   outputs=[self.irradiance], device=self.device)
         return self.irradiance

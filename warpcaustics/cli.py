@@ -48,8 +48,10 @@ def _render(args: argparse.Namespace) -> int:
     scene = load_scene(args.config, overrides)  # validate everything before touching the output
     if args.frames < 1:
         raise WarpcausticsError(f"--frames = {args.frames} must be at least 1")
-    if args.fps <= 0:
-        raise WarpcausticsError(f"--fps = {args.fps} must be positive")
+    if not args.fps > 0 or args.fps == float("inf"):
+        raise WarpcausticsError(f"--fps = {args.fps} must be a positive number")
+    if args.time != args.time or abs(args.time) == float("inf"):
+        raise WarpcausticsError(f"--time = {args.time} must be a finite number of seconds")
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")

@@ -19,14 +19,20 @@ def load_heights(path: Path, resolution: int | None) -> np.ndarray:
                           f"(relative paths start at the config file's folder)")
     try:
         heights = np.load(path, allow_pickle=False)
-    except (ValueError, OSError) as exc:
-        raise ConfigError(f"water.file = {str(path)!r} is not a readable .npy array: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - any unreadable file is the same user error
+        raise ConfigError(f"water.file = {str(path)!r} is not a readable .npy array "
+                          f"({type(exc).__name__}: {exc}); save heights with numpy.save") from None
+    if not isinstance(heights, np.ndarray):
+        raise ConfigError(f"water.file = {str(path)!r} is a .npz archive; save one array with "
+                          f"numpy.save (.npy)")
+    if heights.dtype.kind not in "iuf":
+        raise ConfigError(f"water.file = {str(path)!r} holds {heights.dtype} values; heights must be "
+                          f"real numbers (float or integer) in metres")
     if heights.ndim != 2 or heights.shape[0] != heights.shape[1] or heights.shape[0] < 4:
         raise ConfigError(f"water.file = {str(path)!r} has shape {heights.shape}; it must be a square "
                           f"2-D array of heights, at least 4×4")
-    if not np.issubdtype(heights.dtype, np.number) or not np.all(np.isfinite(heights)):
-        raise ConfigError(f"water.file = {str(path)!r} must hold finite numbers (found NaN, inf or "
-                          f"non-numeric values)")
+    if not np.all(np.isfinite(heights)):
+        raise ConfigError(f"water.file = {str(path)!r} must hold finite numbers (found NaN or inf)")
     if resolution is not None and resolution != heights.shape[0]:
         raise ConfigError(f"water.resolution = {resolution} disagrees with water.file, which is "
                           f"{heights.shape[0]}×{heights.shape[0]}; remove water.resolution or set it "

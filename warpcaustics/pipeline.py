@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -12,7 +13,8 @@ import warp as wp
 
 from warpcaustics import caustics, spectra
 from warpcaustics import device as devices
-from warpcaustics.refraction import Refracted, refract_to_floor
+from warpcaustics.errors import WarpcausticsError
+from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
 from warpcaustics.water import make_water, water_bytes
 
@@ -119,11 +121,14 @@ class Renderer:
             self.water = make_water(cfg, self.device, scene.heights)
             n = scene.water_resolution
             self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
+            self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
                                                 self.attenuation_per_m, self.device)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
+        if not math.isfinite(time_s):
+            raise WarpcausticsError(f"time_s = {time_s} is not a finite number of seconds")
         with _memory_errors(self.device, self.bytes_needed):
             return self._render(float(time_s))
 
@@ -134,9 +139,16 @@ class Renderer:
         watch = _Stopwatch(dev)
         with watch.stage("water"):
             surface = self.water.at(time_s)
+            lowest, highest = height_range(surface, dev)
+        if lowest <= -cfg.floor.depth_m:
+            raise WarpcausticsError(
+                f"floor.depth_m = {cfg.floor.depth_m} is too shallow: the water surface reaches "
+                f"z = {lowest:.3f} m at t = {time_s:g} s; make the floor deeper or the waves lower")
+        with watch.stage("shading"):
+            visible = sun_visibility(surface, sun_dir, highest, dev, out=self.visible)
         with watch.stage("refraction"):
-            refracted = refract_to_floor(surface, self.group_ior, sun_dir, -cfg.floor.depth_m, dev,
-                                         out=self.refracted)
+            refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,
+                                         -cfg.floor.depth_m, dev, out=self.refracted)
         with watch.stage("floor_caustics"):
             floor = self.floor.run(surface, refracted, sun_dir)
         with watch.stage("readback"):

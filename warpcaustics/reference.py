@@ -11,6 +11,8 @@ import numpy as np
 
 MIN_DOWNWARD_COS = 1.0e-3
 DEGENERATE_AREA_TEXELS = 1.0e-9
+MAX_CLIPPED_TEXELS = 4096
+SAMPLE_SUBDIVISIONS = 32
 _CHUNK_PAIRS = 1 << 18  # (triangle, texel) pairs clipped at once; bounds peak memory
 
 
@@ -34,7 +36,34 @@ def refract(d: np.ndarray, n: np.ndarray, eta: float) -> np.ndarray:
     return np.where(k >= 0, t, 0.0)
 
 
-def refract_to_floor(positions, normals, sun_dir, ior, floor_z):
+def sun_visibility(positions, sun_dir, extent_m):
+    """(N, N) 1 where a vertex sees the sun over the periodic height field, 0 where shaded.
+
+    The same half-cell march towards the sun as the kernel, for all vertices at once.
+    """
+    n = positions.shape[0]
+    s = np.asarray(sun_dir, np.float64)
+    horizontal = np.hypot(s[0], s[1])
+    visible = np.ones((n, n))
+    if horizontal < 1e-6:
+        return visible
+    z = positions[..., 2]
+    cell = extent_m / n
+    step = 0.5 * cell / horizontal
+    steps = np.ceil((z.max() - z) / (s[2] * step)).astype(np.int64) + 1
+    for i in range(1, int(steps.max()) + 1):
+        q = positions + (i * step) * s
+        u = (q[..., 0] + 0.5 * extent_m) * n / extent_m - 0.5
+        v = (q[..., 1] + 0.5 * extent_m) * n / extent_m - 0.5
+        i0, j0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
+        tu, tv = u - i0, v - j0
+        h = ((1 - tv) * ((1 - tu) * z[j0 % n, i0 % n] + tu * z[j0 % n, (i0 + 1) % n])
+             + tv * ((1 - tu) * z[(j0 + 1) % n, i0 % n] + tu * z[(j0 + 1) % n, (i0 + 1) % n]))
+        visible[(i <= steps) & (h > q[..., 2] + 1e-4 * cell)] = 0.0
+    return visible
+
+
+def refract_to_floor(positions, normals, sun_dir, ior, floor_z, visible=None):
     """Per-vertex floor hit (N, N, 2), path length (N, N) and transmittance (N, N)."""
     eta = 1.0 / ior
     s = np.asarray(sun_dir, np.float64)
@@ -46,6 +75,8 @@ def refract_to_floor(positions, normals, sun_dir, ior, floor_z):
     ell = (floor_z - positions[..., 2]) / t[..., 2]
     hit = positions[..., :2] + ell[..., None] * t[..., :2]
     trans = np.where(ok, fresnel_transmittance(cos_i, eta), 0.0)
+    if visible is not None:
+        trans = trans * visible
     return hit, ell, trans
 
 
@@ -67,6 +98,16 @@ def triangles(n: int, extent_m: float):
         idx.append(np.stack(ci, axis=1))
         shift.append(np.stack(cs, axis=1))
     return np.concatenate(idx), np.concatenate(shift).astype(np.float64)
+
+
+def _subtriangle_centroids(s: int) -> tuple[np.ndarray, float]:
+    """Barycentric (u, v) of the centroids of the s² congruent sub-triangles, and their weight."""
+    a, b = np.meshgrid(np.arange(s), np.arange(s), indexing="ij")
+    up = (a + b) <= s - 1
+    down = (a + b) <= s - 2
+    pts = np.concatenate([np.stack([a[up] + 1 / 3, b[up] + 1 / 3], -1),
+                          np.stack([a[down] + 2 / 3, b[down] + 2 / 3], -1)]) / s
+    return pts, 1.0 / (s * s)
 
 
 def _clip(px, py, count, axis, bound, keep_above):
@@ -115,7 +156,8 @@ def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradian
     normals = np.asarray(normals, np.float64)
     n = positions.shape[0]
     m = map_resolution
-    hit, ell, trans = refract_to_floor(positions, normals, sun_dir, ior, -floor_depth_m)
+    visible = sun_visibility(positions, sun_dir, extent_m)
+    hit, ell, trans = refract_to_floor(positions, normals, sun_dir, ior, -floor_depth_m, visible)
     idx, shift = triangles(n, extent_m)
     p = positions.reshape(-1, 3)[idx]
     p[..., :2] += shift
@@ -124,16 +166,33 @@ def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradian
     mean_t = np.mean(trans.reshape(-1)[idx][None] * att, axis=2)  # (K, T)
     flux = np.where(a_perp > 0, np.asarray(sun_irradiance)[:, None] * a_perp * mean_t, 0.0)
 
-    q = (hit.reshape(-1, 2)[idx] + shift + 0.5 * extent_m) * (m / extent_m)  # (T, 3, 2) texels
-    lo = np.floor(q.min(axis=1)).astype(np.int64)
-    hi = np.floor(q.max(axis=1)).astype(np.int64)
-    q = q - lo[:, None, :]
+    # Footprints in texels, corner 0 wrapped into [0, M) (a whole-period shift changes nothing).
+    corners = hit.reshape(-1, 2)[idx] + shift
+    q = (corners - corners[:, :1]) * (m / extent_m)
+    q += np.mod((corners[:, :1] + 0.5 * extent_m) * (m / extent_m), m)
+    lo_f, hi_f = np.floor(q.min(axis=1)), np.floor(q.max(axis=1))
     e1, e2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
     area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    lit = np.nonzero(flux[0] > 0)[0]
-    single = (np.all(lo == hi, axis=1) | (area < DEGENERATE_AREA_TEXELS))[lit]
+    lit = np.nonzero(flux.max(axis=0) > 0)[0]
+    coarse = (np.prod(hi_f - lo_f + 1, axis=1) > MAX_CLIPPED_TEXELS)[lit]
+    lo = np.where(coarse[:, None], 0, lo_f[lit]).astype(np.int64)
+    hi = np.where(coarse[:, None], 0, hi_f[lit]).astype(np.int64)
+    lo_all = np.zeros((len(q), 2), np.int64)
+    hi_all = np.zeros((len(q), 2), np.int64)
+    lo_all[lit], hi_all[lit] = lo, hi
+    lo, hi = lo_all, hi_all
+    q = q - lo[:, None, :]
+    single = ~coarse & (np.all(lo[lit] == hi[lit], axis=1) | (area[lit] < DEGENERATE_AREA_TEXELS))
 
     tri_parts, texel_parts, weight_parts = [], [], []
+    # Huge footprints: equal shares at the centroids of S² congruent sub-triangles.
+    tc = lit[coarse]
+    bary, w = _subtriangle_centroids(SAMPLE_SUBDIVISIONS)
+    pts = q[tc, None, 0] + bary[None, :, :1] * e1[tc, None] + bary[None, :, 1:] * e2[tc, None]
+    cells = np.mod(np.floor(pts), m).astype(np.int64)
+    tri_parts.append(np.repeat(tc, len(bary)))
+    texel_parts.append((cells[..., 1] * m + cells[..., 0]).reshape(-1))
+    weight_parts.append(np.full(len(tc) * len(bary), w))
     # Footprints inside one texel (or degenerate): everything to the centroid's texel.
     t1 = lit[single]
     c = lo[t1] + np.floor(q[t1].mean(axis=1)).astype(np.int64)
@@ -141,7 +200,7 @@ def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradian
     texel_parts.append((c[:, 1] % m) * m + (c[:, 0] % m))
     weight_parts.append(np.ones(len(t1)))
     # Larger footprints: clip against every texel of the bounding box.
-    tm = lit[~single]
+    tm = lit[~single & ~coarse]
     span = hi[tm] - lo[tm] + 1
     counts = span[:, 0] * span[:, 1]
     starts = np.concatenate([[0], np.cumsum(counts)])

@@ -29,14 +29,38 @@ class Refracted:
                    wp.empty((groups, n, n), dtype=wp.float32, device=device))
 
 
-def refract_to_floor(surface: Surface, ior: np.ndarray, sun_dir: np.ndarray, floor_z_m: float,
-                     device: str, out: Refracted | None = None) -> Refracted:
-    """Refract the sun at every vertex for each refractive index in ``ior`` (one per group)."""
+def height_range(surface: Surface, device: str) -> tuple[float, float]:
+    """(lowest, highest) surface height [m] (one small read-back)."""
+    z_range = wp.array(np.array([np.inf, -np.inf], np.float32), dtype=wp.float32, device=device)
+    n = surface.resolution
+    wp.launch(refract_kernels.height_range, dim=(n, n), inputs=[surface.positions],
+              outputs=[z_range], device=device)
+    lo, hi = z_range.numpy()
+    return float(lo), float(hi)
+
+
+def sun_visibility(surface: Surface, sun_dir: np.ndarray, highest_m: float, device: str,
+                   out: wp.array2d | None = None) -> wp.array2d:
+    """(N, N) 1 where a vertex sees the sun, 0 where a crest of the surface shades it."""
+    n = surface.resolution
+    out = out if out is not None else wp.empty((n, n), dtype=wp.float32, device=device)
+    z_range = wp.array(np.array([0.0, highest_m], np.float32), dtype=wp.float32, device=device)
+    wp.launch(refract_kernels.sun_visibility, dim=(n, n),
+              inputs=[surface.positions, wp.vec3(*np.asarray(sun_dir, np.float32)),
+                      float(surface.extent_m), z_range],
+              outputs=[out], device=device)
+    return out
+
+
+def refract_to_floor(surface: Surface, visible: wp.array2d, ior: np.ndarray, sun_dir: np.ndarray,
+                     floor_z_m: float, device: str, out: Refracted | None = None) -> Refracted:
+    """Refract the sun at every vertex for each refractive index in ``ior`` (one per group);
+    ``visible`` (N, N) scales each vertex's transmittance (sun shading by the surface itself)."""
     n = surface.resolution
     groups = len(ior)
     out = out or Refracted.allocate(groups, n, device)
     wp.launch(refract_kernels.refract_to_floor, dim=(groups, n, n),
-              inputs=[surface.positions, surface.normals,
+              inputs=[surface.positions, surface.normals, visible,
                       wp.array(np.asarray(ior, np.float32), dtype=wp.float32, device=device),
                       wp.vec3(*np.asarray(sun_dir, np.float32)), float(floor_z_m)],
               outputs=[out.hit_xy, out.path_m, out.transmittance], device=device)
