@@ -12,7 +12,7 @@ from warpcaustics.water import Surface
 
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
-    refraction = groups * n * n * (8 + 4 + 4)
+    refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
     triangle_flux = k * 2 * n * n * 4
     return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
 
