@@ -31,22 +31,35 @@ def evolve_spectrum(
     omega: wp.array2d[wp.float32],
     k_axis: wp.array[wp.float32],
     time_s: float,
-    height_and_slope_x: wp.array2d[wp.vec2],
-    slope_y: wp.array2d[wp.vec2],
+    height_slope_x: wp.array2d[wp.vec2],
+    slope_y_disp_x: wp.array2d[wp.vec2],
+    disp_y_dxx: wp.array2d[wp.vec2],
+    dyy_dxy: wp.array2d[wp.vec2],
 ):
-    """Spectra at time t, packed two real fields per complex FFT.
+    """Spectra at time t, two real fields packed per complex FFT (all spectra are Hermitian).
 
-    ``height_and_slope_x = H + i·(i kx H)`` transforms to ``h + i ∂h/∂x`` and ``slope_y = i ky H``
-    to ``∂h/∂y`` (both inverse transforms are real because H is Hermitian).
+    ``h̃ = h̃0(k) e^{-iωt} + conj(h̃0(-k)) e^{iωt}`` (Tessendorf eq. 26 with t → −t, so that h̃0(k)
+    is a wave travelling along +k). Packed pairs: (h, ∂h/∂x), (∂h/∂y, D_x), (D_y, ∂D_x/∂x),
+    (∂D_y/∂y, ∂D_x/∂y) with the choppy displacement ``D̃ = -i k̂ h̃`` (eq. 29) and its derivatives
+    ``∂_a D_b ↔ (k_a k_b / k) h̃``.
     """
     iy, ix = wp.tid()
     wt = omega[iy, ix] * time_s
-    h = cmul(h0[iy, ix], cexp_i(wt)) + cmul(h0_minus_conj[iy, ix], cexp_i(-wt))
+    h = cmul(h0[iy, ix], cexp_i(-wt)) + cmul(h0_minus_conj[iy, ix], cexp_i(wt))
     kx = k_axis[ix]
     ky = k_axis[iy]
-    # i·(i kx h) = -kx h ; i ky h = (-ky h.im, ky h.re)
-    height_and_slope_x[iy, ix] = h - kx * h
-    slope_y[iy, ix] = wp.vec2(-ky * h[1], ky * h[0])
+    k = wp.sqrt(kx * kx + ky * ky)
+    inv_k = float(0.0)
+    if k > 0.0:
+        inv_k = 1.0 / k
+    # i·(i a h) = -a h ; i·(-i a h) = a h ; i a h = (-a h.im, a h.re)
+    height_slope_x[iy, ix] = h - kx * h
+    slope_y_disp_x[iy, ix] = wp.vec2(-ky * h[1], ky * h[0]) + (kx * inv_k) * h
+    disp_y = wp.vec2(ky * inv_k * h[1], -ky * inv_k * h[0])  # -i (ky/k) h
+    dxx = (kx * kx * inv_k) * h
+    disp_y_dxx[iy, ix] = disp_y + wp.vec2(-dxx[1], dxx[0])
+    dxy = (kx * ky * inv_k) * h
+    dyy_dxy[iy, ix] = (ky * ky * inv_k) * h + wp.vec2(-dxy[1], dxy[0])
 
 
 @functools.cache
@@ -75,15 +88,37 @@ def transpose(src: wp.array2d[wp.vec2], dst: wp.array2d[wp.vec2]):
 
 @wp.kernel
 def assemble_surface(
-    height_and_slope_x: wp.array2d[wp.vec2],
-    slope_y: wp.array2d[wp.vec2],
+    height_slope_x: wp.array2d[wp.vec2],
+    slope_y_disp_x: wp.array2d[wp.vec2],
+    disp_y_dxx: wp.array2d[wp.vec2],
+    dyy_dxy: wp.array2d[wp.vec2],
+    choppiness: float,
     extent_m: float,
     positions: wp.array2d[wp.vec3],
     normals: wp.array2d[wp.vec3],
+    jacobian: wp.array2d[wp.float32],
 ):
-    """Vertices at cell centres ``(i + 0.5) L/N - L/2`` with height h and normal ∝ (-h_x, -h_y, 1)."""
+    """Vertex = cell centre + λ D (horizontal), height h; normal = ∂P/∂x × ∂P/∂y normalised;
+    Jacobian of the horizontal map J = (1 + λD_xx)(1 + λD_yy) − (λD_xy)² (≤ 0 where it folds).
+
+    With λ = 0 the last two spectra are not transformed and are not read.
+    """
     iy, ix = wp.tid()
-    a = height_and_slope_x[iy, ix]
+    a = height_slope_x[iy, ix]
+    b = slope_y_disp_x[iy, ix]
     xy = cell_centre(ix, iy, positions.shape[0], extent_m)
-    positions[iy, ix] = wp.vec3(xy[0], xy[1], a[0])
-    normals[iy, ix] = normal_from_slopes(a[1], slope_y[iy, ix][0])
+    if choppiness == 0.0:
+        positions[iy, ix] = wp.vec3(xy[0], xy[1], a[0])
+        normals[iy, ix] = normal_from_slopes(a[1], b[0])
+        jacobian[iy, ix] = 1.0
+        return
+    c = disp_y_dxx[iy, ix]
+    d = dyy_dxy[iy, ix]
+    jxx = 1.0 + choppiness * c[1]
+    jyy = 1.0 + choppiness * d[0]
+    jxy = choppiness * d[1]
+    positions[iy, ix] = wp.vec3(xy[0] + choppiness * b[1], xy[1] + choppiness * c[0], a[0])
+    tangent_x = wp.vec3(jxx, jxy, a[1])
+    tangent_y = wp.vec3(jxy, jyy, b[0])
+    normals[iy, ix] = wp.normalize(wp.cross(tangent_x, tangent_y))
+    jacobian[iy, ix] = jxx * jyy - jxy * jxy

@@ -34,19 +34,35 @@ def test_fft_round_trip(device, rng):
     assert np.linalg.norm(got - x) / np.linalg.norm(x) <= 1e-5
 
 
-def _ocean(n, device, **kw):
-    params = {"amplitude": 3e-3, "wind_speed_m_s": 5.0, "wind_direction_deg": 25.0, "small_wave_m": 0.0}
-    params.update(kw)
-    return water.FFTOcean(n, 10.0, 4.0, device, seed=11, **params)
+PHILLIPS = {"amplitude": 3e-3, "wind_speed_m_s": 5.0, "wind_direction_deg": 25.0, "small_wave_m": 0.0}
+
+
+def _phillips_h0(n, extent, seed=11, **params):
+    k = water.wavenumbers(n, extent)
+    spectrum = water.phillips_spectrum(*np.meshgrid(k, k), **{**PHILLIPS, **params})
+    return water.initial_spectrum(spectrum, extent, seed=seed)
+
+
+def _ocean(n, device, extent=10.0, depth=4.0, seed=11, choppiness=0.0, **params):
+    return water.FFTOcean(_phillips_h0(n, extent, seed, **params), extent, depth, device,
+                          choppiness=choppiness)
 
 
 def test_ocean_heights_are_real(device):
-    """The evolved spectrum is Hermitian: its Warp inverse FFT is real (imaginary part ≤ 1e-5 of the
-    real part), which is what lets two real fields share one complex transform."""
+    """The evolved height spectrum is Hermitian, so its Warp inverse FFT is real (imaginary part
+    ≤ 1e-5 of the real part): the condition for packing two real fields in one complex FFT."""
     ocean = _ocean(64, device)
-    _, slope_y = ocean.spectra_at(3.7)
-    field = water.from_vec2(water.ifft2(slope_y))  # i ky H alone: must transform to ∂h/∂y, real
-    assert np.abs(field.imag).max() <= 1e-5 * np.abs(field.real).max()
+    heights = water.from_vec2(water.ifft2(water.to_vec2(_spectrum_of_heights(ocean, 3.7), device)))
+    assert np.abs(heights.imag).max() <= 1e-5 * np.abs(heights.real).max()
+    np.testing.assert_allclose(heights.real, ocean.at(3.7).positions.numpy()[..., 2], atol=1e-6)
+
+
+def _spectrum_of_heights(ocean, t):
+    """h̃(k, t) of an FFTOcean rebuilt on the host from its device arrays (cell-centre phase included)."""
+    h0 = water.from_vec2(ocean.h0)
+    h0m = water.from_vec2(ocean.h0_minus_conj)
+    omega = ocean.omega.numpy().astype(np.float64)
+    return h0 * np.exp(-1j * omega * t) + h0m * np.exp(1j * omega * t)
 
 
 @pytest.mark.parametrize("wind_speed", [4.0, 8.0])
@@ -60,7 +76,7 @@ def test_ocean_height_variance_matches_the_spectrum(device, wind_speed):
               "small_wave_m": 0.0}
     variances = []
     for seed in range(24):
-        ocean = water.FFTOcean(n, extent, 1000.0, device, seed=seed, **params)
+        ocean = water.FFTOcean(_phillips_h0(n, extent, seed, **params), extent, 1000.0, device)
         variances.append(np.var(ocean.at(1.3).positions.numpy()[..., 2].astype(np.float64)))
     variances = np.array(variances)
     k = water.wavenumbers(n, extent)
@@ -90,14 +106,14 @@ def test_ocean_matches_its_fourier_series(device):
     pos = surface.positions.numpy().astype(np.float64)
     nrm = surface.normals.numpy().astype(np.float64)
 
-    h0 = water.initial_spectrum(n, extent, seed=11, amplitude=3e-3, wind_speed_m_s=5.0,
-                                wind_direction_deg=25.0, small_wave_m=0.0)
+    h0 = _phillips_h0(n, extent)
     k = water.wavenumbers(n, extent)
     kx, ky = np.meshgrid(k, k)
     kk = np.hypot(kx, ky)
     omega = np.sqrt(9.81 * kk * np.tanh(kk * 4.0))
     neg = (-np.arange(n)) % n
-    ht = h0 * np.exp(1j * omega * t) + np.conj(h0[neg][:, neg]) * np.exp(-1j * omega * t)
+    # h̃0(k) travels along +k: e^{-iωt} (Tessendorf eq. 26 with t → −t).
+    ht = h0 * np.exp(-1j * omega * t) + np.conj(h0[neg][:, neg]) * np.exp(1j * omega * t)
     x = (np.arange(n) + 0.5) * extent / n - extent / 2
     xs, ys = np.meshgrid(x, x)
     phase = np.exp(1j * (np.multiply.outer(xs, kx) + np.multiply.outer(ys, ky)))  # (n,n,n,n)
@@ -147,3 +163,104 @@ def test_heightfield_normals_and_bilinear_sampling(device, rng):
     # float32 sample coordinates: |u| <= 200 texels -> ~1e-5 in the weights, times jumps of up to
     # ~6 between random neighbours.
     np.testing.assert_allclose(out.numpy(), ref, atol=1e-4)
+
+
+def _single_mode(n, extent, m, amplitude=0.01):
+    """h̃0 with one Fourier mode (m, 0): a single wave travelling along +x."""
+    h0 = np.zeros((n, n), complex)
+    h0[0, m] = amplitude
+    return h0
+
+
+@pytest.mark.parametrize("depth_m", [1000.0, 1.0])
+def test_single_mode_moves_at_the_phase_speed(device, depth_m):
+    """A single-mode ocean travels along +k at c = ω/k with ω² = g k tanh(k h) (deep and finite
+    depth, k h = 0.79), measured from the phase of its Fourier mode over time, within 1 %."""
+    n, extent, m = 64, 32.0, 4
+    ocean = water.FFTOcean(_single_mode(n, extent, m), extent, depth_m, device)
+    k = 2 * np.pi * m / extent
+    expected = np.sqrt(9.81 * k * np.tanh(k * depth_m)) / k
+    dt = 0.05
+    phases = []
+    for t in (0.0, dt):
+        h = ocean.at(t).positions.numpy()[..., 2].astype(np.float64)
+        phases.append(np.angle(np.fft.fft(h[0])[m]))
+    # h ∝ cos(k x - ω t + φ): the mode's phase falls by ω dt, i.e. the crest moves along +x.
+    speed = -np.angle(np.exp(1j * (phases[1] - phases[0]))) / (k * dt)
+    assert speed == pytest.approx(expected, rel=0.01)
+    if depth_m < 10:
+        assert expected < 0.9 * np.sqrt(9.81 / k)  # the finite-depth case really differs from deep
+
+
+def test_spectral_normals_match_finite_differences(device):
+    """Normals from spectral derivatives agree with central differences of the heights on a fine grid
+    (a band-limited ocean, so the O((kΔ)²) difference error is below 1e-3)."""
+    n, extent = 256, 10.0
+    ocean = _ocean(n, device, extent=extent, small_wave_m=0.25)
+    surface = ocean.at(0.7)
+    h = surface.positions.numpy()[..., 2].astype(np.float64)
+    cell = extent / n
+    hx = (np.roll(h, -1, axis=1) - np.roll(h, 1, axis=1)) / (2 * cell)
+    hy = (np.roll(h, -1, axis=0) - np.roll(h, 1, axis=0)) / (2 * cell)
+    fd = np.stack([-hx, -hy, np.ones_like(h)], -1)
+    fd /= np.linalg.norm(fd, axis=-1, keepdims=True)
+    assert np.abs(fd[..., 2] - 1).max() > 1e-3  # the surface is not flat
+    np.testing.assert_allclose(surface.normals.numpy(), fd, atol=1e-3)
+
+
+def test_choppy_jacobian_and_folds(device):
+    """Choppy waves: J = 1 everywhere for λ = 0; J equals finite differences of the displaced
+    vertices; the folded fraction (J ≤ 0) is 0 for small λ and grows with λ."""
+    n, extent = 128, 20.0
+    folds = []
+    for lam in (0.0, 0.5, 1.5, 3.0):
+        surface = _ocean(n, device, extent=extent, choppiness=lam, amplitude=5e-2,
+                         small_wave_m=0.5).at(1.0)  # band-limited: differences are accurate
+        jac = surface.jacobian.numpy().astype(np.float64)
+        folds.append(np.mean(jac <= 0.0))
+        if lam == 0.0:
+            assert np.all(jac == 1.0)
+        if lam == 0.5:
+            p = surface.positions.numpy().astype(np.float64)
+            cell = extent / n
+            dxdx = (np.roll(p[..., 0], -1, 1) - np.roll(p[..., 0], 1, 1)) / (2 * cell)
+            dydy = (np.roll(p[..., 1], -1, 0) - np.roll(p[..., 1], 1, 0)) / (2 * cell)
+            dxdy = (np.roll(p[..., 0], -1, 0) - np.roll(p[..., 0], 1, 0)) / (2 * cell)
+            dydx = (np.roll(p[..., 1], -1, 1) - np.roll(p[..., 1], 1, 1)) / (2 * cell)
+            inner = (slice(2, -2), slice(2, -2))  # x wraps by L at the edges
+            fd = (dxdx * dydy - dxdy * dydx)[inner]
+            # O((kΔ)²) difference error with kΔ ≲ 0.3 at the cut-off.
+            assert np.abs(jac[inner] - fd).mean() < 0.03 * np.abs(jac[inner] - 1).mean()
+    assert folds[0] == 0.0 and folds[1] == 0.0
+    assert folds[3] > folds[2] > 0.0
+
+
+def test_jonswap_variance_matches_its_frequency_spectrum(device):
+    """JONSWAP drawn on the wavenumber grid keeps the variance of the frequency spectrum it came
+    from: Σ P(k) Δk² = ∫ S(ω) dω within 3 % (tests the change of variables and the spreading's
+    normalisation), and the seeds' mean variance matches within 3σ."""
+    from warpcaustics.config import config_from_dict
+
+    cfg = config_from_dict({}, {"water.spectrum": "jonswap", "water.wind_speed_m_s": 6.0,
+                                "water.fetch_m": 20000.0, "water.extent_m": 300.0,
+                                "water.resolution": 512, "floor.depth_m": 30.0})
+    k = water.wavenumbers(512, 300.0)
+    p = water.ocean_spectrum(cfg, *np.meshgrid(k, k))
+    drawn = p.sum() * (2 * np.pi / 300.0) ** 2
+
+    g, u, f = 9.81, 6.0, 20000.0
+    alpha = 0.076 * (u * u / (f * g)) ** 0.22
+    wp_ = 22.0 * (g * g / (u * f)) ** (1 / 3)
+    omega = np.linspace(0.2 * wp_, 12 * wp_, 200001)
+    sigma = np.where(omega <= wp_, 0.07, 0.09)
+    s = alpha * g * g / omega**5 * np.exp(-1.25 * (wp_ / omega) ** 4) * 3.3 ** np.exp(
+        -((omega - wp_) ** 2) / (2 * sigma**2 * wp_**2))
+    assert drawn == pytest.approx(np.trapezoid(s, omega), rel=0.03)
+
+    variances = [np.var(water.FFTOcean.from_config(
+        config_from_dict({}, {"water.spectrum": "jonswap", "water.wind_speed_m_s": 6.0,
+                              "water.fetch_m": 20000.0, "water.extent_m": 300.0,
+                              "water.resolution": 512, "floor.depth_m": 30.0, "water.seed": sd}),
+        device).at(0.0).positions.numpy()[..., 2].astype(np.float64)) for sd in range(16)]
+    sigma_mean = np.std(variances, ddof=1) / np.sqrt(len(variances))
+    assert abs(np.mean(variances) - drawn) <= 3 * sigma_mean

@@ -38,6 +38,7 @@ class WaterModel(str, enum.Enum):
 
 class WaterSpectrum(str, enum.Enum):
     PHILLIPS = "phillips"
+    JONSWAP = "jonswap"
 
 
 class WaterType(str, enum.Enum):
@@ -58,7 +59,7 @@ class DeviceChoice(str, enum.Enum):
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
     "caustics.method": ("photons", "beams", "both", "sunmap", "eikonal", "wave3d"),
-    "water.spectrum": ("jonswap",),
+    "water.model": ("pool", "wavepool", "procedural"),
 }
 
 
@@ -74,7 +75,7 @@ class WaterConfig:
     """``.npy`` 2-D float array of heights [m], ``h[iy, ix]``, at cell centres; relative paths
     are resolved against the config file's folder."""
     spectrum: WaterSpectrum = WaterSpectrum.PHILLIPS
-    """Wave spectrum of the ``fft`` ocean."""
+    """Wave spectrum of the ``fft`` ocean: ``phillips`` (Tessendorf) or ``jonswap`` (fetch-limited)."""
     wind_speed_m_s: float = field(default=4.0, metadata=_range(0.0, 60.0, lo_open=True))
     """Wind speed at 10 m [m/s]."""
     wind_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
@@ -83,6 +84,14 @@ class WaterConfig:
     """Phillips constant A (dimensionless): height variance = A·π·(V²/g)²/2 over all k."""
     small_wave_m: float = field(default=0.0, metadata=_range(0.0, None))
     """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
+    fetch_m: float = field(default=100_000.0, metadata=_range(0.0, 1.0e7, lo_open=True))
+    """Distance over which the wind has blown (JONSWAP) [m]."""
+    jonswap_gamma: float = field(default=3.3, metadata=_range(1.0, 10.0))
+    """JONSWAP peak enhancement γ (1 = Pierson–Moskowitz shape) [-]."""
+    spreading_s: float = field(default=10.0, metadata=_range(0.0, 1000.0))
+    """Exponent s of the cos-2s directional spreading (JONSWAP); larger = narrower [-]."""
+    choppiness: float = field(default=0.0, metadata=_range(0.0, 5.0))
+    """Strength λ of the choppy horizontal displacement (Tessendorf eq. 29) [-]; 0 = none."""
     seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
     """Seed of the ocean's random phases and amplitudes."""
 

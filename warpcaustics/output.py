@@ -140,6 +140,7 @@ def write_run_json(out_dir: Path, results: list) -> Path:
             "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
             "floor_flux_w_nm": r.floor_flux_w_nm,
             "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
+            "fold_fraction": r.fold_fraction,
         } for i, r in enumerate(results)],
     })
     return path

@@ -45,6 +45,8 @@ class RenderResult:
     """(N, N, 3) water surface vertices [m]."""
     surface_normals: np.ndarray
     """(N, N, 3) unit surface normals."""
+    fold_fraction: float = 0.0
+    """Fraction of surface vertices where choppy displacement folds the surface (Jacobian ≤ 0)."""
     timings_s: dict[str, float] = field(default_factory=dict)
     """Wall time of each stage [s] (device synchronised)."""
 
@@ -156,13 +158,15 @@ class Renderer:
             transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
+            folds = float(np.mean(surface.jacobian.numpy() <= 0.0)) if surface.jacobian is not None else 0.0
         k = len(self.bins.centres_nm)
         return RenderResult(
             scene=self.scene, time_s=time_s, device=dev, wavelengths_nm=self.bins.centres_nm,
             bin_widths_nm=self.bins.widths_nm, floor_irradiance=floor_np,
             attenuation_per_m=self.attenuation_per_m, ior=np.full(k, cfg.optics.ior),
             sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
-            surface_positions=positions, surface_normals=normals, timings_s=watch.timings)
+            surface_positions=positions, surface_normals=normals, fold_fraction=folds,
+            timings_s=watch.timings)
 
 
 _MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"

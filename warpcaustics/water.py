@@ -2,7 +2,8 @@
 
 Vertices sit at cell centres ``(i + 0.5)·L/N − L/2`` of a periodic N×N grid, row index along +y.
 Models: ``flat`` and ``heightfield`` (a periodic height field, normals by central differences) and
-``fft`` (Tessendorf's ocean with a Phillips spectrum; heights and slopes by inverse FFT in Warp).
+``fft`` (Tessendorf's ocean, Phillips or JONSWAP spectrum, optional choppy displacement; heights,
+slopes and displacements by inverse FFT in Warp).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config, WaterModel
+from warpcaustics.config import Config, WaterModel, WaterSpectrum
 from warpcaustics.heights import DEFAULT_RESOLUTION
 from warpcaustics.kernels import heightfield as hf_kernels
 from warpcaustics.kernels import ocean as ocean_kernels
@@ -30,6 +31,8 @@ class Surface:
     """(N, N) unit normals pointing up, out of the water."""
     extent_m: float
     """Side L of the periodic patch [m]."""
+    jacobian: wp.array2d | None = None
+    """(N, N) Jacobian of the choppy horizontal map (≤ 0 where the surface folds), if any."""
 
     @property
     def resolution(self) -> int:
@@ -78,18 +81,67 @@ def phillips_spectrum(kx: np.ndarray, ky: np.ndarray, *, amplitude: float, wind_
     return p
 
 
-def initial_spectrum(n: int, extent_m: float, *, seed: int, **phillips) -> np.ndarray:
+def jonswap_spectrum(kx: np.ndarray, ky: np.ndarray, *, wind_speed_m_s: float,
+                     wind_direction_deg: float, fetch_m: float, gamma: float, spreading_s: float,
+                     depth_m: float, small_wave_m: float) -> np.ndarray:
+    """JONSWAP directional wavenumber spectrum P(k) [m^4], zero at k = 0.
+
+    Frequency spectrum (Hasselmann et al. 1973, in the form of Horvath 2015, "Empirical
+    directional wave spectra for computer graphics", eq. 28–30):
+    ``S(ω) = α g² ω⁻⁵ exp(−5/4 (ω_p/ω)⁴) γ^r``, ``r = exp(−(ω − ω_p)² / (2σ²ω_p²))``,
+    σ = 0.07 for ω ≤ ω_p else 0.09, ``α = 0.076 (U²/(F g))^0.22``, ``ω_p = 22 (g²/(U F))^(1/3)``.
+    Directional spreading: Longuet-Higgins cos-2s, ``D(θ) ∝ |cos((θ − θ_w)/2)|^{2s}``, normalised
+    numerically over (−π, π]. Change of variables to the wavenumber plane with the finite-depth
+    dispersion relation: ``P(k) = S(ω(k)) D(θ) (dω/dk) / k`` so that ∫P d²k = ∫S dω.
+    """
+    g = GRAVITY_M_S2
+    k = np.hypot(kx, ky)
+    alpha = 0.076 * (wind_speed_m_s**2 / (fetch_m * g)) ** 0.22
+    omega_p = 22.0 * (g * g / (wind_speed_m_s * fetch_m)) ** (1.0 / 3.0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        th = np.tanh(k * depth_m)
+        omega = np.sqrt(g * k * th)
+        domega_dk = g * (th + k * depth_m * (1.0 - th * th)) / (2.0 * omega)
+        sigma = np.where(omega <= omega_p, 0.07, 0.09)
+        r = np.exp(-((omega - omega_p) ** 2) / (2.0 * sigma**2 * omega_p**2))
+        s_omega = alpha * g * g / omega**5 * np.exp(-1.25 * (omega_p / omega) ** 4) * gamma**r
+        theta = np.arctan2(ky, kx) - np.radians(wind_direction_deg)
+        p = s_omega * cos2s_spreading(theta, spreading_s) * domega_dk / k * np.exp(-k * k * small_wave_m**2)
+    p[~np.isfinite(p) | (k == 0.0)] = 0.0
+    return p
+
+
+def cos2s_spreading(theta: np.ndarray, s: float) -> np.ndarray:
+    """Longuet-Higgins cos-2s directional spreading, normalised so ∫ D dθ = 1 over a full turn."""
+    fine = np.linspace(-np.pi, np.pi, 20001)
+    norm = np.trapezoid(np.abs(np.cos(fine / 2.0)) ** (2.0 * s), fine)
+    return np.abs(np.cos(theta / 2.0)) ** (2.0 * s) / norm
+
+
+def ocean_spectrum(cfg: Config, kx: np.ndarray, ky: np.ndarray) -> np.ndarray:
+    """The directional spectrum P(k) [m^4] named by ``water.spectrum``."""
+    w = cfg.water
+    if w.spectrum is WaterSpectrum.JONSWAP:
+        return jonswap_spectrum(kx, ky, wind_speed_m_s=w.wind_speed_m_s,
+                                wind_direction_deg=w.wind_direction_deg, fetch_m=w.fetch_m,
+                                gamma=w.jonswap_gamma, spreading_s=w.spreading_s,
+                                depth_m=cfg.floor.depth_m, small_wave_m=w.small_wave_m)
+    return phillips_spectrum(kx, ky, amplitude=w.phillips_amplitude, wind_speed_m_s=w.wind_speed_m_s,
+                             wind_direction_deg=w.wind_direction_deg, small_wave_m=w.small_wave_m)
+
+
+def initial_spectrum(spectrum: np.ndarray, extent_m: float, *, seed: int) -> np.ndarray:
     """h̃0(k) = ξ sqrt(P(k) Δk² / 2), ξ complex unit Gaussian (Tessendorf eq. 42), FFT order.
 
-    With this scaling the variance of h(x, t) is Σ_k P(k) Δk² ≈ ∫P d²k. The Nyquist row and column
-    are zeroed so that the spectrum shifted to cell centres stays Hermitian (real heights).
+    ``spectrum`` is P(k) [m^4] on the FFT grid. With this scaling the variance of h(x, t) is
+    Σ_k P(k) Δk² ≈ ∫P d²k. The Nyquist row and column are zeroed so that the spectrum shifted to
+    cell centres stays Hermitian (real heights).
     """
-    k = wavenumbers(n, extent_m)
-    kx, ky = np.meshgrid(k, k)
+    n = spectrum.shape[0]
     dk = 2.0 * np.pi / extent_m
     rng = np.random.default_rng(seed)
     xi = (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))) / np.sqrt(2.0)
-    h0 = xi * np.sqrt(phillips_spectrum(kx, ky, **phillips) * dk * dk / 2.0)
+    h0 = xi * np.sqrt(spectrum * dk * dk / 2.0)
     h0[n // 2, :] = 0.0
     h0[:, n // 2] = 0.0
     return h0
@@ -143,19 +195,24 @@ def _fft2(data: wp.array2d, row_kernel, scratch: wp.array2d | None) -> wp.array2
     return data
 
 
-class FFTOcean:
-    """Tessendorf FFT ocean with a Phillips spectrum; deep-or-finite-depth dispersion."""
+def dispersion(k: np.ndarray, depth_m: float) -> np.ndarray:
+    """Angular frequency of gravity waves over a floor at depth h: ω² = g k tanh(k h) (Tessendorf
+    eq. 19) [rad/s]."""
+    return np.sqrt(GRAVITY_M_S2 * k * np.tanh(k * depth_m))
 
-    def __init__(self, n: int, extent_m: float, depth_m: float, device: str, *, seed: int,
-                 **phillips):
+
+class FFTOcean:
+    """Tessendorf FFT ocean: any initial spectrum h̃0, finite-depth dispersion, choppy waves."""
+
+    def __init__(self, h0: np.ndarray, extent_m: float, depth_m: float, device: str, *,
+                 choppiness: float = 0.0):
+        n = h0.shape[0]
         self.device = device
         self.extent_m = extent_m
+        self.choppiness = float(choppiness)
         k = wavenumbers(n, extent_m)
         kx, ky = np.meshgrid(k, k)
-        kmag = np.hypot(kx, ky)
-        # Dispersion over a floor at depth h: ω² = g k tanh(k h) (Tessendorf eq. 19).
-        omega = np.sqrt(GRAVITY_M_S2 * kmag * np.tanh(kmag * depth_m))
-        h0 = initial_spectrum(n, extent_m, seed=seed, **phillips)
+        omega = dispersion(np.hypot(kx, ky), depth_m)
         h0_minus = h0[(-np.arange(n)) % n][:, (-np.arange(n)) % n]
         # Vertex (ix, iy) is at x0 + ix L/N with x0 = -L/2 + L/(2N): fold e^{i k·x0} into h̃0.
         x0 = -0.5 * extent_m + 0.5 * extent_m / n
@@ -164,39 +221,50 @@ class FFTOcean:
         self.h0_minus_conj = to_vec2(np.conj(h0_minus) * shift, device)
         self.omega = wp.array(omega.astype(np.float32), dtype=wp.float32, device=device)
         self.k_axis = wp.array(k.astype(np.float32), dtype=wp.float32, device=device)
-        self._a = wp.empty((n, n), dtype=wp.vec2, device=device)
-        self._b = wp.empty((n, n), dtype=wp.vec2, device=device)
+        self._spectra = [wp.empty((n, n), dtype=wp.vec2, device=device) for _ in range(4)]
         self._scratch = wp.empty((n, n), dtype=wp.vec2, device=device)
+
+    @classmethod
+    def from_config(cls, cfg: Config, device: str) -> FFTOcean:
+        """The ocean of ``water.*`` (spectrum, wind, fetch, choppiness, seed) over ``floor.depth_m``."""
+        w = cfg.water
+        n = w.resolution or DEFAULT_RESOLUTION
+        k = wavenumbers(n, w.extent_m)
+        spectrum = ocean_spectrum(cfg, *np.meshgrid(k, k))
+        return cls(initial_spectrum(spectrum, w.extent_m, seed=w.seed), w.extent_m, cfg.floor.depth_m,
+                   device, choppiness=w.choppiness)
 
     @property
     def resolution(self) -> int:
         return self.h0.shape[0]
 
-    def spectra_at(self, time_s: float) -> tuple[wp.array2d, wp.array2d]:
-        """Device spectra (H + i·i kx H, i ky H) at time t (before the inverse FFT)."""
+    def spectra_at(self, time_s: float) -> list[wp.array2d]:
+        """The four packed device spectra at time t (see kernels/ocean.py:evolve_spectrum)."""
         n = self.resolution
         wp.launch(ocean_kernels.evolve_spectrum, dim=(n, n),
                   inputs=[self.h0, self.h0_minus_conj, self.omega, self.k_axis, float(time_s)],
-                  outputs=[self._a, self._b], device=self.device)
-        return self._a, self._b
+                  outputs=self._spectra, device=self.device)
+        return self._spectra
 
     def at(self, time_s: float) -> Surface:
         n = self.resolution
-        a, b = self.spectra_at(time_s)
-        ifft2(a, self._scratch)
-        ifft2(b, self._scratch)
+        spectra = self.spectra_at(time_s)
+        for spectrum in spectra[: 4 if self.choppiness else 2]:
+            ifft2(spectrum, self._scratch)
         positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
         normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        wp.launch(ocean_kernels.assemble_surface, dim=(n, n), inputs=[a, b, self.extent_m],
-                  outputs=[positions, normals], device=self.device)
-        return Surface(positions, normals, self.extent_m)
+        jacobian = wp.empty((n, n), dtype=wp.float32, device=self.device)
+        wp.launch(ocean_kernels.assemble_surface, dim=(n, n),
+                  inputs=[*spectra, self.choppiness, self.extent_m],
+                  outputs=[positions, normals, jacobian], device=self.device)
+        return Surface(positions, normals, self.extent_m, jacobian)
 
 
 def water_bytes(cfg: Config, n: int) -> int:
     """Device memory the water model holds for an N×N grid [bytes]."""
     surface = n * n * 24  # positions + normals (vec3f)
     if cfg.water.model is WaterModel.FFT:
-        return surface + n * n * (8 * 5 + 4)  # h0, h0-, two spectra, scratch (vec2f) + omega
+        return surface + n * n * (8 * 7 + 8)  # h0, h0-, four spectra, scratch (vec2f); ω, J
     return surface + n * n * 4
 
 
@@ -204,9 +272,7 @@ def make_water(cfg: Config, device: str, heights: np.ndarray | None):
     """Build the surface model named by ``water.model``."""
     w = cfg.water
     if w.model is WaterModel.FFT:
-        return FFTOcean(w.resolution or DEFAULT_RESOLUTION, w.extent_m, cfg.floor.depth_m, device,
-                        seed=w.seed, amplitude=w.phillips_amplitude, wind_speed_m_s=w.wind_speed_m_s,
-                        wind_direction_deg=w.wind_direction_deg, small_wave_m=w.small_wave_m)
+        return FFTOcean.from_config(cfg, device)
     if w.model is WaterModel.HEIGHTFIELD:
         return HeightfieldWater(heights, w.extent_m, device)
     n = w.resolution or DEFAULT_RESOLUTION
