@@ -15,21 +15,27 @@ import time
 from importlib import metadata
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 
 # (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
 FULL = [(256, 512, 16, True), (512, 1024, 16, True), (1024, 2048, 16, False)]
 QUICK = [(128, 256, 8, True)]
+# FFT ocean step sizes N.
+OCEAN_FULL = [64, 128, 256, 512, 1024]
+OCEAN_QUICK = [64, 128]
 
 
-def _in_child(func_name: str, *args):
-    """Run benchmarks.frame.<func_name>(*args) in a fresh spawned process (own peak memory)."""
+def _in_child(func_name: str, *args, module: str = "frame"):
+    """Run benchmarks.<module>.<func_name>(*args) in a fresh spawned process (own peak memory)."""
     ctx = mp.get_context("spawn")
     with ctx.Pool(1) as pool:
-        return pool.apply(_call, (func_name, args))
+        return pool.apply(_call, (module, func_name, args))
 
 
-def _call(func_name, args):
+def _call(module, func_name, args):
+    import importlib
     import os
 
     os.chdir(ROOT)
@@ -37,9 +43,54 @@ def _call(func_name, args):
     from warpcaustics.device import _warp
 
     _warp()
-    from benchmarks import frame
+    return getattr(importlib.import_module(f"benchmarks.{module}"), func_name)(*args)
 
-    return getattr(frame, func_name)(*args)
+
+def _ocean_steps(sizes: list[int], device: str, repeats: int) -> list[dict]:
+    rows = []
+    for n in sizes:
+        w = _in_child("measure_warp", n, device, repeats, module="ocean_step")
+        npy = _in_child("measure_numpy", n, repeats, module="ocean_step")
+        row = {"water_n": n, "warp_step_s": w["step_s"], "numpy_step_s": npy["step_s"],
+               "speedup_warp_vs_numpy": npy["step_s"] / w["step_s"],
+               "max_abs_position_diff_m": npy["max_abs_position_diff_m"]}
+        rows.append(row)
+        print(f"ocean step   N={n:5d} (choppy, 4 FFTs) | warp[{device}] {w['step_s'] * 1e3:9.2f} ms | "
+              f"numpy.fft {npy['step_s'] * 1e3:9.2f} ms | ratio {row['speedup_warp_vs_numpy']:6.1f}x",
+              flush=True)
+    if len(rows) >= 2:
+        n = np.log([r["water_n"] for r in rows])
+        for key in ("warp_step_s", "numpy_step_s"):
+            slope = np.polyfit(n, np.log([r[key] for r in rows]), 1)[0]
+            print(f"  log-log slope of {key} vs N: {slope:.2f} (N² log N ≈ 2.0–2.2)")
+            for r in rows:
+                r[f"{key}_loglog_slope"] = float(slope)
+    return rows
+
+
+def _plot_ocean(rows: list[dict], path: Path) -> None:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("matplotlib not installed (pip install -e '.[bench]'): no plot written")
+        return
+    n = [r["water_n"] for r in rows]
+    fig, ax = plt.subplots(figsize=(5, 3.6), dpi=120)
+    for key, label in (("warp_step_s", "Warp"), ("numpy_step_s", "numpy.fft")):
+        ax.loglog(n, [r[key] * 1e3 for r in rows], "o-",
+                  label=f"{label} (slope {rows[0][f'{key}_loglog_slope']:.2f})")
+    ax.set_xlabel("water resolution N (N×N)")
+    ax.set_ylabel("one ocean step [ms]")
+    ax.set_title("FFT ocean step, choppy (4 complex 2-D FFTs), CPU")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    print(f"wrote {path}")
 
 
 def _cpu_name() -> str:
@@ -77,6 +128,11 @@ def main(argv: list[str] | None = None) -> int:
               f"peak {warp_res['peak_rss_mib']:7.0f} MiB | numpy {np_time} s | ratio {speed}",
               flush=True)
 
+    ocean_rows = _ocean_steps(OCEAN_QUICK if args.quick else OCEAN_FULL, args.device, repeats)
+    if not args.quick:
+        device_tag = args.device.replace(":", "")
+        _plot_ocean(ocean_rows, ROOT / "docs" / "images" / f"ocean_step_scaling_{device_tag}.png")
+
     record = {
         "benchmark": "ocean_frame_floor_caustics",
         "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
@@ -88,6 +144,7 @@ def main(argv: list[str] | None = None) -> int:
         "repeats": repeats,
         "timing": "median wall time; Warp after one warm-up frame, device synchronised",
         "results": rows,
+        "ocean_step": ocean_rows,
     }
     out = args.out or ROOT / "benchmarks" / "results" / (
         f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")

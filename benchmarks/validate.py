@@ -101,11 +101,13 @@ def main() -> int:
           f"{np.maximum(a_perp, 0).sum() / (64.0 * s_dir[2]):.3f}; floor flux / beam flux "
           f"{r.floor_flux_w_nm[0] / beam:.3f}")
 
+    from test_water import _phillips_h0
+
     print("\n## Ocean height variance vs the spectrum (24 seeds, 512² over 200 m, A = 3e-3)")
     for wind in (4.0, 8.0):
         params = {"amplitude": 3e-3, "wind_speed_m_s": wind, "wind_direction_deg": 40.0, "small_wave_m": 0.0}
-        var = np.array([np.var(water.FFTOcean(512, 200.0, 1000.0, "cpu", seed=sd, **params).at(1.3)
-                               .positions.numpy()[..., 2].astype(np.float64)) for sd in range(24)])
+        var = np.array([np.var(water.FFTOcean(_phillips_h0(512, 200.0, sd, **params), 200.0, 1000.0, "cpu")
+                               .at(1.3).positions.numpy()[..., 2].astype(np.float64)) for sd in range(24)])
         k = water.wavenumbers(512, 200.0)
         p = water.phillips_spectrum(*np.meshgrid(k, k), **params)
         p[256, :] = 0.0
@@ -116,6 +118,46 @@ def main() -> int:
         print(f"wind {wind} m/s: mean variance {var.mean():.5f} m², drawn ΣPΔk² {drawn:.5f} "
               f"({(var.mean() / drawn - 1):+.2%}, σ of the mean {sig / drawn:.1%}), continuous "
               f"{cont:.5f} ({drawn / cont - 1:+.2%}); Hs {4 * np.sqrt(var.mean()):.3f} m")
+
+    print("\n## FFT ocean dynamics and choppiness")
+    from test_water import _ocean, _single_mode
+
+    from warpcaustics.config import config_from_dict
+
+    for depth in (1000.0, 1.0):
+        ocean = water.FFTOcean(_single_mode(64, 32.0, 4), 32.0, depth, "cpu")
+        kw = 2 * np.pi * 4 / 32.0
+        ph = [np.angle(np.fft.fft(ocean.at(t).positions.numpy()[0, :, 2].astype(np.float64))[4])
+              for t in (0.0, 0.05)]
+        c = -np.angle(np.exp(1j * (ph[1] - ph[0]))) / (kw * 0.05)
+        c0 = np.sqrt(9.81 * kw * np.tanh(kw * depth)) / kw
+        print(f"single mode, depth {depth:6.1f} m: phase speed {c:.4f} m/s, ω/k {c0:.4f} ({c / c0 - 1:+.2%})")
+    surface = _ocean(256, "cpu", extent=10.0, small_wave_m=0.25).at(0.7)
+    hh = surface.positions.numpy()[..., 2].astype(np.float64)
+    cell = 10.0 / 256
+    fd = np.stack([-(np.roll(hh, -1, 1) - np.roll(hh, 1, 1)) / (2 * cell),
+                   -(np.roll(hh, -1, 0) - np.roll(hh, 1, 0)) / (2 * cell), np.ones_like(hh)], -1)
+    fd /= np.linalg.norm(fd, axis=-1, keepdims=True)
+    print(f"spectral normals vs central differences (256², band-limited): max |Δn| "
+          f"{np.abs(surface.normals.numpy() - fd).max():.1e}")
+    for lam in (0.0, 0.5, 1.5, 3.0):
+        jac = _ocean(128, "cpu", extent=20.0, choppiness=lam, amplitude=5e-2, small_wave_m=0.5).at(
+            1.0).jacobian.numpy()
+        print(f"choppiness {lam}: folded fraction {np.mean(jac <= 0):.3%}, mean |J - 1| "
+              f"{np.abs(jac - 1).mean():.3f}")
+    cfg = config_from_dict({}, {"water.spectrum": "jonswap", "water.wind_speed_m_s": 6.0,
+                                "water.fetch_m": 20000.0, "water.extent_m": 300.0,
+                                "water.resolution": 512, "floor.depth_m": 30.0})
+    kk = water.wavenumbers(512, 300.0)
+    drawn = water.ocean_spectrum(cfg, *np.meshgrid(kk, kk)).sum() * (2 * np.pi / 300.0) ** 2
+    g, u, f = 9.81, 6.0, 20000.0
+    al, wpk = 0.076 * (u * u / (f * g)) ** 0.22, 22.0 * (g * g / (u * f)) ** (1 / 3)
+    om = np.linspace(0.2 * wpk, 12 * wpk, 200001)
+    sg = np.where(om <= wpk, 0.07, 0.09)
+    so = (al * g * g / om**5 * np.exp(-1.25 * (wpk / om) ** 4)
+          * 3.3 ** np.exp(-((om - wpk) ** 2) / (2 * sg**2 * wpk**2)))
+    print(f"JONSWAP (6 m/s, 20 km fetch): Σ P Δk² {drawn:.5f} m², ∫ S dω {np.trapezoid(so, om):.5f} m² "
+          f"({drawn / np.trapezoid(so, om) - 1:+.2%})")
 
     print("\n## Colour: D65 → linear sRGB / Y")
     from warpcaustics import colour_out

@@ -1,0 +1,75 @@
+"""One FFT-ocean step (spectrum at t, inverse FFTs, surface assembly): Warp vs numpy.fft.
+
+Both compute the same choppy surface (λ = 1: four packed complex 2-D transforms) from the same
+initial spectrum: the four Hermitian spectra at time t, their inverse FFTs, then positions,
+normals and the Jacobian at every vertex.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+
+def _ocean(n: int, device: str):
+    import warpcaustics as wc
+    from warpcaustics.water import FFTOcean
+
+    scene = wc.load_scene("configs/ocean.toml", {"water.resolution": n, "water.choppiness": 1.0})
+    return FFTOcean.from_config(scene.config, device)
+
+
+def measure_warp(n: int, device: str, repeats: int) -> dict:
+    import warp as wp
+
+    ocean = _ocean(n, device)
+    ocean.at(0.0)  # warm-up: JIT compile excluded
+    wp.synchronize_device(device)
+    times = []
+    for i in range(repeats):
+        t0 = time.perf_counter()
+        ocean.at(0.1 * (i + 1))
+        wp.synchronize_device(device)
+        times.append(time.perf_counter() - t0)
+    return {"step_s": float(np.median(times))}
+
+
+def numpy_step(h0, h0m, omega, k, choppiness, extent_m, t):
+    """The same step in numpy (complex128 spectra, numpy.fft.ifft2)."""
+    n = len(k)
+    kx, ky = np.meshgrid(k, k)
+    kk = np.hypot(kx, ky)
+    inv_k = np.divide(1.0, kk, out=np.zeros_like(kk), where=kk > 0)
+    h = h0 * np.exp(-1j * omega * t) + h0m * np.exp(1j * omega * t)
+    f = lambda spec: np.fft.ifft2(spec) * (n * n)  # noqa: E731
+    a = f(h + 1j * (1j * kx * h))
+    b = f(1j * ky * h + 1j * (-1j * kx * inv_k * h))
+    c = f(-1j * ky * inv_k * h + 1j * (kx * kx * inv_k * h))
+    d = f(ky * ky * inv_k * h + 1j * (kx * ky * inv_k * h))
+    x = (np.arange(n) + 0.5) * extent_m / n - extent_m / 2
+    xs, ys = np.meshgrid(x, x)
+    jxx, jyy, jxy = 1 + choppiness * c.imag, 1 + choppiness * d.real, choppiness * d.imag
+    positions = np.stack([xs + choppiness * b.imag, ys + choppiness * c.real, a.real], -1)
+    tx = np.stack([jxx, jxy, a.imag], -1)
+    ty = np.stack([jxy, jyy, b.real], -1)
+    normals = np.cross(tx, ty)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    return positions, normals, jxx * jyy - jxy * jxy
+
+
+def measure_numpy(n: int, repeats: int) -> dict:
+    from warpcaustics.water import from_vec2
+
+    ocean = _ocean(n, "cpu")
+    h0, h0m = from_vec2(ocean.h0), from_vec2(ocean.h0_minus_conj)
+    omega = ocean.omega.numpy().astype(np.float64)
+    k = ocean.k_axis.numpy().astype(np.float64)
+    times = []
+    for i in range(repeats):
+        t0 = time.perf_counter()
+        positions, _, _ = numpy_step(h0, h0m, omega, k, 1.0, ocean.extent_m, 0.1 * (i + 1))
+        times.append(time.perf_counter() - t0)
+    warp_pos = ocean.at(0.1 * repeats).positions.numpy()
+    err = float(np.abs(warp_pos - positions).max())
+    return {"step_s": float(np.median(times)), "max_abs_position_diff_m": err}
