@@ -22,9 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 # (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
 FULL = [(256, 512, 16, True), (512, 1024, 16, True), (1024, 2048, 16, False)]
 QUICK = [(128, 256, 8, True)]
-# FFT ocean step sizes N.
-OCEAN_FULL = [64, 128, 256, 512, 1024]
-OCEAN_QUICK = [64, 128]
+# Step benchmarks: (module, label, sizes N full, sizes N quick)
+STEPS = [("ocean_step", "FFT ocean step, choppy (4 complex 2-D FFTs)", [64, 128, 256, 512, 1024], [64, 128]),
+         ("pool_step", "shallow-water pool substep", [64, 128, 256, 512, 1024], [64, 128])]
 
 
 def _in_child(func_name: str, *args, module: str = "frame"):
@@ -46,29 +46,29 @@ def _call(module, func_name, args):
     return getattr(importlib.import_module(f"benchmarks.{module}"), func_name)(*args)
 
 
-def _ocean_steps(sizes: list[int], device: str, repeats: int) -> list[dict]:
+def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dict]:
     rows = []
     for n in sizes:
-        w = _in_child("measure_warp", n, device, repeats, module="ocean_step")
-        npy = _in_child("measure_numpy", n, repeats, module="ocean_step")
+        w = _in_child("measure_warp", n, device, repeats, module=module)
+        npy = _in_child("measure_numpy", n, repeats, module=module)
         row = {"water_n": n, "warp_step_s": w["step_s"], "numpy_step_s": npy["step_s"],
-               "speedup_warp_vs_numpy": npy["step_s"] / w["step_s"],
-               "max_abs_position_diff_m": npy["max_abs_position_diff_m"]}
+               "speedup_warp_vs_numpy": npy["step_s"] / w["step_s"]}
+        row.update({key: val for key, val in npy.items() if key != "step_s"})
         rows.append(row)
-        print(f"ocean step   N={n:5d} (choppy, 4 FFTs) | warp[{device}] {w['step_s'] * 1e3:9.2f} ms | "
-              f"numpy.fft {npy['step_s'] * 1e3:9.2f} ms | ratio {row['speedup_warp_vs_numpy']:6.1f}x",
+        print(f"{module:11s}  N={n:5d} | warp[{device}] {w['step_s'] * 1e3:9.3f} ms | "
+              f"numpy {npy['step_s'] * 1e3:9.3f} ms | ratio {row['speedup_warp_vs_numpy']:6.1f}x",
               flush=True)
     if len(rows) >= 2:
         n = np.log([r["water_n"] for r in rows])
         for key in ("warp_step_s", "numpy_step_s"):
             slope = np.polyfit(n, np.log([r[key] for r in rows]), 1)[0]
-            print(f"  log-log slope of {key} vs N: {slope:.2f} (N² log N ≈ 2.0–2.2)")
+            print(f"  log-log slope of {key} vs N: {slope:.2f}")
             for r in rows:
                 r[f"{key}_loglog_slope"] = float(slope)
     return rows
 
 
-def _plot_ocean(rows: list[dict], path: Path) -> None:
+def _plot_steps(rows: list[dict], title: str, path: Path) -> None:
     try:
         import matplotlib
 
@@ -79,12 +79,12 @@ def _plot_ocean(rows: list[dict], path: Path) -> None:
         return
     n = [r["water_n"] for r in rows]
     fig, ax = plt.subplots(figsize=(5, 3.6), dpi=120)
-    for key, label in (("warp_step_s", "Warp"), ("numpy_step_s", "numpy.fft")):
+    for key, label in (("warp_step_s", "Warp"), ("numpy_step_s", "numpy")):
         ax.loglog(n, [r[key] * 1e3 for r in rows], "o-",
                   label=f"{label} (slope {rows[0][f'{key}_loglog_slope']:.2f})")
     ax.set_xlabel("water resolution N (N×N)")
-    ax.set_ylabel("one ocean step [ms]")
-    ax.set_title("FFT ocean step, choppy (4 complex 2-D FFTs), CPU")
+    ax.set_ylabel("one step [ms]")
+    ax.set_title(title, fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
@@ -128,10 +128,13 @@ def main(argv: list[str] | None = None) -> int:
               f"peak {warp_res['peak_rss_mib']:7.0f} MiB | numpy {np_time} s | ratio {speed}",
               flush=True)
 
-    ocean_rows = _ocean_steps(OCEAN_QUICK if args.quick else OCEAN_FULL, args.device, repeats)
-    if not args.quick:
-        device_tag = args.device.replace(":", "")
-        _plot_ocean(ocean_rows, ROOT / "docs" / "images" / f"ocean_step_scaling_{device_tag}.png")
+    steps = {}
+    for module, title, full, quick in STEPS:
+        steps[module] = _steps(module, quick if args.quick else full, args.device, repeats)
+        if not args.quick:
+            device_tag = args.device.replace(":", "")
+            _plot_steps(steps[module], f"{title}, {args.device}",
+                        ROOT / "docs" / "images" / f"{module}_scaling_{device_tag}.png")
 
     record = {
         "benchmark": "ocean_frame_floor_caustics",
@@ -144,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
         "repeats": repeats,
         "timing": "median wall time; Warp after one warm-up frame, device synchronised",
         "results": rows,
-        "ocean_step": ocean_rows,
+        "steps": steps,
     }
     out = args.out or ROOT / "benchmarks" / "results" / (
         f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")

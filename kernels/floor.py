@@ -72,11 +72,26 @@ def lift(p: wp.vec3, shift: wp.vec2) -> wp.vec3:
 
 
 @wp.func
-def wrap(i: int, m: int) -> int:
+def texel(i: int, m: int, periodic: int) -> int:
+    """Texel index i on a map of m: wrapped when periodic, −1 (dropped) outside a walled map."""
+    if periodic == 0:
+        if i < 0 or i >= m:
+            return -1
+        return i
     r = i % m
     if r < 0:
         r += m
     return r
+
+
+@wp.func
+def texel_of(x: float, m: int, periodic: int) -> int:
+    """Texel holding coordinate x [texels], safe for coordinates beyond the int range."""
+    if periodic == 0:
+        if x < 0.0 or x >= float(m):
+            return -1
+        return int(x)
+    return int(wrap_coord(x, m))
 
 
 @wp.kernel
@@ -89,6 +104,7 @@ def triangle_flux(
     attenuation_per_m: wp.array[wp.float32],
     wavelengths_per_group: int,
     extent_m: float,
+    periodic: int,
     flux_w_nm: wp.array4d[wp.float32],
 ):
     """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at every wavelength k.
@@ -107,6 +123,8 @@ def triangle_flux(
     p1 = lift(positions[y1, x1], s1)
     p2 = lift(positions[y2, x2], s2)
     a_perp = wp.max(0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir), 0.0)
+    if periodic == 0 and (ix == n - 1 or iy == n - 1):
+        a_perp = 0.0  # a walled surface has no triangles across its edges
     for k in range(sun_irradiance.shape[0]):
         g = k / wavelengths_per_group
         c = attenuation_per_m[k]
@@ -131,7 +149,10 @@ def add_to_texel(
     ty: int,
     weight: float,
 ):
-    """Add ``weight`` × the triangle's flux to texel (ty, tx) of each wavelength of its group."""
+    """Add ``weight`` × the triangle's flux to texel (ty, tx) of each wavelength of its group
+    (nothing for a texel index of −1: light that left a walled map)."""
+    if tx < 0 or ty < 0:
+        return
     for j in range(k_count):
         k = k_begin + j
         wp.atomic_add(floor_texels, ty, tx, k, weight * flux_w_nm[iy, ix, half, k])
@@ -150,6 +171,7 @@ def deposit_by_samples(
     e1: wp.vec2,
     e2: wp.vec2,
     m: int,
+    periodic: int,
     inv_texel_area: float,
 ):
     """Deposit a footprint (q0, q0 + e1, q0 + e2) [texels] through the centroids of its
@@ -164,7 +186,7 @@ def deposit_by_samples(
                 off = 1.0 / 3.0 + float(flip) / 3.0
                 p = q0 + ((float(a) + off) / float(s)) * e1 + ((float(b) + off) / float(s)) * e2
                 add_to_texel(floor_texels, flux_w_nm, k_begin, k_count, iy, ix, half,
-                             int(wrap_coord(p[0], m)), int(wrap_coord(p[1], m)), weight)
+                             texel_of(p[0], m, periodic), texel_of(p[1], m, periodic), weight)
 
 
 @wp.kernel
@@ -173,6 +195,7 @@ def deposit_footprints(
     flux_w_nm: wp.array4d[wp.float32],
     wavelengths_per_group: int,
     extent_m: float,
+    periodic: int,
     floor_texels: wp.array3d[wp.float32],
     coarse_count: wp.array[wp.int32],
 ):
@@ -203,7 +226,8 @@ def deposit_footprints(
     e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
     e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
     q0 = (a + wp.vec2(0.5 * extent_m)) * scale
-    q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
+    if periodic != 0:
+        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
     q1 = q0 + e1
     q2 = q0 + e2
     inv_texel_area = scale * scale  # 1 / texel area [m^-2]
@@ -215,7 +239,7 @@ def deposit_footprints(
         # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
         wp.atomic_add(coarse_count, 0, 1)
         deposit_by_samples(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
-                           q0, e1, e2, m, inv_texel_area)
+                           q0, e1, e2, m, periodic, inv_texel_area)
         return
     i_lo = int(u_lo)
     j_lo = int(v_lo)
@@ -229,8 +253,8 @@ def deposit_footprints(
     area = 0.5 * wp.abs(e1[0] * e2[1] - e2[0] * e1[1])
     if (i_lo == i_hi and j_lo == j_hi) or area < DEGENERATE_AREA_TEXELS:
         c = (q0 + q1 + q2) / 3.0
-        tx = wrap(i_lo + int(wp.floor(c[0])), m)
-        ty = wrap(j_lo + int(wp.floor(c[1])), m)
+        tx = texel(i_lo + int(wp.floor(c[0])), m, periodic)
+        ty = texel(j_lo + int(wp.floor(c[1])), m, periodic)
         add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
                      tx, ty, inv_texel_area)
         return
@@ -257,7 +281,7 @@ def deposit_footprints(
             if rn >= 3:
                 w = polygon_area(rx, ry, rn) / area * inv_texel_area
                 add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
-                             half, wrap(i_lo + ci, m), wrap(j_lo + cj, m), w)
+                             half, texel(i_lo + ci, m, periodic), texel(j_lo + cj, m, periodic), w)
 
 
 @wp.kernel

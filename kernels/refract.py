@@ -49,7 +49,8 @@ def refract_to_floor(
 
 @wp.func
 def surface_height(positions: wp.array2d[wp.vec3], extent_m: float, x: float, y: float) -> float:
-    """Height of a cell-centre height field at (x, y) [m]: periodic bilinear interpolation."""
+    """Height of a cell-centre height field at (x, y) [m]: periodic bilinear interpolation
+    (a walled surface is only sampled inside its walls)."""
     i0, j0, i1, j1, tu, tv = bilinear_cell(positions.shape[0], extent_m, x, y)
     return bilerp(positions[j0, i0][2], positions[j0, i1][2], positions[j1, i0][2],
                   positions[j1, i1][2], tu, tv)
@@ -69,6 +70,7 @@ def sun_visibility(
     positions: wp.array2d[wp.vec3],
     sun_dir: wp.vec3,
     extent_m: float,
+    periodic: int,
     z_range: wp.array[wp.float32],
     visible: wp.array2d[wp.float32],
 ):
@@ -90,6 +92,9 @@ def sun_visibility(
     tolerance = 1.0e-4 * cell
     for i in range(1, steps + 1):
         q = p + (float(i) * step) * sun_dir
+        if periodic == 0 and (wp.abs(q[0]) > 0.5 * extent_m - 0.5 * cell
+                              or wp.abs(q[1]) > 0.5 * extent_m - 0.5 * cell):
+            return  # the ray leaves a walled pool over its rim: nothing more to hide the sun
         if surface_height(positions, extent_m, q[0], q[1]) > q[2] + tolerance:
             visible[iy, ix] = 0.0
             return

@@ -38,8 +38,9 @@ class FloorCaustics:
         """Footprints of the last run deposited by area samples (too large to clip texel by texel)."""
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray) -> wp.array3d:
-        """Fill :attr:`irradiance`; every triangle's flux lands on the floor, so per band
-        ``sum(irradiance) * texel_area == sum(flux)`` to rounding."""
+        """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
+        so per band ``sum(irradiance) * texel_area == sum(flux)`` to rounding; in a walled pool
+        the flux that would land beyond the walls is not followed."""
         n = surface.resolution
         k = self.sun_irradiance.shape[0]
         m = self.texels.shape[0]
@@ -48,12 +49,14 @@ class FloorCaustics:
         wp.launch(floor_kernels.triangle_flux, dim=(n, n, 2),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
                           wp.vec3(*np.asarray(sun_dir, np.float32)), self.sun_irradiance,
-                          self.attenuation_per_m, per_group, float(surface.extent_m)],
+                          self.attenuation_per_m, per_group, float(surface.extent_m),
+                          int(surface.periodic)],
                   outputs=[self.flux], device=self.device)
         self.texels.zero_()
         self.coarse_count.zero_()
         wp.launch(floor_kernels.deposit_footprints, dim=(groups, n, n, 2),
-                  inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m)],
+                  inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
+                          int(surface.periodic)],
                   outputs=[self.texels, self.coarse_count], device=self.device)
         wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
                   outputs=[self.irradiance], device=self.device)

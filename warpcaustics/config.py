@@ -34,6 +34,7 @@ class WaterModel(str, enum.Enum):
     FLAT = "flat"
     HEIGHTFIELD = "heightfield"
     FFT = "fft"
+    POOL = "pool"
 
 
 class WaterSpectrum(str, enum.Enum):
@@ -59,8 +60,22 @@ class DeviceChoice(str, enum.Enum):
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
     "caustics.method": ("photons", "beams", "both", "sunmap", "eikonal", "wave3d"),
-    "water.model": ("pool", "wavepool", "procedural"),
+    "water.model": ("wavepool", "procedural"),
 }
+
+
+@dataclass(frozen=True)
+class DropConfig:
+    time_s: float = field(default=0.0, metadata=_range(0.0, None))
+    """When the drop lands [s]."""
+    x_m: float = 0.0
+    """Where it lands, x [m] (the pool spans ±extent_m/2)."""
+    y_m: float = 0.0
+    """Where it lands, y [m]."""
+    radius_m: float = field(default=0.1, metadata=_range(0.0, None, lo_open=True))
+    """Gaussian radius (standard deviation) of the added water [m]."""
+    height_m: float = field(default=0.05, metadata=_range(-10.0, 10.0))
+    """Peak height of the added (or, if negative, removed) water [m]."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +107,13 @@ class WaterConfig:
     """Exponent s of the cos-2s directional spreading (JONSWAP); larger = narrower [-]."""
     choppiness: float = field(default=0.0, metadata=_range(0.0, 5.0))
     """Strength λ of the choppy horizontal displacement (Tessendorf eq. 29) [-]; 0 = none."""
+    viscosity_m2_s: float = field(default=1.0e-4, metadata=_range(0.0, 1.0))
+    """Kinematic (eddy) viscosity of the shallow-water ``pool`` [m²/s]."""
+    cfl: float = field(default=0.4, metadata=_range(0.0, 1.0, lo_open=True))
+    """Courant number of the pool's substeps: dt = cfl·Δx / (|u| + √(g h)) [-]."""
+    drops: tuple[DropConfig, ...] = ()
+    """Drops falling into the ``pool``: ``[[water.drops]]`` tables with time_s, x_m, y_m,
+    radius_m, height_m."""
     seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
     """Seed of the ocean's random phases and amplitudes."""
 
@@ -179,11 +201,22 @@ def all_keys(cls: type = Config, prefix: str = "") -> list[str]:
     """Every dotted key of the configuration tree (leaves only)."""
     keys = []
     for name, tp in _hints(cls).items():
-        if _is_section(tp):
+        if _tuple_item(tp) is not None:
+            keys += [f"{prefix}{name}[].{k}" for k in all_keys(_tuple_item(tp))]
+        elif _is_section(tp):
             keys += all_keys(tp, f"{prefix}{name}.")
         else:
             keys.append(f"{prefix}{name}")
     return keys
+
+
+def _tuple_item(tp: Any) -> type | None:
+    """The dataclass D of a ``tuple[D, ...]`` annotation (a TOML array of tables), else None."""
+    if typing.get_origin(tp) is tuple:
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis and dataclasses.is_dataclass(args[0]):
+            return args[0]
+    return None
 
 
 def _nearest(key: str) -> str:
@@ -255,7 +288,13 @@ def _build(cls: type, table: dict, prefix: str) -> Any:
             raise ConfigError(f"unknown key '{key}' = {_describe(value)}; nearest valid key: "
                               f"'{_nearest(key)}' (see docs/config.md)")
         tp = hints[name]
-        if _is_section(tp):
+        item = _tuple_item(tp)
+        if item is not None:
+            if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+                raise ConfigError(f"{key} must be a list of tables, e.g. {key} = [{{ ... }}] or "
+                                  f"[[{key}]] sections")
+            kwargs[name] = tuple(_build(item, v, f"{key}[{i}].") for i, v in enumerate(value))
+        elif _is_section(tp):
             if not isinstance(value, dict):
                 raise ConfigError(f"{key} = {_describe(value)} must be a table ([{key}] or "
                                   f"{key}.<name> = ...)")
@@ -338,6 +377,8 @@ def config_to_dict(cfg: Any) -> dict:
         value = getattr(cfg, f.name)
         if dataclasses.is_dataclass(value):
             out[f.name] = config_to_dict(value)
+        elif isinstance(value, tuple):
+            out[f.name] = [config_to_dict(v) for v in value]
         elif isinstance(value, enum.Enum):
             out[f.name] = value.value
         else:

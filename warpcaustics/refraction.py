@@ -47,7 +47,7 @@ def sun_visibility(surface: Surface, sun_dir: np.ndarray, highest_m: float, devi
     z_range = wp.array(np.array([0.0, highest_m], np.float32), dtype=wp.float32, device=device)
     wp.launch(refract_kernels.sun_visibility, dim=(n, n),
               inputs=[surface.positions, wp.vec3(*np.asarray(sun_dir, np.float32)),
-                      float(surface.extent_m), z_range],
+                      float(surface.extent_m), int(surface.periodic), z_range],
               outputs=[out], device=device)
     return out
 

@@ -33,6 +33,8 @@ class Surface:
     """Side L of the periodic patch [m]."""
     jacobian: wp.array2d | None = None
     """(N, N) Jacobian of the choppy horizontal map (≤ 0 where the surface folds), if any."""
+    periodic: bool = True
+    """True for a tileable patch (footprints wrap); False for a walled pool."""
 
     @property
     def resolution(self) -> int:
@@ -265,6 +267,8 @@ def water_bytes(cfg: Config, n: int) -> int:
     surface = n * n * 24  # positions + normals (vec3f)
     if cfg.water.model is WaterModel.FFT:
         return surface + n * n * (8 * 7 + 8)  # h0, h0-, four spectra, scratch (vec2f); ω, J
+    if cfg.water.model is WaterModel.POOL:
+        return surface + n * n * 4 * 7  # h, h', depth, u, v and their advected copies
     return surface + n * n * 4
 
 
@@ -273,6 +277,10 @@ def make_water(cfg: Config, device: str, heights: np.ndarray | None):
     w = cfg.water
     if w.model is WaterModel.FFT:
         return FFTOcean.from_config(cfg, device)
+    if w.model is WaterModel.POOL:
+        from warpcaustics.pool import ShallowWaterPool
+
+        return ShallowWaterPool.from_config(cfg, device)
     if w.model is WaterModel.HEIGHTFIELD:
         return HeightfieldWater(heights, w.extent_m, device)
     n = w.resolution or DEFAULT_RESOLUTION

@@ -1,0 +1,139 @@
+"""The shallow-water pool (host side): a stateful surface that steps forward in time.
+
+Sandberg's "Navier–Stokes water" dynamic pool: depth-averaged mass and momentum with gravity and
+viscosity (``kernels/pool.py``), reflecting walls at ±L/2, drops at given times and places. Each
+call to :meth:`ShallowWaterPool.at` advances the state to the asked time with CFL-limited
+substeps, so an animation steps frame k from frame k−1 instead of re-simulating from t = 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config, DropConfig
+from warpcaustics.errors import WarpcausticsError
+from warpcaustics.kernels import pool as pool_kernels
+from warpcaustics.water import Surface
+
+MAX_SUBSTEPS_PER_CALL = 1_000_000
+SPEED_REFRESH_SUBSTEPS = 4
+"""Substeps between measurements of the maximum wave speed (the CFL limit); the configured
+Courant number (default 0.4) leaves room for the speed to grow in between."""
+
+
+class ShallowWaterPool:
+    """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
+
+    def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
+                 viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = ()):
+        self.device = device
+        self.extent_m = float(extent_m)
+        self.cell_m = self.extent_m / n
+        self.viscosity = float(viscosity_m2_s)
+        self.cfl = float(cfl)
+        depth = np.broadcast_to(np.asarray(floor_depth_m, np.float32), (n, n))
+        self.floor_depth = wp.array(np.ascontiguousarray(depth), dtype=wp.float32, device=device)
+        self.h = wp.array(np.ascontiguousarray(depth), dtype=wp.float32, device=device)  # at rest
+        self.u = wp.zeros((n, n + 1), dtype=wp.float32, device=device)
+        self.v = wp.zeros((n + 1, n), dtype=wp.float32, device=device)
+        self._h_next = wp.empty_like(self.h)
+        self._u_adv = wp.empty_like(self.u)
+        self._v_adv = wp.empty_like(self.v)
+        self._speed = wp.zeros(1, dtype=wp.float32, device=device)
+        self.time_s = 0.0
+        self.substeps = 0
+        self._drops = sorted(drops, key=lambda d: d.time_s)
+        self._apply_drops_until(0.0)
+
+    @classmethod
+    def from_config(cls, cfg: Config, device: str) -> ShallowWaterPool:
+        w = cfg.water
+        return cls(w.resolution, w.extent_m, cfg.floor.depth_m, device, viscosity_m2_s=w.viscosity_m2_s,
+                   cfl=w.cfl, drops=w.drops)
+
+    @property
+    def resolution(self) -> int:
+        return self.h.shape[0]
+
+    def volume_m3(self) -> float:
+        """Water volume, summed in float64 [m³]."""
+        return float(self.h.numpy().astype(np.float64).sum() * self.cell_m**2)
+
+    def max_wave_speed(self) -> float:
+        """max(|u| + |v| + √(g h)) over the cells [m/s] (one small read-back)."""
+        self._speed.zero_()
+        n = self.resolution
+        wp.launch(pool_kernels.wave_speed, dim=(n, n), inputs=[self.h, self.u, self.v],
+                  outputs=[self._speed], device=self.device)
+        return float(self._speed.numpy()[0])
+
+    def step(self, dt: float) -> None:
+        """One substep of dt [s] (the caller keeps dt within the CFL limit)."""
+        n = self.resolution
+        dev = self.device
+        k = float(dt / self.cell_m)
+        wp.launch(pool_kernels.advect_u, dim=(n, n + 1), inputs=[self.u, self.v, k], outputs=[self._u_adv],
+                  device=dev)
+        wp.launch(pool_kernels.advect_v, dim=(n + 1, n), inputs=[self.u, self.v, k], outputs=[self._v_adv],
+                  device=dev)
+        args = [self.h, self.floor_depth, float(dt), self.cell_m, self.viscosity]
+        wp.launch(pool_kernels.accelerate_u, dim=(n, n + 1), inputs=[self._u_adv, *args], outputs=[self.u],
+                  device=dev)
+        wp.launch(pool_kernels.accelerate_v, dim=(n + 1, n), inputs=[self._v_adv, *args], outputs=[self.v],
+                  device=dev)
+        wp.launch(pool_kernels.update_depth, dim=(n, n), inputs=[self.h, self.u, self.v, k],
+                  outputs=[self._h_next], device=dev)
+        self.h, self._h_next = self._h_next, self.h
+        self.substeps += 1
+
+    def advance(self, time_s: float) -> None:
+        """Step forward to ``time_s`` [s] with CFL-limited substeps, dropping drops on the way."""
+        if time_s < self.time_s - 1e-9:
+            raise WarpcausticsError(
+                f"the pool is stateful: time_s = {time_s:g} s comes before its current time "
+                f"{self.time_s:g} s; render its frames in increasing time")
+        # Viscous limit of the explicit Laplacian: ν dt / Δ² ≤ 1/8.
+        dt_viscous = self.cell_m**2 / (8.0 * self.viscosity) if self.viscosity > 0 else math.inf
+        speed = math.nan
+        for i in range(MAX_SUBSTEPS_PER_CALL):
+            remaining = time_s - self.time_s
+            if remaining <= 1e-12:
+                break
+            if i % SPEED_REFRESH_SUBSTEPS == 0 or not math.isfinite(speed):
+                speed = self.max_wave_speed()  # a read-back: not every substep
+            if not math.isfinite(speed):
+                raise WarpcausticsError(f"the pool became unstable at t = {self.time_s:g} s; lower "
+                                        f"water.cfl (now {self.cfl}) or the drops' height")
+            dt = min(remaining, self.cfl * self.cell_m / max(speed, 1e-6), dt_viscous)
+            next_drop = next((d.time_s for d in self._drops if d.time_s > self.time_s), math.inf)
+            dt = min(dt, max(next_drop - self.time_s, 1e-9))
+            self.step(dt)
+            self.time_s += dt
+            if self._apply_drops_until(self.time_s):
+                speed = math.nan  # a drop changes the wave speed: measure again
+        else:  # pragma: no cover - a guard, not a code path
+            raise WarpcausticsError("the pool needs more than a million substeps for one frame; "
+                                    "lower water.resolution or raise --fps")
+
+    def _apply_drops_until(self, time_s: float) -> bool:
+        n = self.resolution
+        dropped = False
+        while self._drops and self._drops[0].time_s <= time_s + 1e-12:
+            dropped = True
+            d = self._drops.pop(0)
+            wp.launch(pool_kernels.add_drop, dim=(n, n),
+                      inputs=[self.h, self.extent_m, d.x_m, d.y_m, d.radius_m, d.height_m],
+                      device=self.device)
+        return dropped
+
+    def at(self, time_s: float) -> Surface:
+        self.advance(time_s)
+        n = self.resolution
+        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        wp.launch(pool_kernels.pool_surface, dim=(n, n), inputs=[self.h, self.floor_depth, self.extent_m],
+                  outputs=[positions, normals], device=self.device)
+        return Surface(positions, normals, self.extent_m, periodic=False)
