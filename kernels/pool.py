@@ -156,3 +156,16 @@ def pool_surface(h: wp.array2d[wp.float32], floor_depth: wp.array2d[wp.float32],
     xy = cell_centre(ix, iy, n, extent_m)
     positions[iy, ix] = wp.vec3(xy[0], xy[1], h[iy, ix] - floor_depth[iy, ix])
     normals[iy, ix] = normal_from_slopes(ex, ey)
+
+
+@wp.kernel
+def wave_equation_step(h: wp.array2d[wp.float32], h_prev: wp.array2d[wp.float32], courant2: float,
+                       damping_dt: float, h_next: wp.array2d[wp.float32]):
+    """Damped wave equation η_tt = c² ∇²η − γ η_t, leapfrog in time, reflecting walls (mirror
+    neighbours): η⁺ = η + (1 − γΔt)(η − η⁻) + (cΔt/Δ)² ∇²η."""
+    iy, ix = wp.tid()
+    n = h.shape[0]
+    c = h[iy, ix]
+    lap = (h[iy, wp.max(ix - 1, 0)] + h[iy, wp.min(ix + 1, n - 1)] + h[wp.max(iy - 1, 0), ix]
+           + h[wp.min(iy + 1, n - 1), ix] - 4.0 * c)
+    h_next[iy, ix] = c + (1.0 - damping_dt) * (c - h_prev[iy, ix]) + courant2 * lap

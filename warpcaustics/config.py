@@ -35,6 +35,7 @@ class WaterModel(str, enum.Enum):
     HEIGHTFIELD = "heightfield"
     FFT = "fft"
     POOL = "pool"
+    WAVEPOOL = "wavepool"
 
 
 class WaterSpectrum(str, enum.Enum):
@@ -60,7 +61,7 @@ class DeviceChoice(str, enum.Enum):
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
     "caustics.method": ("photons", "beams", "both", "sunmap", "eikonal", "wave3d"),
-    "water.model": ("wavepool", "procedural"),
+    "water.model": ("procedural",),
 }
 
 
@@ -112,8 +113,12 @@ class WaterConfig:
     cfl: float = field(default=0.4, metadata=_range(0.0, 1.0, lo_open=True))
     """Courant number of the pool's substeps: dt = cfl·Δx / (|u| + √(g h)) [-]."""
     drops: tuple[DropConfig, ...] = ()
-    """Drops falling into the ``pool``: ``[[water.drops]]`` tables with time_s, x_m, y_m,
-    radius_m, height_m."""
+    """Drops falling into the ``pool`` or ``wavepool``: ``[[water.drops]]`` tables with time_s,
+    x_m, y_m, radius_m, height_m."""
+    wave_speed_m_s: float = field(default=0.0, metadata=_range(0.0, 100.0))
+    """Wave speed c of the ``wavepool`` [m/s]; 0 means the shallow-water speed √(g·floor.depth_m)."""
+    damping_per_s: float = field(default=0.5, metadata=_range(0.0, 100.0))
+    """Damping γ of the ``wavepool`` (η_tt = c²∇²η − γη_t): energy decays as e^(−γt) [1/s]."""
     seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
     """Seed of the ocean's random phases and amplitudes."""
 

@@ -269,6 +269,8 @@ def water_bytes(cfg: Config, n: int) -> int:
         return surface + n * n * (8 * 7 + 8)  # h0, h0-, four spectra, scratch (vec2f); ω, J
     if cfg.water.model is WaterModel.POOL:
         return surface + n * n * 4 * 7  # h, h', depth, u, v and their advected copies
+    if cfg.water.model is WaterModel.WAVEPOOL:
+        return surface + n * n * 4 * 4  # η, η⁻, η⁺, zero depth
     return surface + n * n * 4
 
 
@@ -281,6 +283,10 @@ def make_water(cfg: Config, device: str, heights: np.ndarray | None):
         from warpcaustics.pool import ShallowWaterPool
 
         return ShallowWaterPool.from_config(cfg, device)
+    if w.model is WaterModel.WAVEPOOL:
+        from warpcaustics.wavepool import WaveEquationPool
+
+        return WaveEquationPool.from_config(cfg, device)
     if w.model is WaterModel.HEIGHTFIELD:
         return HeightfieldWater(heights, w.extent_m, device)
     n = w.resolution or DEFAULT_RESOLUTION
