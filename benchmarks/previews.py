@@ -1,0 +1,46 @@
+"""Render the README's pictures: ``python -m benchmarks.previews`` (CPU, about a minute).
+
+- ``docs/images/ocean.png``: frame 0 of configs/ocean.toml;
+- ``docs/images/pool_frames.png``: six frames of configs/pool.toml side by side (0.25 s apart),
+  the pool stepping forward from frame to frame.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _preview(result) -> np.ndarray:
+    from warpcaustics import colour_out
+    from warpcaustics.spectra import SpectralBins
+
+    edges = np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
+                            result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2])
+    xyz = colour_out.spectral_to_xyz(result.floor_irradiance[:, ::-1, :], SpectralBins(edges))
+    return colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1])
+
+
+def main() -> int:
+    import warpcaustics as wc
+    from warpcaustics.output import write_png
+
+    images = ROOT / "docs" / "images"
+    ocean = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml"), device="cpu")
+    write_png(images / "ocean.png", _preview(ocean))
+
+    renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / "pool.toml"), device="cpu")
+    frames = [_preview(renderer.render(t)) for t in np.arange(1, 7) * 0.25]
+    gap = np.full((frames[0].shape[0], 6, 3), 255, np.uint8)
+    strip = np.concatenate([x for f in frames for x in (f, gap)][:-1], axis=1)
+    write_png(images / "pool_frames.png", np.ascontiguousarray(strip[::2, ::2]))
+    print(f"wrote {images / 'ocean.png'} and {images / 'pool_frames.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
