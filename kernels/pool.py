@@ -169,3 +169,27 @@ def wave_equation_step(h: wp.array2d[wp.float32], h_prev: wp.array2d[wp.float32]
     lap = (h[iy, wp.max(ix - 1, 0)] + h[iy, wp.min(ix + 1, n - 1)] + h[wp.max(iy - 1, 0), ix]
            + h[wp.min(iy + 1, n - 1), ix] - 4.0 * c)
     h_next[iy, ix] = c + (1.0 - damping_dt) * (c - h_prev[iy, ix]) + courant2 * lap
+
+
+@wp.kernel
+def push_u(u: wp.array2d[wp.float32], extent_m: float, centre: wp.vec2, radius_m: float,
+           body_velocity: wp.vec2, blend: float):
+    """Inside the body's disc, relax u towards the body's velocity (a moving body pushes water)."""
+    iy, jx = wp.tid()
+    n = u.shape[0]
+    cell = extent_m / float(n)
+    p = wp.vec2(float(jx) * cell - 0.5 * extent_m, (float(iy) + 0.5) * cell - 0.5 * extent_m)
+    if jx > 0 and jx < n and wp.length(p - centre) < radius_m:
+        u[iy, jx] = u[iy, jx] + blend * (body_velocity[0] - u[iy, jx])
+
+
+@wp.kernel
+def push_v(v: wp.array2d[wp.float32], extent_m: float, centre: wp.vec2, radius_m: float,
+           body_velocity: wp.vec2, blend: float):
+    """Inside the body's disc, relax v towards the body's velocity."""
+    jy, ix = wp.tid()
+    n = v.shape[1]
+    cell = extent_m / float(n)
+    p = wp.vec2((float(ix) + 0.5) * cell - 0.5 * extent_m, float(jy) * cell - 0.5 * extent_m)
+    if jy > 0 and jy < n and wp.length(p - centre) < radius_m:
+        v[jy, ix] = v[jy, ix] + blend * (body_velocity[1] - v[jy, ix])

@@ -113,3 +113,33 @@ def test_wave_pool_ridge_travels_at_c(device):
     pool.advance(2.5)
     x2, t2 = peak_x(), pool.time_s
     assert (x2 - x1) / (t2 - t1) == pytest.approx(np.sqrt(9.81 * DEPTH_M), rel=0.03)
+
+
+def test_moving_body_pushes_the_water(device):
+    """A disc moving on a circle drags the water under it along (mean velocity inside the disc
+    ≥ half the body's), raises a bow wave ahead of it and a trough behind, and keeps the volume."""
+    from warpcaustics.config import BodyConfig
+
+    body = BodyConfig(radius_m=0.2, path_radius_m=1.0, period_s=4.0)
+    pool = ShallowWaterPool(96, 4.0, DEPTH_M, device, body=body)
+    before = pool.volume_m3()
+    surface = pool.at(1.0)
+    centre, velocity = pool.body_state(pool.time_s)
+    speed = np.linalg.norm(velocity)
+    ahead = centre + 1.8 * body.radius_m * velocity / speed
+    behind = centre - 1.8 * body.radius_m * velocity / speed
+    n, cell = 96, 4.0 / 96
+    eta = surface.positions.numpy()[..., 2]
+
+    def at(p):
+        return eta[int((p[1] + 2.0) / cell), int((p[0] + 2.0) / cell)]
+
+    assert at(ahead) > 0.01 > -0.01 > at(behind)
+    x = (np.arange(n) + 0.5) * cell - 2.0
+    xx, yy = np.meshgrid(x, x)
+    inside = np.hypot(xx - centre[0], yy - centre[1]) < body.radius_m
+    u_c = 0.5 * (pool.u.numpy()[:, :-1] + pool.u.numpy()[:, 1:])
+    v_c = 0.5 * (pool.v.numpy()[:-1] + pool.v.numpy()[1:])
+    along = (u_c[inside] * velocity[0] + v_c[inside] * velocity[1]) / speed
+    assert along.mean() > 0.5 * speed
+    assert abs(pool.volume_m3() / before - 1.0) < 1e-6

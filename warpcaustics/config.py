@@ -80,6 +80,22 @@ class DropConfig:
 
 
 @dataclass(frozen=True)
+class BodyConfig:
+    radius_m: float = field(default=0.0, metadata=_range(0.0, None))
+    """Radius of a disc-shaped body moving through the ``pool`` [m]; 0 = no body."""
+    center_x_m: float = 0.0
+    """Centre of its circular path, x [m]."""
+    center_y_m: float = 0.0
+    """Centre of its circular path, y [m]."""
+    path_radius_m: float = field(default=1.0, metadata=_range(0.0, None))
+    """Radius of the circular path [m]."""
+    period_s: float = field(default=4.0, metadata=_range(0.0, None, lo_open=True))
+    """Time for one turn (counter-clockwise seen from above) [s]."""
+    response_s: float = field(default=0.02, metadata=_range(0.0, None, lo_open=True))
+    """Time over which the water under the body takes on its velocity [s]."""
+
+
+@dataclass(frozen=True)
 class WaterConfig:
     model: WaterModel = WaterModel.FFT
     """Surface model: ``flat``, ``heightfield`` (from ``water.file``) or ``fft`` (Tessendorf)."""
@@ -115,6 +131,8 @@ class WaterConfig:
     drops: tuple[DropConfig, ...] = ()
     """Drops falling into the ``pool`` or ``wavepool``: ``[[water.drops]]`` tables with time_s,
     x_m, y_m, radius_m, height_m."""
+    body: BodyConfig = field(default_factory=BodyConfig)
+    """A body moving through the ``pool`` on a circular path, pushing the water."""
     wave_speed_m_s: float = field(default=0.0, metadata=_range(0.0, 100.0))
     """Wave speed c of the ``wavepool`` [m/s]; 0 means the shallow-water speed √(g·floor.depth_m)."""
     damping_per_s: float = field(default=0.5, metadata=_range(0.0, 100.0))

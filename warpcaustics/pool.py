@@ -1,7 +1,8 @@
 """The shallow-water pool (host side): a stateful surface that steps forward in time.
 
 Sandberg's "Navier–Stokes water" dynamic pool: depth-averaged mass and momentum with gravity and
-viscosity (``kernels/pool.py``), reflecting walls at ±L/2, drops at given times and places. Each
+viscosity (``kernels/pool.py``), reflecting walls at ±L/2, drops at given times and places, and a
+disc-shaped body moving on a circular path that drags the water under it towards its velocity. Each
 call to :meth:`ShallowWaterPool.at` advances the state to the asked time with CFL-limited
 substeps, so an animation steps frame k from frame k−1 instead of re-simulating from t = 0.
 """
@@ -13,7 +14,7 @@ import math
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config, DropConfig
+from warpcaustics.config import BodyConfig, Config, DropConfig
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels import pool as pool_kernels
 from warpcaustics.water import Surface
@@ -28,7 +29,8 @@ class ShallowWaterPool:
     """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
 
     def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
-                 viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = ()):
+                 viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = (),
+                 body: BodyConfig | None = None):
         self.device = device
         self.extent_m = float(extent_m)
         self.cell_m = self.extent_m / n
@@ -43,6 +45,7 @@ class ShallowWaterPool:
         self._u_adv = wp.empty_like(self.u)
         self._v_adv = wp.empty_like(self.v)
         self._speed = wp.zeros(1, dtype=wp.float32, device=device)
+        self.body = body if body is not None and body.radius_m > 0 else None
         self.time_s = 0.0
         self.substeps = 0
         self._drops = sorted(drops, key=lambda d: d.time_s)
@@ -52,7 +55,17 @@ class ShallowWaterPool:
     def from_config(cls, cfg: Config, device: str) -> ShallowWaterPool:
         w = cfg.water
         return cls(w.resolution, w.extent_m, cfg.floor.depth_m, device, viscosity_m2_s=w.viscosity_m2_s,
-                   cfl=w.cfl, drops=w.drops)
+                   cfl=w.cfl, drops=w.drops, body=w.body)
+
+    def body_state(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Centre [m] and velocity [m/s] of the body at ``time_s`` on its circular path."""
+        b = self.body
+        w = 2.0 * math.pi / b.period_s
+        a = w * time_s
+        centre = np.array([b.center_x_m + b.path_radius_m * math.cos(a),
+                           b.center_y_m + b.path_radius_m * math.sin(a)])
+        velocity = b.path_radius_m * w * np.array([-math.sin(a), math.cos(a)])
+        return centre, velocity
 
     @property
     def resolution(self) -> int:
@@ -84,6 +97,12 @@ class ShallowWaterPool:
                   device=dev)
         wp.launch(pool_kernels.accelerate_v, dim=(n + 1, n), inputs=[self._v_adv, *args], outputs=[self.v],
                   device=dev)
+        if self.body is not None:
+            centre, velocity = self.body_state(self.time_s + dt)
+            push = [self.extent_m, wp.vec2(*centre), self.body.radius_m, wp.vec2(*velocity),
+                    min(1.0, dt / self.body.response_s)]
+            wp.launch(pool_kernels.push_u, dim=(n, n + 1), inputs=[self.u, *push], device=dev)
+            wp.launch(pool_kernels.push_v, dim=(n + 1, n), inputs=[self.v, *push], device=dev)
         wp.launch(pool_kernels.update_depth, dim=(n, n), inputs=[self.h, self.u, self.v, k],
                   outputs=[self._h_next], device=dev)
         self.h, self._h_next = self._h_next, self.h
@@ -107,7 +126,10 @@ class ShallowWaterPool:
             if not math.isfinite(speed):
                 raise WarpcausticsError(f"the pool became unstable at t = {self.time_s:g} s; lower "
                                         f"water.cfl (now {self.cfl}) or the drops' height")
-            dt = min(remaining, self.cfl * self.cell_m / max(speed, 1e-6), dt_viscous)
+            body_speed = 0.0
+            if self.body is not None:
+                body_speed = 2.0 * math.pi * self.body.path_radius_m / self.body.period_s
+            dt = min(remaining, self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
             next_drop = next((d.time_s for d in self._drops if d.time_s > self.time_s), math.inf)
             dt = min(dt, max(next_drop - self.time_s, 1e-9))
             self.step(dt)
