@@ -81,3 +81,35 @@ def test_light_from_behind_transmits_nothing(device):
     n = np.array([[0.0, 1.0, 0.0]])  # n·d > 0: the ray arrives from behind the surface
     _, tr = _run(d, n, 1.0 / 1.333, device)
     assert tr[0] == 0.0
+
+
+def test_dispersion_follows_quan_fry(device):
+    """With dispersion, the refraction angle at 450 and 650 nm matches Snell with Quan & Fry's n(λ)
+    to 1e-6 rad; n(λ) itself equals the shared data's tabulated Quan–Fry values (20 °C, 35 ‰)."""
+    import csv
+    from pathlib import Path
+
+    from warpcaustics import spectra
+    from warpcaustics.refraction import refract_to_floor
+    from warpcaustics.water import HeightfieldWater
+
+    table = (Path(__file__).resolve().parents[2] / "shared" / "data" / "water"
+             / "n_water_quan_fry_1995_computed.csv")
+    if not table.exists():  # the shared data sit beside the checkout in CI and development
+        pytest.skip("shared/data not beside this checkout")
+    rows = {float(r["wavelength_nm"]): float(r["n_rel_air_T20_S35"]) for r in csv.DictReader(table.open())}
+    n = spectra.quan_fry_index(np.array([450.0, 650.0]), 35.0, 20.0)
+    np.testing.assert_allclose(n, [rows[450.0], rows[650.0]], atol=1e-6)  # the table has 6 decimals
+
+    surface = HeightfieldWater(np.zeros((8, 8)), 4.0, device).at(0.0)
+    elevation = np.radians(35.0)
+    sun = np.array([np.cos(elevation), 0.0, np.sin(elevation)])
+    visible = wp.full((8, 8), 1.0, dtype=wp.float32, device=device)
+    depth = 10.0
+    hits = refract_to_floor(surface, visible, n, sun, -depth, device).hit_xy.numpy()
+    start = surface.positions.numpy()[0, 0, :2]
+    offset = np.linalg.norm(hits[:, 0, 0].astype(np.float64) - start, axis=1)
+    theta_t = np.arctan2(offset, depth)
+    expected = np.arcsin(np.cos(elevation) / n)  # sin θi = cos(elevation), n_air = 1
+    np.testing.assert_allclose(theta_t, expected, atol=1e-6)
+    assert theta_t[0] < theta_t[1] - 1e-3  # blue bends more than red

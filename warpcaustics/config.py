@@ -171,7 +171,13 @@ class OpticsConfig:
     """Water optics: ``pure`` (Pope & Fry 1997 absorption + Zhang 2009 scattering) or ``none``
     (c = 0, for validation)."""
     ior: float = field(default=1.333, metadata=_range(1.0, 3.0, lo_open=True))
-    """Refractive index of water, used for every wavelength [-]."""
+    """Refractive index of water, used for every wavelength when ``dispersion`` is off [-]."""
+    dispersion: bool = False
+    """Use n(λ) of seawater from Quan & Fry (1995) at each bin centre instead of ``ior``."""
+    salinity_psu: float = field(default=35.0, metadata=_range(0.0, 45.0))
+    """Salinity for n(λ) (Quan & Fry 1995; fitted for 0–35 ‰) [PSU ≈ ‰]."""
+    temperature_c: float = field(default=20.0, metadata=_range(-2.0, 35.0))
+    """Water temperature for n(λ) (Quan & Fry 1995; fitted for 0–30 °C) [°C]."""
     wavelengths: WavelengthConfig = field(default_factory=WavelengthConfig)
     """Spectral sampling."""
 

@@ -99,7 +99,8 @@ def scene_bytes(scene: Scene) -> int:
     cfg = scene.config
     n = scene.water_resolution
     k = cfg.optics.wavelengths.bins
-    return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, 1)
+    groups = k if cfg.optics.dispersion else 1
+    return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
 
 
 class Renderer:
@@ -118,7 +119,9 @@ class Renderer:
         self.bins = spectra.bins_for(cfg.optics)
         self.sun_irradiance = spectra.sun_irradiance(self.bins)
         self.attenuation_per_m = spectra.water_optics(cfg.optics.water_type, self.bins).attenuation_per_m
-        self.group_ior = np.full(1, cfg.optics.ior)  # one index group: no dispersion yet
+        self.ior = spectra.refractive_index(cfg.optics, self.bins)
+        # One refraction per distinct index: K groups with dispersion, else one shared by all bins.
+        self.group_ior = self.ior if cfg.optics.dispersion else self.ior[:1]
         with _memory_errors(self.device, self.bytes_needed):
             self.water = make_water(cfg, self.device, scene.heights)
             n = scene.water_resolution
@@ -159,11 +162,10 @@ class Renderer:
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
             folds = float(np.mean(surface.jacobian.numpy() <= 0.0)) if surface.jacobian is not None else 0.0
-        k = len(self.bins.centres_nm)
         return RenderResult(
             scene=self.scene, time_s=time_s, device=dev, wavelengths_nm=self.bins.centres_nm,
             bin_widths_nm=self.bins.widths_nm, floor_irradiance=floor_np,
-            attenuation_per_m=self.attenuation_per_m, ior=np.full(k, cfg.optics.ior),
+            attenuation_per_m=self.attenuation_per_m, ior=self.ior,
             sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
             surface_positions=positions, surface_normals=normals, fold_fraction=folds,
             timings_s=watch.timings)

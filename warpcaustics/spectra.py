@@ -9,7 +9,10 @@ table. Sources (files under ``warpcaustics/data/``, provenance in its README):
 - ``pure`` water absorption: Pope & Fry (1997), Appl. Opt. 36, 8710 [1/m];
 - ``pure`` water scattering: Zhang, Hu & He (2009), Opt. Express 17, 5698, seawater at 35 PSU and
   20 °C [1/m];
-- ``none``: c = 0 (validation).
+- ``none``: c = 0 (validation);
+- refractive index n(λ) of seawater relative to air: Quan & Fry (1995), Appl. Opt. 34, 3477,
+  ``n = n0 + (n1 + n2 T + n3 T²) S + n4 T² + (n5 + n6 S + n7 T)/λ + n8/λ² + n9/λ³`` (λ in nm,
+  T in °C, S in ‰), coefficients from ``data/n_water_quan_fry_1995_coefficients.csv``.
 """
 
 from __future__ import annotations
@@ -114,3 +117,25 @@ def water_optics(water_type: WaterType, bins: SpectralBins) -> WaterOptics:
         b = bins.average(*pure_scattering_table(), what="Zhang 2009 scattering")
         return WaterOptics(a, b)
     raise ConfigError(f"optics.water_type = {water_type.value!r} has no optical data")  # pragma: no cover
+
+
+@functools.cache
+def _quan_fry_coefficients() -> dict[str, float]:
+    rows = (DATA_DIR / "n_water_quan_fry_1995_coefficients.csv").read_text(encoding="utf-8").splitlines()[1:]
+    return {name: float(value) for name, value in (row.split(",") for row in rows)}
+
+
+def quan_fry_index(wavelength_nm: np.ndarray, salinity_psu: float, temperature_c: float) -> np.ndarray:
+    """Refractive index of seawater relative to air, Quan & Fry (1995) [-]."""
+    c = _quan_fry_coefficients()
+    lam = np.asarray(wavelength_nm, dtype=np.float64)
+    s, t = salinity_psu, temperature_c
+    return (c["n0"] + (c["n1"] + c["n2"] * t + c["n3"] * t * t) * s + c["n4"] * t * t
+            + (c["n5"] + c["n6"] * s + c["n7"] * t) / lam + c["n8"] / lam**2 + c["n9"] / lam**3)
+
+
+def refractive_index(optics: OpticsConfig, bins: SpectralBins) -> np.ndarray:
+    """(K,) refractive index per bin: Quan & Fry at the bin centres, or ``optics.ior`` throughout."""
+    if optics.dispersion:
+        return quan_fry_index(bins.centres_nm, optics.salinity_psu, optics.temperature_c)
+    return np.full(len(bins.centres_nm), optics.ior)
