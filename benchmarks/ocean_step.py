@@ -44,9 +44,9 @@ def numpy_step(h0, h0m, omega, k, choppiness, extent_m, t):
     h = h0 * np.exp(-1j * omega * t) + h0m * np.exp(1j * omega * t)
     f = lambda spec: np.fft.ifft2(spec) * (n * n)  # noqa: E731
     a = f(h + 1j * (1j * kx * h))
-    b = f(1j * ky * h + 1j * (-1j * kx * inv_k * h))
-    c = f(-1j * ky * inv_k * h + 1j * (kx * kx * inv_k * h))
-    d = f(ky * ky * inv_k * h + 1j * (kx * ky * inv_k * h))
+    b = f(1j * ky * h + 1j * (1j * kx * inv_k * h))
+    c = f(1j * ky * inv_k * h + 1j * (-kx * kx * inv_k * h))
+    d = f(-ky * ky * inv_k * h + 1j * (-kx * ky * inv_k * h))
     x = (np.arange(n) + 0.5) * extent_m / n - extent_m / 2
     xs, ys = np.meshgrid(x, x)
     jxx, jyy, jxy = 1 + choppiness * c.imag, 1 + choppiness * d.real, choppiness * d.imag

@@ -5,11 +5,11 @@ horizontal section of its caustic volume (Sandberg & Falemo 2005; Ernst et al. 2
 spread over the footprint by exact area overlap with each texel (Sutherland–Hodgman clipping), so
 the flux deposited equals the triangle's flux to rounding, whatever the footprint's size or
 orientation (folded footprints count by their unsigned area). Texel indices wrap: the surface
-and the floor map are periodic with period L.
+and the floor map are periodic with period L (in walled pools light beyond the walls is dropped).
 
-Surface triangles: quad (ix, iy)…(ix+1, iy+1) of the periodic N×N vertex grid splits into
-``half = 0``: corners (0,0), (1,0), (1,1) and ``half = 1``: (0,0), (1,1), (0,1), both
-counter-clockwise seen from above. A corner past the last row/column wraps to index 0 shifted by L.
+Surface triangles: each quad of the vertex grid splits into ``half = 0``: corners (0,0), (1,0),
+(1,1) and ``half = 1``: (0,0), (1,1), (0,1), both counter-clockwise seen from above (see
+``quad_corner`` for the periodic wrap and for walled pools).
 """
 
 import warp as wp
@@ -30,8 +30,14 @@ equal share of the flux."""
 
 
 @wp.func
-def quad_corner(ix: int, iy: int, half: int, corner: int, n: int, extent_m: float):
-    """Grid index of a triangle corner and the periodic shift [m] that makes it contiguous."""
+def quad_corner(qx: int, qy: int, half: int, corner: int, n: int, extent_m: float, periodic: int):
+    """Grid index of a triangle corner of quad (qx, qy) and the shift [m] to add to that vertex.
+
+    Periodic surfaces have N×N quads; a corner past the last row/column wraps to index 0 shifted by
+    L. Walled surfaces have (N+1)×(N+1) quads reaching the walls: quad q spans vertices q−1…q, and a
+    corner outside the grid is a wall vertex, the edge vertex moved by ±Δ/2 onto the wall (same
+    height, normal, transmittance and refracted direction), so the floor is covered to the walls.
+    """
     dx = int(0)
     dy = int(0)
     if half == 0:
@@ -44,15 +50,32 @@ def quad_corner(ix: int, iy: int, half: int, corner: int, n: int, extent_m: floa
             dx = 1
         if corner >= 1:
             dy = 1
-    cx = ix + dx
-    cy = iy + dy
     shift = wp.vec2(0.0)
-    if cx == n:
+    if periodic != 0:
+        cx = qx + dx
+        cy = qy + dy
+        if cx == n:
+            cx = 0
+            shift[0] = extent_m
+        if cy == n:
+            cy = 0
+            shift[1] = extent_m
+        return cx, cy, shift
+    half_cell = 0.5 * extent_m / float(n)
+    cx = qx - 1 + dx
+    cy = qy - 1 + dy
+    if cx < 0:
         cx = 0
-        shift[0] = extent_m
-    if cy == n:
+        shift[0] = -half_cell
+    if cx > n - 1:
+        cx = n - 1
+        shift[0] = half_cell
+    if cy < 0:
         cy = 0
-        shift[1] = extent_m
+        shift[1] = -half_cell
+    if cy > n - 1:
+        cy = n - 1
+        shift[1] = half_cell
     return cx, cy, shift
 
 
@@ -109,22 +132,21 @@ def triangle_flux(
 ):
     """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at every wavelength k.
 
-    ``flux_w_nm`` is (N, N, 2, K): a triangle's wavelengths are contiguous for the deposit.
+    ``flux_w_nm`` is (Q, Q, 2, K) with Q quads per side (N periodic, N+1 walled): a triangle's
+    wavelengths are contiguous for the deposit.
 
     ``E_sun(k) * A_perp * mean_i(T_i exp(-c(k) l_i))``, with ``A_perp`` the triangle's area
     projected perpendicular to the sun (0 for triangles facing away from it).
     """
     iy, ix, half = wp.tid()
     n = positions.shape[0]
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
+    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
+    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
+    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
     p0 = lift(positions[y0, x0], s0)
     p1 = lift(positions[y1, x1], s1)
     p2 = lift(positions[y2, x2], s2)
     a_perp = wp.max(0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir), 0.0)
-    if periodic == 0 and (ix == n - 1 or iy == n - 1):
-        a_perp = 0.0  # a walled surface has no triangles across its edges
     for k in range(sun_irradiance.shape[0]):
         g = k / wavelengths_per_group
         c = attenuation_per_m[k]
@@ -215,9 +237,9 @@ def deposit_footprints(
         group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
     if group_flux <= 0.0:
         return  # facing away from the sun, fully reflected or fully absorbed: nothing to spread
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m)
+    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
+    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
+    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
     scale = float(m) / extent_m
     # Footprint in texel units: corner 0 wrapped into [0, M) (a whole-period shift leaves the
     # periodic deposit unchanged and keeps indices small), edges taken in metres first so their

@@ -40,8 +40,9 @@ def evolve_spectrum(
 
     ``h̃ = h̃0(k) e^{-iωt} + conj(h̃0(-k)) e^{iωt}`` (Tessendorf eq. 26 with t → −t, so that h̃0(k)
     is a wave travelling along +k). Packed pairs: (h, ∂h/∂x), (∂h/∂y, D_x), (D_y, ∂D_x/∂x),
-    (∂D_y/∂y, ∂D_x/∂y) with the choppy displacement ``D̃ = -i k̂ h̃`` (eq. 29) and its derivatives
-    ``∂_a D_b ↔ (k_a k_b / k) h̃``.
+    (∂D_y/∂y, ∂D_x/∂y) with the choppy displacement ``D̃ = +i k̂ h̃`` and its derivatives
+    ``∂_a D_b ↔ −(k_a k_b / k) h̃``. The sign is that of Tessendorf's Gerstner wave (eq. 7): vertices
+    move towards the crests, which sharpen (his eq. 29 prints −i, which needs λ < 0).
     """
     iy, ix = wp.tid()
     wt = omega[iy, ix] * time_s
@@ -52,14 +53,14 @@ def evolve_spectrum(
     inv_k = float(0.0)
     if k > 0.0:
         inv_k = 1.0 / k
-    # i·(i a h) = -a h ; i·(-i a h) = a h ; i a h = (-a h.im, a h.re)
+    # i·(i a h) = -a h ; i a h = (-a h.im, a h.re)
     height_slope_x[iy, ix] = h - kx * h
-    slope_y_disp_x[iy, ix] = wp.vec2(-ky * h[1], ky * h[0]) + (kx * inv_k) * h
-    disp_y = wp.vec2(ky * inv_k * h[1], -ky * inv_k * h[0])  # -i (ky/k) h
-    dxx = (kx * kx * inv_k) * h
+    slope_y_disp_x[iy, ix] = wp.vec2(-ky * h[1], ky * h[0]) - (kx * inv_k) * h  # + i·(i kx/k h)
+    disp_y = wp.vec2(-ky * inv_k * h[1], ky * inv_k * h[0])  # i (ky/k) h
+    dxx = -(kx * kx * inv_k) * h
     disp_y_dxx[iy, ix] = disp_y + wp.vec2(-dxx[1], dxx[0])
-    dxy = (kx * ky * inv_k) * h
-    dyy_dxy[iy, ix] = (ky * ky * inv_k) * h + wp.vec2(-dxy[1], dxy[0])
+    dxy = -(kx * ky * inv_k) * h
+    dyy_dxy[iy, ix] = -(ky * ky * inv_k) * h + wp.vec2(-dxy[1], dxy[0])
 
 
 @functools.cache

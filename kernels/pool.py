@@ -131,6 +131,16 @@ def add_drop(h: wp.array2d[wp.float32], extent_m: float, x_m: float, y_m: float,
 
 
 @wp.kernel
+def add_bump(eta: wp.array2d[wp.float32], extent_m: float, x_m: float, y_m: float, radius_m: float,
+             height_m: float):
+    """Add a Gaussian bump to a surface elevation η (no clamp: η is negative in troughs)."""
+    iy, ix = wp.tid()
+    c = cell_centre(ix, iy, eta.shape[0], extent_m)
+    r2 = (c[0] - x_m) * (c[0] - x_m) + (c[1] - y_m) * (c[1] - y_m)
+    eta[iy, ix] = eta[iy, ix] + height_m * wp.exp(-0.5 * r2 / (radius_m * radius_m))
+
+
+@wp.kernel
 def wave_speed(h: wp.array2d[wp.float32], u: wp.array2d[wp.float32], v: wp.array2d[wp.float32],
                speed: wp.array[wp.float32]):
     """speed[0] = max over cells of |u| + |v| + √(g h) (atomic max; initialise to 0)."""

@@ -21,7 +21,7 @@ def _flat_scene(elevation_deg, depth_m, water_type="pure", **extra):
 @pytest.mark.parametrize("elevation_deg", [15.0, 40.0, 65.0, 90.0])
 @pytest.mark.parametrize("depth_m", [0.5, 5.0, 30.0])
 def test_flat_water_matches_beer_lambert_and_fresnel(device, elevation_deg, depth_m):
-    """Flat water: E = E_sun cosθ T(θ) exp(-c D / cosθ_t), uniform over the floor (0.5 %)."""
+    """Flat water: E = E_sun cosθ T(θ) exp(-c D / cosθ_t), uniform over the floor (1e-4)."""
     result = wc.render(_flat_scene(elevation_deg, depth_m), device=device)
     theta = np.radians(90.0 - elevation_deg)
     n = 1.333
@@ -31,7 +31,8 @@ def test_flat_water_matches_beer_lambert_and_fresnel(device, elevation_deg, dept
         -result.attenuation_per_m * depth_m / cos_t)
     floor = result.floor_irradiance.astype(np.float64)
     assert np.all(result.attenuation_per_m > 0)  # the pure-water path is really exercised
-    np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=5e-3)
+    # The issue asks for 0.5 %; float32 geometry reaches ~1e-5, so hold it to 1e-4.
+    np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=1e-4)
 
 
 def test_flat_nonabsorbing_water_keeps_all_transmitted_flux(device):
@@ -52,8 +53,9 @@ def _rough_ocean(**extra):
     return wc.load_scene(None, overrides)
 
 
-def _transmitted_flux_float64(result):
-    """Σ over surface triangles of E_sun · A⊥ · mean Fresnel T, from the surface alone (float64)."""
+def _transmitted_flux_float64(result, ior=None):
+    """Σ over surface triangles of E_sun · A⊥ · mean Fresnel T, from the surface alone (float64);
+    ``ior`` per band (dispersion) or one index for all."""
     p = result.surface_positions.astype(np.float64)
     nrm = result.surface_normals.astype(np.float64)
     s = result.scene.sun_direction
@@ -63,10 +65,13 @@ def _transmitted_flux_float64(result):
     tri[..., :2] += shift
     a_perp = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]) @ s
     cos_i = nrm.reshape(-1, 3) @ s
-    t = fresnel_t_angles(np.arccos(np.clip(cos_i, -1, 1)), 1.0, 1.333)
-    t[cos_i <= 0] = 0.0
-    per_tri = np.where(a_perp > 0, a_perp * t[idx].mean(axis=1), 0.0)
-    return result.sun_irradiance * per_tri.sum()
+    indices = np.broadcast_to(1.333 if ior is None else np.asarray(ior), result.sun_irradiance.shape)
+    flux = []
+    for e_sun, n_k in zip(result.sun_irradiance, indices, strict=True):
+        t = fresnel_t_angles(np.arccos(np.clip(cos_i, -1, 1)), 1.0, n_k)
+        t[cos_i <= 0] = 0.0
+        flux.append(e_sun * np.where(a_perp > 0, a_perp * t[idx].mean(axis=1), 0.0).sum())
+    return np.array(flux)
 
 
 def test_energy_conserved_on_rough_ocean(device):
@@ -191,8 +196,9 @@ def test_huge_footprints_stay_bounded_and_conserve_flux(device):
 
 def test_dispersion_flat_water_and_energy(device):
     """With dispersion every band refracts with its own n(λ): still water gives each band
-    E_sun cosθ T_λ(θ) exp(−c D/cosθ_t,λ) (0.5 %), and a rough ocean keeps all the transmitted flux
-    per band (1e-4) while the bands' maps differ (coloured fringes)."""
+    E_sun cosθ T_λ(θ) exp(−c D/cosθ_t,λ) (1e-4; one index for all bands would miss by 5e-3), and a
+    rough ocean keeps each band's transmitted flux (1e-4, against a float64 sum with that band's n)
+    while the bands' maps differ (coloured fringes)."""
     from warpcaustics import spectra
 
     result = wc.render(_flat_scene(35.0, 5.0, **{"optics.dispersion": True}), device=device)
@@ -204,9 +210,9 @@ def test_dispersion_flat_water_and_energy(device):
     attenuation = np.exp(-result.attenuation_per_m * 5.0 / cos_t)
     expected = result.sun_irradiance * np.cos(theta) * t_fresnel * attenuation
     floor = result.floor_irradiance.astype(np.float64)
-    np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=5e-3)
+    np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=1e-4)
 
     rough = wc.render(_rough_ocean(**{"optics.dispersion": True}), device=device)
-    np.testing.assert_allclose(rough.floor_flux_w_nm, rough.transmitted_flux_w_nm, rtol=1e-4)
+    np.testing.assert_allclose(rough.floor_flux_w_nm, _transmitted_flux_float64(rough, rough.ior), rtol=1e-4)
     normalised = rough.floor_irradiance / rough.floor_irradiance.mean(axis=(1, 2), keepdims=True)
     assert np.abs(normalised[0] - normalised[-1]).mean() > 1e-3  # blue and red caustics differ

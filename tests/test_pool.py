@@ -143,3 +143,66 @@ def test_moving_body_pushes_the_water(device):
     along = (u_c[inside] * velocity[0] + v_c[inside] * velocity[1]) / speed
     assert along.mean() > 0.5 * speed
     assert abs(pool.volume_m3() / before - 1.0) < 1e-6
+
+
+def test_walled_pool_floor_flux(device):
+    """Still water in a walled pool: with an overhead sun the floor is lit evenly to the walls and
+    receives E·T(0)·L²; with an oblique sun the light shifted beyond the walls by D·tanθ_t is lost,
+    leaving exactly the overlap (L − s_x)(L − s_y) of the shifted square (1e-5)."""
+    for elevation, azimuth in ((90.0, 0.0), (50.0, 30.0)):
+        scene = wc.load_scene(None, {"water.model": "pool", "water.resolution": 32, "water.extent_m": 2.0,
+                                     "floor.depth_m": DEPTH_M, "sun.elevation_deg": elevation,
+                                     "sun.azimuth_deg": azimuth, "optics.water_type": "none",
+                                     "caustics.map_resolution": 40, "optics.wavelengths.bins": 1})
+        result = wc.render(scene, device=device)
+        theta = np.radians(90.0 - elevation)
+        theta_t = np.arcsin(np.sin(theta) / 1.333)
+        shift = DEPTH_M * np.tan(theta_t) * np.abs([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
+        beam = result.sun_irradiance[0] * np.cos(theta) * fresnel_t(theta) * 4.0
+        expected = beam * (2.0 - shift[0]) * (2.0 - shift[1]) / 4.0
+        assert result.floor_flux_w_nm[0] == pytest.approx(expected, rel=1e-5)
+        if elevation == 90.0:
+            floor = result.floor_irradiance[0]
+            np.testing.assert_allclose(floor, floor.mean(), rtol=1e-5)  # lit evenly up to the walls
+
+
+def fresnel_t(theta):
+    from conftest import fresnel_t_angles
+
+    return fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
+
+
+def test_drops_during_the_run_add_their_volume(device):
+    """Stepping with advance() through drops at t > 0 (one removing water): the volume changes by
+    exactly the drops' volumes (the sampled Gaussians), nothing else (1e-6)."""
+    drops = (DropConfig(time_s=0.2, x_m=0.5, radius_m=0.15, height_m=0.05),
+             DropConfig(time_s=0.45, x_m=-0.6, y_m=0.3, radius_m=0.1, height_m=-0.03))
+    pool = ShallowWaterPool(64, 4.0, DEPTH_M, device, drops=drops)
+    before = pool.volume_m3()
+    pool.advance(0.8)
+    x = (np.arange(64) + 0.5) * 4.0 / 64 - 2.0
+    xx, yy = np.meshgrid(x, x)
+    added = sum(d.height_m * np.exp(-0.5 * ((xx - d.x_m) ** 2 + (yy - d.y_m) ** 2) / d.radius_m**2).sum()
+                for d in drops) * (4.0 / 64) ** 2
+    assert pool.volume_m3() == pytest.approx(before + added, rel=1e-6)
+
+
+def test_wave_pool_drop_keeps_the_troughs(device):
+    """A drop into a moving wave pool adds its bump and nothing else: troughs stay negative and the
+    mean elevation rises by the bump's volume (a negative drop lowers it)."""
+    from warpcaustics.wavepool import WaveEquationPool
+
+    for height in (0.002, -0.002):
+        drops = (DropConfig(time_s=0.0, radius_m=0.15, height_m=0.02),
+                 DropConfig(time_s=0.5, x_m=0.5, radius_m=0.1, height_m=height))
+        pool = WaveEquationPool(64, 4.0, DEPTH_M, device, damping_per_s=0.0, drops=drops)
+        pool.advance(0.5 - 0.5 * pool.dt)
+        before = pool.eta.numpy().astype(np.float64).copy()
+        pool.advance(0.5 + 0.5 * pool.dt)  # one step, then the drop
+        after = pool.eta.numpy().astype(np.float64)
+        x = (np.arange(64) + 0.5) * 4.0 / 64 - 2.0
+        xx, yy = np.meshgrid(x, x)
+        bump = (height * np.exp(-0.5 * ((xx - 0.5) ** 2 + yy**2) / 0.1**2)).sum()
+        assert before.min() < -1e-4 and after.min() < -1e-4
+        # The wave step conserves Σ η with mirror walls; the drop adds its bump.
+        assert after.sum() - before.sum() == pytest.approx(bump, rel=1e-3)

@@ -264,3 +264,21 @@ def test_jonswap_variance_matches_its_frequency_spectrum(device):
         device).at(0.0).positions.numpy()[..., 2].astype(np.float64)) for sd in range(16)]
     sigma_mean = np.std(variances, ddof=1) / np.sqrt(len(variances))
     assert abs(np.mean(variances) - drawn) <= 3 * sigma_mean
+
+
+def test_choppy_single_wave_sharpens_its_crest(device):
+    """A single choppy wave is a Gerstner wave: vertices move towards the crest, so the Jacobian is
+    J = 1 − λ k h (smallest at the crest, where folds start), and x' − x = λ D with ∂D/∂x = −k h."""
+    n, extent, m, lam = 64, 32.0, 4, 1.5
+    ocean = water.FFTOcean(_single_mode(n, extent, m, amplitude=0.05), extent, 1000.0, device,
+                           choppiness=lam)
+    surface = ocean.at(0.3)
+    k = 2 * np.pi * m / extent
+    z = surface.positions.numpy()[..., 2].astype(np.float64)
+    jac = surface.jacobian.numpy().astype(np.float64)
+    np.testing.assert_allclose(jac, 1.0 - lam * k * z, atol=1e-5)
+    x = (np.arange(n) + 0.5) * extent / n - extent / 2
+    shift = surface.positions.numpy()[0, :, 0].astype(np.float64) - x
+    crest = np.argmax(z[0])
+    # just before the crest the vertices move forward (+x), just after it backward: towards it
+    assert shift[(crest - 2) % n] > 0 > shift[(crest + 2) % n]

@@ -13,7 +13,7 @@ from warpcaustics.water import Surface
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
-    triangle_flux = k * 2 * n * n * 4
+    triangle_flux = k * 2 * (n + 1) * (n + 1) * 4
     return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
 
 
@@ -21,7 +21,7 @@ class FloorCaustics:
     """Owns the floor stage's device buffers, reused from frame to frame."""
 
     def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, device: str):
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True):
         k = len(sun_irradiance)
         m = map_resolution
         self.device = device
@@ -29,8 +29,9 @@ class FloorCaustics:
                                        device=device)
         self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
                                           device=device)
-        self.flux = wp.empty((n, n, 2, k), dtype=wp.float32, device=device)
-        """Flux per triangle and wavelength (N, N, 2, K) [W nm^-1]."""
+        quads = n if periodic else n + 1  # a walled surface also has quads reaching its walls
+        self.flux = wp.empty((quads, quads, 2, k), dtype=wp.float32, device=device)
+        """Flux per triangle and wavelength (Q, Q, 2, K) [W nm^-1], Q quads per side."""
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
@@ -41,12 +42,14 @@ class FloorCaustics:
         """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
         so per band ``sum(irradiance) * texel_area == sum(flux)`` to rounding; in a walled pool
         the flux that would land beyond the walls is not followed."""
-        n = surface.resolution
+        quads = self.flux.shape[0]
+        if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
+            raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
         k = self.sun_irradiance.shape[0]
         m = self.texels.shape[0]
         groups = refracted.hit_xy.shape[0]
         per_group = k // groups
-        wp.launch(floor_kernels.triangle_flux, dim=(n, n, 2),
+        wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
                           wp.vec3(*np.asarray(sun_dir, np.float32)), self.sun_irradiance,
                           self.attenuation_per_m, per_group, float(surface.extent_m),
@@ -54,7 +57,7 @@ class FloorCaustics:
                   outputs=[self.flux], device=self.device)
         self.texels.zero_()
         self.coarse_count.zero_()
-        wp.launch(floor_kernels.deposit_footprints, dim=(groups, n, n, 2),
+        wp.launch(floor_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
                   inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.texels, self.coarse_count], device=self.device)

@@ -126,8 +126,9 @@ class WaterConfig:
     """Strength λ of the choppy horizontal displacement (Tessendorf eq. 29) [-]; 0 = none."""
     viscosity_m2_s: float = field(default=1.0e-4, metadata=_range(0.0, 1.0))
     """Kinematic (eddy) viscosity of the shallow-water ``pool`` [m²/s]."""
-    cfl: float = field(default=0.4, metadata=_range(0.0, 1.0, lo_open=True))
-    """Courant number of the pool's substeps: dt = cfl·Δx / (|u| + √(g h)) [-]."""
+    cfl: float = field(default=0.4, metadata=_range(0.0, 0.7, lo_open=True))
+    """Courant number of the pools' steps: dt = cfl·Δx / (|u| + √(g h)) [-]; the explicit gravity
+    step is stable up to 1/√2 in 2-D, hence at most 0.7."""
     drops: tuple[DropConfig, ...] = ()
     """Drops falling into the ``pool`` or ``wavepool``: ``[[water.drops]]`` tables with time_s,
     x_m, y_m, radius_m, height_m."""

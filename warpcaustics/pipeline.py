@@ -128,7 +128,8 @@ class Renderer:
             self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
-                                                self.attenuation_per_m, self.device)
+                                                self.attenuation_per_m, self.device,
+                                                periodic=self.water.periodic)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""

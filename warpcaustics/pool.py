@@ -28,6 +28,9 @@ Courant number (default 0.4) leaves room for the speed to grow in between."""
 class ShallowWaterPool:
     """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
 
+    periodic = False
+    """Walled: light beyond the walls is not followed."""
+
     def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
                  viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = (),
                  body: BodyConfig | None = None):

@@ -44,6 +44,9 @@ class Surface:
 class HeightfieldWater:
     """A static periodic height field (``flat`` is all zeros)."""
 
+    periodic = True
+    """A tileable patch: floor footprints wrap."""
+
     def __init__(self, heights: np.ndarray, extent_m: float, device: str):
         self.device = device
         self.extent_m = extent_m
@@ -205,6 +208,9 @@ def dispersion(k: np.ndarray, depth_m: float) -> np.ndarray:
 
 class FFTOcean:
     """Tessendorf FFT ocean: any initial spectrum h̃0, finite-depth dispersion, choppy waves."""
+
+    periodic = True
+    """A tileable patch: floor footprints wrap."""
 
     def __init__(self, h0: np.ndarray, extent_m: float, depth_m: float, device: str, *,
                  choppiness: float = 0.0):

@@ -21,6 +21,9 @@ from warpcaustics.water import GRAVITY_M_S2, Surface
 class WaveEquationPool:
     """η_tt = c² ∇²η − γ η_t in a square pool with walls; c = √(g·depth) unless given."""
 
+    periodic = False
+    """Walled: light beyond the walls is not followed."""
+
     def __init__(self, n: int, extent_m: float, depth_m: float, device: str, *,
                  wave_speed_m_s: float = 0.0, damping_per_s: float = 0.5, cfl: float = 0.4,
                  drops: tuple[DropConfig, ...] = ()):
@@ -30,7 +33,7 @@ class WaveEquationPool:
         self.depth_m = float(depth_m)
         self.speed = wave_speed_m_s if wave_speed_m_s > 0 else math.sqrt(GRAVITY_M_S2 * depth_m)
         self.damping = float(damping_per_s)
-        # Leapfrog stability in 2-D: c Δt / Δ ≤ 1/√2; cfl scales that limit's Courant number.
+        # Leapfrog stability in 2-D: c Δt / Δ ≤ 1/√2 (the config caps cfl at 0.7).
         self.dt = min(cfl, 0.7) * self.cell_m / self.speed
         self.eta = wp.zeros((n, n), dtype=wp.float32, device=device)
         self.eta_prev = wp.zeros((n, n), dtype=wp.float32, device=device)
@@ -61,7 +64,7 @@ class WaveEquationPool:
 
     def advance(self, time_s: float) -> None:
         """Step to the last multiple of the fixed Δt not after ``time_s`` (frames snap to it)."""
-        if time_s < self.time_s - self.dt:
+        if time_s < self.time_s - 1e-9:
             raise WarpcausticsError(
                 f"the wave pool is stateful: time_s = {time_s:g} s comes before its current time "
                 f"{self.time_s:g} s; render its frames in increasing time")
@@ -74,7 +77,7 @@ class WaveEquationPool:
         while self._drops and self._drops[0].time_s <= time_s + 1e-12:
             d = self._drops.pop(0)
             for field in (self.eta, self.eta_prev):  # a bump at rest: no initial velocity
-                wp.launch(pool_kernels.add_drop, dim=(n, n),
+                wp.launch(pool_kernels.add_bump, dim=(n, n),
                           inputs=[field, self.extent_m, d.x_m, d.y_m, d.radius_m, d.height_m],
                           device=self.device)
 
