@@ -46,6 +46,25 @@ class WaterSpectrum(str, enum.Enum):
 class WaterType(str, enum.Enum):
     NONE = "none"
     PURE = "pure"
+    CLEAR_OCEAN = "clear_ocean"
+    COASTAL_OCEAN = "coastal_ocean"
+    TURBID_HARBOR = "turbid_harbor"
+    JERLOV_I = "jerlov_I"
+    JERLOV_IA = "jerlov_IA"
+    JERLOV_IB = "jerlov_IB"
+    JERLOV_II = "jerlov_II"
+    JERLOV_III = "jerlov_III"
+    JERLOV_1C = "jerlov_1C"
+    JERLOV_3C = "jerlov_3C"
+    JERLOV_5C = "jerlov_5C"
+    JERLOV_7C = "jerlov_7C"
+    JERLOV_9C = "jerlov_9C"
+
+
+class JerlovSource(str, enum.Enum):
+    AUTO = "auto"
+    SOLONENKO2015 = "solonenko2015"
+    WILLIAMSON2022 = "williamson2022"
 
 
 class CausticsMethod(str, enum.Enum):
@@ -169,8 +188,14 @@ class WavelengthConfig:
 @dataclass(frozen=True)
 class OpticsConfig:
     water_type: WaterType = WaterType.PURE
-    """Water optics: ``pure`` (Pope & Fry 1997 absorption + Zhang 2009 scattering) or ``none``
-    (c = 0, for validation)."""
+    """Water optics: ``pure`` (Pope & Fry 1997 absorption + Zhang 2009 scattering), the thesis
+    types ``clear_ocean``, ``coastal_ocean``, ``turbid_harbor``, the Jerlov types ``jerlov_I`` …
+    ``jerlov_9C`` (from the ``jerlov`` package), or ``none`` (c = 0, for validation)."""
+    jerlov_source: JerlovSource = JerlovSource.AUTO
+    """Which publication the ``jerlov`` package takes a and b of a Jerlov type from:
+    ``williamson2022`` (measured; IB, II, III, 1C, 3C, 5C), ``solonenko2015`` (all ten types,
+    inverted from Kd; no a for 3C at 675–700 nm and 5C at 600–700 nm) or ``auto`` (Williamson
+    where it has the type, else Solonenko)."""
     ior: float = field(default=1.333, metadata=_range(1.0, 3.0, lo_open=True))
     """Refractive index of water, used for every wavelength when ``dispersion`` is off [-]."""
     dispersion: bool = False

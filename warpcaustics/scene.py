@@ -57,7 +57,7 @@ def _check_spectral_data(cfg: Config) -> None:
 
     bins = spectra.bins_for(cfg.optics)
     spectra.sun_irradiance(bins)
-    spectra.water_optics(cfg.optics.water_type, bins)
+    spectra.water_optics(cfg.optics.water_type, bins, cfg.optics.jerlov_source.value)
 
 
 def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Scene:

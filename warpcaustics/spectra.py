@@ -9,6 +9,10 @@ table. Sources (files under ``warpcaustics/data/``, provenance in its README):
 - ``pure`` water absorption: Pope & Fry (1997), Appl. Opt. 36, 8710 [1/m];
 - ``pure`` water scattering: Zhang, Hu & He (2009), Opt. Express 17, 5698, seawater at 35 PSU and
   20 °C [1/m];
+- ``clear_ocean``, ``coastal_ocean``, ``turbid_harbor``: the de la Fuente thesis's three types
+  (see ``thesis_coefficients``);
+- ``jerlov_*``: a and b of the Jerlov types from the ``jerlov`` package (Solonenko & Mobley 2015
+  or Williamson & Hollins 2022, ``optics.jerlov_source``);
 - ``none``: c = 0 (validation);
 - refractive index n(λ) of seawater relative to air: Quan & Fry (1995), Appl. Opt. 34, 3477,
   ``n = n0 + (n1 + n2 T + n3 T²) S + n4 T² + (n5 + n6 S + n7 T)/λ + n8/λ² + n9/λ³`` (λ in nm,
@@ -18,6 +22,7 @@ table. Sources (files under ``warpcaustics/data/``, provenance in its README):
 from __future__ import annotations
 
 import functools
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -107,7 +112,67 @@ def sun_irradiance(bins: SpectralBins) -> np.ndarray:
     return bins.average(*sun_table(), what="ASTM G173 solar")
 
 
-def water_optics(water_type: WaterType, bins: SpectralBins) -> WaterOptics:
+THESIS_NODES_NM = (450.0, 550.0, 720.0)
+"""Wavelengths at which the three water types of the de la Fuente thesis are given."""
+THESIS_ABSORPTION_PER_M = (0.0150, 0.0638, 1.169)
+"""Pure-water absorption of all three thesis types at THESIS_NODES_NM [1/m] (quoted in issue 4
+from the de la Fuente thesis, which the project's seeds cite)."""
+THESIS_SCATTERING_PER_M = {
+    WaterType.CLEAR_OCEAN: (0.039, 0.035, 0.028),
+    WaterType.COASTAL_OCEAN: (0.234, 0.20, 0.17),
+    WaterType.TURBID_HARBOR: (0.96, 0.82, 0.71),
+}
+"""Scattering of each thesis type at THESIS_NODES_NM [1/m] (same source; the issue lists them
+for 720/550/450 nm, reversed here into ascending wavelength)."""
+
+JERLOV_NAMES = {
+    WaterType.JERLOV_I: "I", WaterType.JERLOV_IA: "IA", WaterType.JERLOV_IB: "IB",
+    WaterType.JERLOV_II: "II", WaterType.JERLOV_III: "III", WaterType.JERLOV_1C: "1C",
+    WaterType.JERLOV_3C: "3C", WaterType.JERLOV_5C: "5C", WaterType.JERLOV_7C: "7C",
+    WaterType.JERLOV_9C: "9C",
+}
+"""Our names of the Jerlov types → the ``jerlov`` package's names."""
+
+
+def thesis_coefficients(water_type: WaterType,
+                        wavelength_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """a(λ), b(λ) of a thesis type: exactly the published values at 450, 550 and 720 nm.
+
+    The thesis gives nothing in between, so: absorption follows the shape of Pope & Fry's
+    pure-water absorption, scaled by a factor interpolated linearly between the nodes' ratios
+    (held at the end ratios outside), so that it passes through the three published values;
+    scattering is a power law in λ between neighbouring nodes (log-log interpolation, the end
+    segments extended), the usual spectral form of particle scattering.
+    """
+    lam = np.asarray(wavelength_nm, dtype=np.float64)
+    pf_lam, pf_a = pure_absorption_table()
+    nodes = np.array(THESIS_NODES_NM)
+    ratio = np.array(THESIS_ABSORPTION_PER_M) / np.interp(nodes, pf_lam, pf_a)
+    a = np.interp(lam, pf_lam, pf_a) * np.interp(lam, nodes, ratio)
+    log_b = np.log(np.array(THESIS_SCATTERING_PER_M[water_type]))
+    x = np.log(lam)
+    seg = np.clip(np.searchsorted(nodes, lam) - 1, 0, len(nodes) - 2)
+    x0, x1 = np.log(nodes[seg]), np.log(nodes[seg + 1])
+    b = np.exp(log_b[seg] + (x - x0) * (log_b[seg + 1] - log_b[seg]) / (x1 - x0))
+    return a, b
+
+
+def jerlov_water(water_type: WaterType, source: str):
+    """The ``jerlov`` package's Water object for one of our Jerlov type names."""
+    import jerlov
+
+    name = JERLOV_NAMES[water_type]
+    if source == "auto":
+        # Measured a and b where they exist (the package's own default), else the Kd inversion.
+        source = "williamson2022" if name in jerlov.SOURCES["williamson2022"].water_types else "solonenko2015"
+    covered = jerlov.SOURCES[source].water_types
+    if name not in covered:
+        raise ConfigError(f"optics.water_type = {water_type.value!r} is not in the {source} data "
+                          f"(it has {', '.join(covered)}); set optics.jerlov_source = 'solonenko2015'")
+    return jerlov.water(name, source=source)
+
+
+def water_optics(water_type: WaterType, bins: SpectralBins, jerlov_source: str = "auto") -> WaterOptics:
     """Absorption and scattering of the named water type, averaged over each bin."""
     if water_type is WaterType.NONE:
         zero = np.zeros(len(bins.centres_nm))
@@ -116,7 +181,28 @@ def water_optics(water_type: WaterType, bins: SpectralBins) -> WaterOptics:
         a = bins.average(*pure_absorption_table(), what="Pope & Fry 1997 absorption")
         b = bins.average(*pure_scattering_table(), what="Zhang 2009 scattering")
         return WaterOptics(a, b)
-    raise ConfigError(f"optics.water_type = {water_type.value!r} has no optical data")  # pragma: no cover
+    lo_nm, hi_nm = bins.edges_nm[0], bins.edges_nm[-1]
+    fine = np.linspace(lo_nm, hi_nm, int(round((hi_nm - lo_nm) * 10)) + 1)  # endpoints exact
+    if water_type in THESIS_SCATTERING_PER_M:
+        a, b = thesis_coefficients(water_type, fine)
+        return WaterOptics(bins.average(fine, a, "thesis"), bins.average(fine, b, "thesis"))
+    water = jerlov_water(water_type, jerlov_source)
+    jerlov_source = water.source.key
+    lo, hi = water.range_nm
+    if bins.edges_nm[0] < lo or bins.edges_nm[-1] > hi:
+        raise ConfigError(f"optics.wavelengths = {bins.edges_nm[0]:g}..{bins.edges_nm[-1]:g} nm lies "
+                          f"outside the {jerlov_source} data for {water_type.value} ({lo:g}..{hi:g} nm); "
+                          f"narrow optics.wavelengths")
+    with warnings.catch_warnings():
+        # The package warns where its values are interpolated or extrapolated; docs/physics.md
+        # lists those caveats per source.
+        warnings.simplefilter("ignore")
+        a = np.asarray(water.a(fine), dtype=np.float64)
+        b = np.asarray(water.b(fine), dtype=np.float64)
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ConfigError(f"the {jerlov_source} data for {water_type.value} have gaps inside "
+                          f"optics.wavelengths; narrow the range or choose another optics.jerlov_source")
+    return WaterOptics(bins.average(fine, a, jerlov_source), bins.average(fine, b, jerlov_source))
 
 
 @functools.cache

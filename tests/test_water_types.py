@@ -1,0 +1,102 @@
+"""Water types: the thesis's published numbers, the jerlov package's values, Jerlov's Kd table."""
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import warpcaustics as wc
+from warpcaustics import spectra
+from warpcaustics.config import WaterType
+
+from conftest import fresnel_t_angles
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "water"
+
+
+@pytest.mark.parametrize(("water_type", "published_b"), [
+    (WaterType.CLEAR_OCEAN, (0.028, 0.035, 0.039)),
+    (WaterType.COASTAL_OCEAN, (0.17, 0.20, 0.234)),
+    (WaterType.TURBID_HARBOR, (0.71, 0.82, 0.96)),
+])
+def test_thesis_types_reproduce_their_published_numbers(water_type, published_b):
+    """At 720, 550 and 450 nm the thesis types give exactly a = (1.169, 0.0638, 0.0150) 1/m and
+    their published b (the numbers as quoted in issue 4, typed here independently of the code)."""
+    a, b = spectra.thesis_coefficients(water_type, np.array([720.0, 550.0, 450.0]))
+    np.testing.assert_allclose(a, [1.169, 0.0638, 0.0150], rtol=1e-12)
+    np.testing.assert_allclose(b, published_b, rtol=1e-12)
+
+
+@pytest.mark.parametrize(("name", "source"), [
+    ("I", "solonenko2015"), ("IA", "solonenko2015"), ("IB", "williamson2022"), ("II", "williamson2022"),
+    ("III", "williamson2022"), ("1C", "williamson2022"), ("3C", "williamson2022"),
+    ("5C", "williamson2022"), ("7C", "solonenko2015"), ("9C", "solonenko2015"),
+    ("IB", "solonenko2015"), ("II", "solonenko2015")])
+def test_jerlov_types_are_the_packages_values(name, source):
+    """jerlov_<name> over 1 nm bins equals the jerlov package's a and b at the bin centres (its own
+    interpolation; the bin average of a piecewise-linear curve differs only in bins holding a node);
+    ``auto`` takes measured Williamson 2022 values where they exist, else Solonenko 2015."""
+    import warnings
+
+    import jerlov
+
+    bins = spectra.SpectralBins.uniform(400.0, 700.0, 300)
+    auto = source == ("williamson2022" if name in ("IB", "II", "III", "1C", "3C", "5C") else "solonenko2015")
+    ours = spectra.water_optics(WaterType(f"jerlov_{name}"), bins, "auto" if auto else source)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        water = jerlov.water(name, source=source)
+        a, b = water.a(bins.centres_nm), water.b(bins.centres_nm)
+    np.testing.assert_allclose(ours.absorption_per_m, a, rtol=2e-3)
+    np.testing.assert_allclose(ours.scattering_per_m, b, rtol=2e-3)
+
+
+def test_jerlov_package_kd_matches_jerlov_1976_table():
+    """The jerlov package's Kd (source jerlov1976) equals Jerlov (1976) Table XXVII as transcribed in
+    shared/data (`kd_jerlov_1976_tableXXVII.csv`), every type at every printed wavelength."""
+    import warnings
+
+    import jerlov
+
+    table = SHARED / "kd_jerlov_1976_tableXXVII.csv"
+    if not table.exists():
+        pytest.skip("shared/data not beside this checkout")
+    rows = list(csv.DictReader(table.open()))
+    columns = {"I": "Kd_I_per_m", "IA": "Kd_IA_per_m", "IB": "Kd_IB_per_m", "II": "Kd_II_per_m",
+               "III": "Kd_III_per_m", "1C": "Kd_C1_per_m", "3C": "Kd_C3_per_m", "5C": "Kd_C5_per_m",
+               "7C": "Kd_C7_per_m", "9C": "Kd_C9_per_m"}
+    compared = 0
+    for name, column in columns.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            water = jerlov.water(name, source="jerlov1976")
+        for row in rows:
+            if row[column] in ("", "nan"):
+                continue
+            wl = float(row["wavelength_nm"])
+            assert water.kd(np.array([wl]))[0] == pytest.approx(float(row[column]), rel=1e-9), (name, wl)
+            compared += 1
+    assert compared > 100
+
+
+@pytest.mark.parametrize("water_type", ["clear_ocean", "turbid_harbor", "jerlov_IB", "jerlov_5C"])
+def test_beer_lambert_per_wavelength_for_water_types(water_type, device):
+    """Still water over each water type: every band follows E_sun cosθ T(θ) exp(−c(λ) D / cosθ_t)
+    against float64 (1e-5: float32 exponentials and flux sums)."""
+    depth = 3.0
+    scene = wc.load_scene(None, {"water.model": "flat", "water.resolution": 16, "water.extent_m": 4.0,
+                                 "caustics.map_resolution": 16, "sun.elevation_deg": 50.0,
+                                 "floor.depth_m": depth, "optics.water_type": water_type})
+    result = wc.render(scene, device=device)
+    theta = np.radians(40.0)
+    cos_t = np.sqrt(1 - (np.sin(theta) / 1.333) ** 2)
+    expected = (result.sun_irradiance * np.cos(theta) * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
+                * np.exp(-result.attenuation_per_m * depth / cos_t))
+    np.testing.assert_allclose(result.floor_irradiance.mean(axis=(1, 2)), expected, rtol=1e-5)
+
+
+def test_jerlov_source_without_the_type_is_a_clear_error():
+    """Asking Williamson 2022 for a type it does not have names the types it has."""
+    with pytest.raises(wc.WarpcausticsError, match="has IB, II, III, 1C, 3C, 5C"):
+        wc.load_scene(None, {"optics.water_type": "jerlov_I", "optics.jerlov_source": "williamson2022"})
