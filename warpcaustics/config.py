@@ -61,6 +61,13 @@ class WaterType(str, enum.Enum):
     JERLOV_9C = "jerlov_9C"
 
 
+class SunSpectrum(str, enum.Enum):
+    ASTM_G173 = "astm_g173"
+    D65 = "d65"
+    BLACKBODY = "blackbody"
+    FILE = "file"
+
+
 class JerlovSource(str, enum.Enum):
     AUTO = "auto"
     SOLONENKO2015 = "solonenko2015"
@@ -173,6 +180,17 @@ class SunConfig:
     """Angle of the sun above the horizon [deg]."""
     azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction towards the sun, from +x towards +y [deg]."""
+    spectrum: SunSpectrum = SunSpectrum.ASTM_G173
+    """Shape of the sun's spectrum: ``astm_g173`` (direct + circumsolar, absolute), ``d65``,
+    ``blackbody`` (at ``temperature_k``) or ``file`` (``sun.file``)."""
+    temperature_k: float = field(default=5778.0, metadata=_range(1000.0, 100000.0))
+    """Temperature of the ``blackbody`` spectrum [K]."""
+    file: str | None = None
+    """CSV of the ``file`` spectrum: a header line, then wavelength [nm], spectral irradiance
+    (any scale); relative paths start at the config file's folder."""
+    irradiance_w_m2: float = field(default=0.0, metadata=_range(0.0, 1.0e5))
+    """Sun irradiance on a plane perpendicular to the beam, integrated over the render's
+    wavelengths [W/m²]; 0 = that of ASTM G173 direct + circumsolar over the same range."""
 
 
 @dataclass(frozen=True)
@@ -371,6 +389,9 @@ def _check_consistency(cfg: Config) -> None:
         raise ConfigError(f"water.file = {cfg.water.file!r} is only read by water.model = "
                           f"'heightfield' (model is {cfg.water.model.value!r}); remove it or change the "
                           "model")
+    if cfg.sun.spectrum is SunSpectrum.FILE and not cfg.sun.file:
+        raise ConfigError("sun.file is missing; sun.spectrum = 'file' needs a CSV of wavelength [nm], "
+                          "irradiance (set sun.file = \"sun.csv\")")
     n = cfg.water.resolution
     if cfg.water.model is WaterModel.FFT and n is not None and (n & (n - 1)):
         raise ConfigError(f"water.resolution = {n} must be a power of two for water.model = 'fft' "

@@ -117,7 +117,7 @@ class Renderer:
         self.bytes_needed = scene_bytes(scene)
         devices.check_fits(self.device, self.bytes_needed, _MEMORY_FIX)
         self.bins = spectra.bins_for(cfg.optics)
-        self.sun_irradiance = spectra.sun_irradiance(self.bins)
+        self.sun_irradiance = spectra.sun_irradiance(self.bins, cfg.sun, scene.base_dir)
         self.attenuation_per_m = spectra.water_optics(cfg.optics.water_type, self.bins,
                                                         cfg.optics.jerlov_source.value).attenuation_per_m
         self.ior = spectra.refractive_index(cfg.optics, self.bins)

@@ -47,16 +47,17 @@ def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) ->
         heights = load_heights(path if path.is_absolute() else base_dir / path, cfg.water.resolution)
         n = heights.shape[0]
     cfg = dataclasses.replace(cfg, water=dataclasses.replace(cfg.water, resolution=n))
-    _check_spectral_data(cfg)
+    _check_spectral_data(cfg, base_dir)
     return Scene(cfg, base_dir, heights, source)
 
 
-def _check_spectral_data(cfg: Config) -> None:
-    """Fail at load time, not at render time, when the bins leave the optical data's range."""
+def _check_spectral_data(cfg: Config, base_dir: Path) -> None:
+    """Fail at load time, not at render time, when the bins leave the optical data's range or
+    the sun's spectrum cannot be read."""
     from warpcaustics import spectra
 
     bins = spectra.bins_for(cfg.optics)
-    spectra.sun_irradiance(bins)
+    spectra.sun_irradiance(bins, cfg.sun, base_dir)
     spectra.water_optics(cfg.optics.water_type, bins, cfg.optics.jerlov_source.value)
 
 

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from warpcaustics.config import OpticsConfig, WaterType
+from warpcaustics.config import OpticsConfig, SunConfig, SunSpectrum, WaterType
 from warpcaustics.errors import ConfigError
 
 DATA_DIR = Path(__file__).parent / "data"
@@ -107,9 +107,53 @@ def bins_for(optics: OpticsConfig) -> SpectralBins:
     return SpectralBins.uniform(w.min_nm, w.max_nm, w.bins)
 
 
-def sun_irradiance(bins: SpectralBins) -> np.ndarray:
-    """Direct + circumsolar solar irradiance per bin [W m^-2 nm^-1] (ASTM G173-03)."""
-    return bins.average(*sun_table(), what="ASTM G173 solar")
+def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
+                   base_dir: Path | None = None) -> np.ndarray:
+    """Solar spectral irradiance per bin on a plane perpendicular to the beam [W m^-2 nm^-1].
+
+    The shape is ASTM G173-03 direct + circumsolar (absolute), CIE D65 (colour-science), a
+    blackbody (Planck's law through colour-science) or a user CSV; the scale makes Σ E Δλ equal
+    ``sun.irradiance_w_m2``, or, when that is 0, the ASTM G173 integral over the same bins.
+    """
+    astm = bins.average(*sun_table(), what="ASTM G173 solar")
+    if sun is None:
+        return astm
+    if sun.spectrum is SunSpectrum.ASTM_G173:
+        shape = astm
+    elif sun.spectrum is SunSpectrum.D65:
+        from warpcaustics.colour_out import _colour
+
+        d65 = _colour().SDS_ILLUMINANTS["D65"]
+        shape = bins.average(d65.wavelengths, d65.values, what="CIE D65")
+    elif sun.spectrum is SunSpectrum.BLACKBODY:
+        from warpcaustics.colour_out import _colour
+
+        fine = np.linspace(bins.edges_nm[0], bins.edges_nm[-1], int(round(np.ptp(bins.edges_nm) * 10)) + 1)
+        planck = _colour().colorimetry.planck_law(fine * 1e-9, sun.temperature_k)
+        shape = bins.average(fine, planck, what="Planck")
+    else:
+        shape = bins.average(*_read_spectrum_csv(sun.file, base_dir), what=f"sun.file {sun.file!r}")
+    total = sun.irradiance_w_m2 if sun.irradiance_w_m2 > 0 else float(np.sum(astm * bins.widths_nm))
+    integral = float(np.sum(shape * bins.widths_nm))
+    if not integral > 0:
+        raise ConfigError(f"sun.spectrum = {sun.spectrum.value!r} has no energy in optics.wavelengths")
+    return shape * (total / integral)
+
+
+def _read_spectrum_csv(name: str, base_dir: Path | None) -> tuple[np.ndarray, np.ndarray]:
+    path = Path(name)
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"sun.file = {str(path)!r} cannot be read as CSV (header line, then "
+                          f"wavelength_nm,irradiance): {exc}") from None
+    if data.shape[1] < 2 or len(data) < 2 or not np.all(np.diff(data[:, 0]) > 0) \
+            or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0):
+        raise ConfigError(f"sun.file = {str(path)!r} needs two columns, wavelengths strictly "
+                          f"increasing and finite, non-negative irradiances")
+    return data[:, 0], data[:, 1]
 
 
 THESIS_NODES_NM = (450.0, 550.0, 720.0)
