@@ -22,6 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 # (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
 FULL = [(256, 512, 16, True), (512, 1024, 16, True), (1024, 2048, 16, False)]
 QUICK = [(128, 256, 8, True)]
+# Cost vs spectral bins K: (water N, map M, bins list) full / quick.
+BINS_FULL = (256, 512, [3, 8, 16, 32])
+BINS_QUICK = (128, 256, [3, 8])
 # Step benchmarks: (module, label, sizes N full, sizes N quick)
 STEPS = [("ocean_step", "FFT ocean step, choppy (4 complex 2-D FFTs)", [64, 128, 256, 512, 1024], [64, 128]),
          ("pool_step", "shallow-water pool substep", [64, 128, 256, 512, 1024], [64, 128])]
@@ -65,6 +68,28 @@ def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dic
             print(f"  log-log slope of {key} vs N: {slope:.2f}")
             for r in rows:
                 r[f"{key}_loglog_slope"] = float(slope)
+    return rows
+
+
+def _bins(n: int, m: int, bins_list: list[int], device: str, repeats: int) -> list[dict]:
+    """Frame cost vs the number of spectral bins K, Warp and numpy, with a linear fit t = t0 + s·K."""
+    rows = []
+    for k in bins_list:
+        w = _in_child("measure_warp", n, m, k, device, repeats)
+        npy = _in_child("measure_numpy", n, m, k, 2)
+        rows.append({"water_n": n, "map_m": m, "bins": k, "warp_stages_s": w["stages_s"],
+                     "numpy_stages_s": npy["stages_s"],
+                     "speedup_warp_vs_numpy": npy["stages_s"] / w["stages_s"]})
+        print(f"bins         N={n:5d} M={m:5d} K={k:3d} | warp[{device}] {w['stages_s'] * 1e3:8.1f} ms | "
+              f"numpy {npy['stages_s'] * 1e3:8.1f} ms | ratio {rows[-1]['speedup_warp_vs_numpy']:6.1f}x",
+              flush=True)
+    ks = [r["bins"] for r in rows]
+    for key in ("warp_stages_s", "numpy_stages_s"):
+        slope, intercept = np.polyfit(ks, [r[key] for r in rows], 1)
+        print(f"  {key}: {intercept * 1e3:.1f} ms + {slope * 1e3:.2f} ms per bin")
+        for r in rows:
+            r[f"{key}_per_bin"] = float(slope)
+            r[f"{key}_fixed"] = float(intercept)
     return rows
 
 
@@ -128,6 +153,8 @@ def main(argv: list[str] | None = None) -> int:
               f"peak {warp_res['peak_rss_mib']:7.0f} MiB | numpy {np_time} s | ratio {speed}",
               flush=True)
 
+    bins_rows = _bins(*(BINS_QUICK if args.quick else BINS_FULL), args.device, repeats)
+
     steps = {}
     for module, title, full, quick in STEPS:
         steps[module] = _steps(module, quick if args.quick else full, args.device, repeats)
@@ -148,6 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         "timing": "median wall time; Warp after one warm-up frame, device synchronised",
         "results": rows,
         "steps": steps,
+        "bins": bins_rows,
     }
     out = args.out or ROOT / "benchmarks" / "results" / (
         f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")
