@@ -231,3 +231,15 @@ def test_wavelengths_outside_the_data_fail_at_load():
     """Bins beyond the optical data's range are refused when the scene is loaded, naming the range."""
     with pytest.raises(ConfigError, match="outside the Pope & Fry 1997 absorption data"):
         wc.load_scene(None, {"optics.wavelengths.max_nm": 760.0})
+
+
+def test_results_of_earlier_frames_stay_intact():
+    """A Renderer reuses its device buffers; results already returned must not change with the next
+    frame (on the CPU, Warp's .numpy() is a view)."""
+    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
+                                                        "optics.wavelengths.bins": 2})
+    renderer = wc.Renderer(scene, "cpu")
+    first = renderer.render(0.0)
+    kept = first.floor_irradiance.copy()
+    renderer.render(1.0)
+    np.testing.assert_array_equal(first.floor_irradiance, kept)

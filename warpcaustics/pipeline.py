@@ -159,7 +159,8 @@ class Renderer:
         with watch.stage("floor_caustics"):
             floor = self.floor.run(surface, refracted, sun_dir)
         with watch.stage("readback"):
-            floor_np = floor.numpy()
+            # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
+            floor_np = floor.numpy().copy()
             transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
