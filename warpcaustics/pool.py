@@ -25,11 +25,48 @@ SPEED_REFRESH_SUBSTEPS = 4
 Courant number (default 0.4) leaves room for the speed to grow in between."""
 
 
-class ShallowWaterPool:
-    """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
+class WalledPool:
+    """What the walled, stateful pools share: drops due at given times, the check that frames go
+    forward, and the surface built from a height field (``pool_surface``)."""
 
     periodic = False
     """Walled: light beyond the walls is not followed."""
+
+    def _init_drops(self, drops: tuple[DropConfig, ...]) -> None:
+        self.time_s = 0.0
+        self._drops = sorted(drops, key=lambda d: d.time_s)
+
+    def _check_forward(self, time_s: float) -> None:
+        if time_s < self.time_s - 1e-9:
+            raise WarpcausticsError(
+                f"the pool is stateful: time_s = {time_s:g} s comes before its current time "
+                f"{self.time_s:g} s; render its frames in increasing time")
+
+    def _apply_drops_until(self, time_s: float, kernel, fields) -> bool:
+        """Launch ``kernel`` on each of ``fields`` for every drop due by ``time_s``; True if any."""
+        n = fields[0].shape[0]
+        dropped = False
+        while self._drops and self._drops[0].time_s <= time_s + 1e-12:
+            d = self._drops.pop(0)
+            dropped = True
+            for field in fields:
+                wp.launch(kernel, dim=(n, n),
+                          inputs=[field, self.extent_m, d.x_m, d.y_m, d.radius_m, d.height_m],
+                          device=self.device)
+        return dropped
+
+    def _surface(self, height: wp.array2d, floor_depth: wp.array2d) -> Surface:
+        """Surface of elevation ``height − floor_depth`` at the cell centres, walled."""
+        n = height.shape[0]
+        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        wp.launch(pool_kernels.pool_surface, dim=(n, n), inputs=[height, floor_depth, self.extent_m],
+                  outputs=[positions, normals], device=self.device)
+        return Surface(positions, normals, self.extent_m, periodic=False)
+
+
+class ShallowWaterPool(WalledPool):
+    """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
 
     def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
                  viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = (),
@@ -49,10 +86,9 @@ class ShallowWaterPool:
         self._v_adv = wp.empty_like(self.v)
         self._speed = wp.zeros(1, dtype=wp.float32, device=device)
         self.body = body if body is not None and body.radius_m > 0 else None
-        self.time_s = 0.0
         self.substeps = 0
-        self._drops = sorted(drops, key=lambda d: d.time_s)
-        self._apply_drops_until(0.0)
+        self._init_drops(drops)
+        self._drop_water(0.0)
 
     @classmethod
     def from_config(cls, cfg: Config, device: str) -> ShallowWaterPool:
@@ -113,10 +149,7 @@ class ShallowWaterPool:
 
     def advance(self, time_s: float) -> None:
         """Step forward to ``time_s`` [s] with CFL-limited substeps, dropping drops on the way."""
-        if time_s < self.time_s - 1e-9:
-            raise WarpcausticsError(
-                f"the pool is stateful: time_s = {time_s:g} s comes before its current time "
-                f"{self.time_s:g} s; render its frames in increasing time")
+        self._check_forward(time_s)
         # Viscous limit of the explicit Laplacian: ν dt / Δ² ≤ 1/8.
         dt_viscous = self.cell_m**2 / (8.0 * self.viscosity) if self.viscosity > 0 else math.inf
         speed = math.nan
@@ -137,28 +170,15 @@ class ShallowWaterPool:
             dt = min(dt, max(next_drop - self.time_s, 1e-9))
             self.step(dt)
             self.time_s += dt
-            if self._apply_drops_until(self.time_s):
+            if self._drop_water(self.time_s):
                 speed = math.nan  # a drop changes the wave speed: measure again
         else:  # pragma: no cover - a guard, not a code path
             raise WarpcausticsError("the pool needs more than a million substeps for one frame; "
                                     "lower water.resolution or raise --fps")
 
-    def _apply_drops_until(self, time_s: float) -> bool:
-        n = self.resolution
-        dropped = False
-        while self._drops and self._drops[0].time_s <= time_s + 1e-12:
-            dropped = True
-            d = self._drops.pop(0)
-            wp.launch(pool_kernels.add_drop, dim=(n, n),
-                      inputs=[self.h, self.extent_m, d.x_m, d.y_m, d.radius_m, d.height_m],
-                      device=self.device)
-        return dropped
+    def _drop_water(self, time_s: float) -> bool:
+        return self._apply_drops_until(time_s, pool_kernels.add_drop, [self.h])
 
     def at(self, time_s: float) -> Surface:
         self.advance(time_s)
-        n = self.resolution
-        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        wp.launch(pool_kernels.pool_surface, dim=(n, n), inputs=[self.h, self.floor_depth, self.extent_m],
-                  outputs=[positions, normals], device=self.device)
-        return Surface(positions, normals, self.extent_m, periodic=False)
+        return self._surface(self.h, self.floor_depth)

@@ -13,16 +13,13 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.config import Config, DropConfig
-from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels import pool as pool_kernels
+from warpcaustics.pool import WalledPool
 from warpcaustics.water import GRAVITY_M_S2, Surface
 
 
-class WaveEquationPool:
+class WaveEquationPool(WalledPool):
     """η_tt = c² ∇²η − γ η_t in a square pool with walls; c = √(g·depth) unless given."""
-
-    periodic = False
-    """Walled: light beyond the walls is not followed."""
 
     def __init__(self, n: int, extent_m: float, depth_m: float, device: str, *,
                  wave_speed_m_s: float = 0.0, damping_per_s: float = 0.5, cfl: float = 0.4,
@@ -39,9 +36,8 @@ class WaveEquationPool:
         self.eta_prev = wp.zeros((n, n), dtype=wp.float32, device=device)
         self._next = wp.zeros((n, n), dtype=wp.float32, device=device)
         self._zero_depth = wp.zeros((n, n), dtype=wp.float32, device=device)
-        self.time_s = 0.0
-        self._drops = sorted(drops, key=lambda d: d.time_s)
-        self._apply_drops_until(0.0)
+        self._init_drops(drops)
+        self._drop_bumps(0.0)
 
     @classmethod
     def from_config(cls, cfg: Config, device: str) -> WaveEquationPool:
@@ -64,31 +60,18 @@ class WaveEquationPool:
 
     def advance(self, time_s: float) -> None:
         """Step to the last multiple of the fixed Δt not after ``time_s`` (frames snap to it)."""
-        if time_s < self.time_s - 1e-9:
-            raise WarpcausticsError(
-                f"the wave pool is stateful: time_s = {time_s:g} s comes before its current time "
-                f"{self.time_s:g} s; render its frames in increasing time")
+        self._check_forward(time_s)
         while self.time_s + self.dt <= time_s + 1e-9:
             self.step()
-            self._apply_drops_until(self.time_s)
+            self._drop_bumps(self.time_s)
 
-    def _apply_drops_until(self, time_s: float) -> None:
-        n = self.resolution
-        while self._drops and self._drops[0].time_s <= time_s + 1e-12:
-            d = self._drops.pop(0)
-            for field in (self.eta, self.eta_prev):  # a bump at rest: no initial velocity
-                wp.launch(pool_kernels.add_bump, dim=(n, n),
-                          inputs=[field, self.extent_m, d.x_m, d.y_m, d.radius_m, d.height_m],
-                          device=self.device)
+    def _drop_bumps(self, time_s: float) -> None:
+        # a bump released at rest: raise η and η⁻ alike, so there is no initial velocity
+        self._apply_drops_until(time_s, pool_kernels.add_bump, [self.eta, self.eta_prev])
 
     def at(self, time_s: float) -> Surface:
         self.advance(time_s)
-        n = self.resolution
-        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        wp.launch(pool_kernels.pool_surface, dim=(n, n), inputs=[self.eta, self._zero_depth, self.extent_m],
-                  outputs=[positions, normals], device=self.device)
-        return Surface(positions, normals, self.extent_m, periodic=False)
+        return self._surface(self.eta, self._zero_depth)
 
     def energy(self) -> float:
         """Discrete wave energy ½Σ(η_t² + c²|∇η|²)Δ² [m⁴/s²·…], for checking the damping rate."""
