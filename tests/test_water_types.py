@@ -8,7 +8,7 @@ import pytest
 
 import warpcaustics as wc
 from warpcaustics import spectra
-from warpcaustics.config import WaterType
+from warpcaustics.config import JerlovSource, OpticsConfig, WaterType
 
 from conftest import fresnel_t_angles
 
@@ -43,7 +43,9 @@ def test_jerlov_types_are_the_packages_values(name, source):
 
     bins = spectra.SpectralBins.uniform(400.0, 700.0, 300)
     auto = source == ("williamson2022" if name in ("IB", "II", "III", "1C", "3C", "5C") else "solonenko2015")
-    ours = spectra.water_optics(WaterType(f"jerlov_{name}"), bins, "auto" if auto else source)
+    optics = OpticsConfig(water_type=WaterType(f"jerlov_{name}"),
+                          jerlov_source=JerlovSource("auto" if auto else source))
+    ours = spectra.water_optics(optics, bins)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         water = jerlov.water(name, source=source)
@@ -100,3 +102,34 @@ def test_jerlov_source_without_the_type_is_a_clear_error():
     """Asking Williamson 2022 for a type it does not have names the types it has."""
     with pytest.raises(wc.WarpcausticsError, match="has IB, II, III, 1C, 3C, 5C"):
         wc.load_scene(None, {"optics.water_type": "jerlov_I", "optics.jerlov_source": "williamson2022"})
+
+
+def test_bio_optical_model_terms():
+    """Case-1 water: with no chlorophyll and no CDOM it is pure seawater; the particle absorption at a
+    tabulated wavelength is A_p·Chl^E_p of Bricaud et al. 1998 (read here from shared/data), CDOM adds
+    a(440)·e^(−S(λ−440)), and particle scattering adds 0.416·Chl^0.766 (Morel & Maritorena 2001)."""
+    table = SHARED / "ap_aph_bricaud_1998_Ap_Ep_Aphi_Ephi.csv"
+    if not table.exists():
+        pytest.skip("shared/data not beside this checkout")
+    row = next(r for r in csv.DictReader(table.open()) if r["wavelength_nm"] == "440")
+    lam = np.array([440.0, 550.0])
+    a0, b0 = spectra.bio_optical_coefficients(0.0, 0.0, 0.0176, lam)
+    np.testing.assert_allclose(a0, np.interp(lam, *spectra.pure_absorption_table()), rtol=1e-12)
+    np.testing.assert_allclose(b0, np.interp(lam, *spectra.pure_scattering_table()), rtol=1e-12)
+    chl, cdom, slope = 2.0, 0.05, 0.015
+    a, b = spectra.bio_optical_coefficients(chl, cdom, slope, lam)
+    particles_440 = float(row["Ap"]) * chl ** float(row["Ep"])
+    assert a[0] - a0[0] == pytest.approx(particles_440 + cdom, rel=1e-9)
+    assert b - b0 == pytest.approx(np.full(2, 0.416 * chl**0.766), rel=1e-9)
+    a_cdom_only, _ = spectra.bio_optical_coefficients(0.0, cdom, slope, lam)
+    assert a_cdom_only[1] - a0[1] == pytest.approx(cdom * np.exp(-slope * 110.0), rel=1e-9)
+
+
+def test_more_chlorophyll_darkens_the_floor():
+    """The floor under greener water receives less light in every band (more absorption and
+    scattering out of the beam)."""
+    base = {"water.model": "flat", "water.resolution": 8, "caustics.map_resolution": 8,
+            "floor.depth_m": 10.0, "optics.water_type": "bio_optical"}
+    clear = wc.render(wc.load_scene(None, {**base, "optics.chlorophyll_mg_m3": 0.05}), device="cpu")
+    green = wc.render(wc.load_scene(None, {**base, "optics.chlorophyll_mg_m3": 5.0}), device="cpu")
+    assert np.all(green.floor_irradiance.mean(axis=(1, 2)) < clear.floor_irradiance.mean(axis=(1, 2)))

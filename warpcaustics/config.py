@@ -59,6 +59,7 @@ class WaterType(str, enum.Enum):
     JERLOV_5C = "jerlov_5C"
     JERLOV_7C = "jerlov_7C"
     JERLOV_9C = "jerlov_9C"
+    BIO_OPTICAL = "bio_optical"
 
 
 class SunSpectrum(str, enum.Enum):
@@ -216,6 +217,13 @@ class OpticsConfig:
     where it has the type, else Solonenko)."""
     ior: float = field(default=1.333, metadata=_range(1.0, 3.0, lo_open=True))
     """Refractive index of water, used for every wavelength when ``dispersion`` is off [-]."""
+    chlorophyll_mg_m3: float = field(default=0.1, metadata=_range(0.0, 100.0))
+    """Chlorophyll concentration of the ``bio_optical`` (case-1) water [mg m⁻³]."""
+    cdom_440_per_m: float = field(default=0.0, metadata=_range(0.0, 20.0))
+    """CDOM absorption at 440 nm of the ``bio_optical`` water [1/m]."""
+    cdom_slope_per_nm: float = field(default=0.0176, metadata=_range(0.0, 0.1))
+    """Exponential slope S of CDOM absorption, a(λ) = a(440) e^(−S(λ−440)) [1/nm] (default:
+    ECOMAMA-MORS, shared/data bio_optical_model_parameters.csv)."""
     dispersion: bool = False
     """Use n(λ) of seawater from Quan & Fry (1995) at each bin centre instead of ``ior``."""
     salinity_psu: float = field(default=35.0, metadata=_range(0.0, 45.0))

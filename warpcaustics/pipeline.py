@@ -118,8 +118,7 @@ class Renderer:
         devices.check_fits(self.device, self.bytes_needed, _MEMORY_FIX)
         self.bins = spectra.bins_for(cfg.optics)
         self.sun_irradiance = spectra.sun_irradiance(self.bins, cfg.sun, scene.base_dir)
-        self.attenuation_per_m = spectra.water_optics(cfg.optics.water_type, self.bins,
-                                                        cfg.optics.jerlov_source.value).attenuation_per_m
+        self.attenuation_per_m = spectra.water_optics(cfg.optics, self.bins).attenuation_per_m
         self.ior = spectra.refractive_index(cfg.optics, self.bins)
         # One refraction per distinct index: K groups with dispersion, else one shared by all bins.
         self.group_ior = self.ior if cfg.optics.dispersion else self.ior[:1]

@@ -58,7 +58,7 @@ def _check_spectral_data(cfg: Config, base_dir: Path) -> None:
 
     bins = spectra.bins_for(cfg.optics)
     spectra.sun_irradiance(bins, cfg.sun, base_dir)
-    spectra.water_optics(cfg.optics.water_type, bins, cfg.optics.jerlov_source.value)
+    spectra.water_optics(cfg.optics, bins)
 
 
 def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Scene:

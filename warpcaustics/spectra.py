@@ -216,8 +216,50 @@ def jerlov_water(water_type: WaterType, source: str):
     return jerlov.water(name, source=source)
 
 
-def water_optics(water_type: WaterType, bins: SpectralBins, jerlov_source: str = "auto") -> WaterOptics:
-    """Absorption and scattering of the named water type, averaged over each bin."""
+def bricaud_1998_table() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(λ, A_p, E_p) of Bricaud et al. (1998): particle absorption a_p = A_p·Chl^E_p."""
+    wl, a_p = _table("ap_aph_bricaud_1998_Ap_Ep_Aphi_Ephi.csv", "Ap")
+    _, e_p = _table("ap_aph_bricaud_1998_Ap_Ep_Aphi_Ephi.csv", "Ep")
+    return wl, a_p, e_p
+
+
+@functools.cache
+def _bio_optical_parameter(model: str, name: str) -> float:
+    import csv
+
+    with (DATA_DIR / "bio_optical_model_parameters.csv").open(encoding="utf-8") as f:
+        for row in csv.DictReader(f):
+            if row["model"].startswith(model) and row["parameter"] == name:
+                return float(row["value_or_expression"])
+    raise KeyError(f"{model} {name}")  # pragma: no cover - the shipped file has them
+
+
+def bio_optical_coefficients(chlorophyll_mg_m3: float, cdom_440_per_m: float, cdom_slope_per_nm: float,
+                             wavelength_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """a(λ), b(λ) of case-1 water with chlorophyll and CDOM [1/m].
+
+    a = a_w (Pope & Fry 1997) + A_p(λ)·Chl^E_p(λ) (particles, Bricaud et al. 1998)
+        + a_CDOM(440)·exp(−S(λ − 440));
+    b = b_w (Zhang et al. 2009, seawater) + b_p, with b_p(550) = 0.416·Chl^0.766 (Morel & Maritorena
+    2001). The sourced data give no spectral shape for b_p, so it is held at its 550 nm value.
+    """
+    lam = np.asarray(wavelength_nm, dtype=np.float64)
+    wl, a_p, e_p = bricaud_1998_table()
+    particles = 0.0
+    if chlorophyll_mg_m3 > 0:
+        particles = np.interp(lam, wl, a_p) * chlorophyll_mg_m3 ** np.interp(lam, wl, e_p)
+    a = (np.interp(lam, *pure_absorption_table()) + particles
+         + cdom_440_per_m * np.exp(-cdom_slope_per_nm * (lam - 440.0)))
+    coefficient = _bio_optical_parameter("Morel & Maritorena 2001", "bp550_coefficient")
+    exponent = _bio_optical_parameter("Morel & Maritorena 2001", "bp550_exponent")
+    b = np.interp(lam, *pure_scattering_table()) + coefficient * chlorophyll_mg_m3**exponent
+    return a, b
+
+
+def water_optics(optics: OpticsConfig, bins: SpectralBins) -> WaterOptics:
+    """Absorption and scattering of ``optics.water_type``, averaged over each bin."""
+    water_type = optics.water_type
+    jerlov_source = optics.jerlov_source.value
     if water_type is WaterType.NONE:
         zero = np.zeros(len(bins.centres_nm))
         return WaterOptics(zero, zero.copy())
@@ -227,6 +269,13 @@ def water_optics(water_type: WaterType, bins: SpectralBins, jerlov_source: str =
         return WaterOptics(a, b)
     lo_nm, hi_nm = bins.edges_nm[0], bins.edges_nm[-1]
     fine = np.linspace(lo_nm, hi_nm, int(round((hi_nm - lo_nm) * 10)) + 1)  # endpoints exact
+    if water_type is WaterType.BIO_OPTICAL:
+        if lo_nm < 400.0 or hi_nm > 700.0:
+            raise ConfigError(f"optics.wavelengths = {lo_nm:g}..{hi_nm:g} nm lies outside the Bricaud "
+                              f"1998 data (400..700 nm) of optics.water_type = 'bio_optical'")
+        a, b = bio_optical_coefficients(optics.chlorophyll_mg_m3, optics.cdom_440_per_m,
+                                        optics.cdom_slope_per_nm, fine)
+        return WaterOptics(bins.average(fine, a, "bio-optical"), bins.average(fine, b, "bio-optical"))
     if water_type in THESIS_SCATTERING_PER_M:
         a, b = thesis_coefficients(water_type, fine)
         return WaterOptics(bins.average(fine, a, "thesis"), bins.average(fine, b, "thesis"))
