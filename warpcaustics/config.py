@@ -202,6 +202,11 @@ class WavelengthConfig:
     """Upper edge of the last bin [nm]."""
     bins: int = field(default=16, metadata=_range(1, 400))
     """Number K of equal bins; values are bin averages per nm."""
+    list_nm: tuple[float, ...] = field(default=(), metadata=_range(300.0, 1000.0))
+    """Explicit bin centres [nm], strictly increasing, instead of equal bins: each bin reaches
+    half-way to its neighbours (the outer bins are symmetric about their centres). In TOML write
+    ``optics.wavelengths = [450.0, 550.0, 650.0]``; ``optics.wavelengths = "rgb"`` means three
+    equal bins over 400–700 nm."""
 
 
 @dataclass(frozen=True)
@@ -328,6 +333,11 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
             raise ConfigError(f"{key} = {_describe(value)} is not implemented yet; allowed now: "
                               f"{', '.join(allowed)}")
         raise ConfigError(f"{key} = {_describe(value)} is not allowed; allowed: {', '.join(allowed)}")
+    if typing.get_origin(tp) is tuple and typing.get_args(tp) == (float, Ellipsis):
+        if not isinstance(value, (list, tuple)) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            raise ConfigError(f"{key} = {_describe(value)} must be a list of numbers")
+        return tuple(_convert(key, v, float, meta) for v in value)
     if tp is bool:
         if isinstance(value, bool):
             return value
@@ -387,6 +397,8 @@ def _build(cls: type, table: dict, prefix: str) -> Any:
 
 def _check_consistency(cfg: Config) -> None:
     w = cfg.optics.wavelengths
+    if any(b <= a for a, b in zip(w.list_nm, w.list_nm[1:])):
+        raise ConfigError(f"optics.wavelengths = {list(w.list_nm)} must be strictly increasing")
     if w.max_nm <= w.min_nm:
         raise ConfigError(f"optics.wavelengths.max_nm = {w.max_nm} must exceed "
                           f"optics.wavelengths.min_nm = {w.min_nm}")
@@ -434,6 +446,17 @@ def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Co
     table = _deepcopy(table)
     for key, value in (overrides or {}).items():
         _set_dotted(table, key, value)
+    optics = table.get("optics")
+    if isinstance(optics, dict):
+        wavelengths = optics.get("wavelengths")
+        # Shorthands: a list of centres, or "rgb" (three equal bins over 400-700 nm).
+        if isinstance(wavelengths, list):
+            optics["wavelengths"] = {"list_nm": wavelengths}
+        elif wavelengths == "rgb":
+            optics["wavelengths"] = {"min_nm": 400.0, "max_nm": 700.0, "bins": 3}
+        elif isinstance(wavelengths, str):
+            raise ConfigError(f"optics.wavelengths = {wavelengths!r} is not allowed; allowed: a table "
+                              f"{{min_nm, max_nm, bins}}, a list of centres [nm] or \"rgb\"")
     cfg = _build(Config, table, "")
     _check_consistency(cfg)
     return cfg
@@ -462,7 +485,7 @@ def config_to_dict(cfg: Any) -> dict:
         if dataclasses.is_dataclass(value):
             out[f.name] = config_to_dict(value)
         elif isinstance(value, tuple):
-            out[f.name] = [config_to_dict(v) for v in value]
+            out[f.name] = [config_to_dict(v) if dataclasses.is_dataclass(v) else v for v in value]
         elif isinstance(value, enum.Enum):
             out[f.name] = value.value
         else:

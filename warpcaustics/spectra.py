@@ -66,6 +66,16 @@ class SpectralBins:
     def uniform(cls, min_nm: float, max_nm: float, bins: int) -> SpectralBins:
         return cls(np.linspace(min_nm, max_nm, bins + 1))
 
+    @classmethod
+    def around(cls, centres_nm: np.ndarray) -> SpectralBins:
+        """Bins around given centres: inner edges half-way between neighbours, outer bins symmetric
+        about their centres (one centre alone gets a 10 nm bin)."""
+        c = np.asarray(centres_nm, dtype=np.float64)
+        if len(c) == 1:
+            return cls(np.array([c[0] - 5.0, c[0] + 5.0]))
+        inner = 0.5 * (c[1:] + c[:-1])
+        return cls(np.concatenate([[2 * c[0] - inner[0]], inner, [2 * c[-1] - inner[-1]]]))
+
     @property
     def centres_nm(self) -> np.ndarray:
         return 0.5 * (self.edges_nm[1:] + self.edges_nm[:-1])
@@ -103,7 +113,10 @@ class WaterOptics:
 
 
 def bins_for(optics: OpticsConfig) -> SpectralBins:
+    """The render's bins: K equal bins, or bins around an explicit list of centres."""
     w = optics.wavelengths
+    if w.list_nm:
+        return SpectralBins.around(np.array(w.list_nm, dtype=np.float64))
     return SpectralBins.uniform(w.min_nm, w.max_nm, w.bins)
 
 
