@@ -69,6 +69,22 @@ class SunSpectrum(str, enum.Enum):
     FILE = "file"
 
 
+class PhaseFunctionKind(str, enum.Enum):
+    HENYEY_GREENSTEIN = "henyey_greenstein"
+    PETZOLD = "petzold"
+
+
+class PetzoldStation(str, enum.Enum):
+    AUTEC_7 = "AUTEC 7"
+    AUTEC_8 = "AUTEC 8"
+    AUTEC_9 = "AUTEC 9"
+    HAOCE_5 = "HAOCE 5"
+    HAOCE_11 = "HAOCE 11"
+    NUC_2200 = "NUC 2200"
+    NUC_2040 = "NUC 2040"
+    NUC_2240 = "NUC 2240"
+
+
 class JerlovSource(str, enum.Enum):
     AUTO = "auto"
     SOLONENKO2015 = "solonenko2015"
@@ -229,6 +245,13 @@ class OpticsConfig:
     cdom_slope_per_nm: float = field(default=0.0176, metadata=_range(0.0, 0.1))
     """Exponential slope S of CDOM absorption, a(λ) = a(440) e^(−S(λ−440)) [1/nm] (default:
     ECOMAMA-MORS, shared/data bio_optical_model_parameters.csv)."""
+    phase_function: PhaseFunctionKind = PhaseFunctionKind.HENYEY_GREENSTEIN
+    """Phase function of in-water scattering (for the volume caustics of issues 5–6):
+    ``henyey_greenstein`` or ``petzold`` (measured, from the ``jerlov`` package)."""
+    hg_g: float | None = field(default=None, metadata=_range(-0.99, 0.99))
+    """Mean cosine g of Henyey–Greenstein; default: that of ``petzold_station`` [-]."""
+    petzold_station: PetzoldStation = PetzoldStation.HAOCE_11
+    """Petzold (1972) station of the ``petzold`` phase function (and of the default g)."""
     dispersion: bool = False
     """Use n(λ) of seawater from Quan & Fry (1995) at each bin centre instead of ``ior``."""
     salinity_psu: float = field(default=35.0, metadata=_range(0.0, 45.0))
