@@ -243,3 +243,22 @@ def test_results_of_earlier_frames_stay_intact():
     kept = first.floor_irradiance.copy()
     renderer.render(1.0)
     np.testing.assert_array_equal(first.floor_irradiance, kept)
+
+
+def test_spectral_exr_reads_back_through_colour_science_fichet_reader(tmp_path):
+    """The spectral EXR is a valid Fichet et al. (2021) file: colour-science's reader (needs the
+    openimageio test extra) returns our wavelengths, emissive units and the floor map, image row 0
+    being the largest y."""
+    pytest.importorskip("OpenImageIO")
+    import colour
+
+    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
+                                                        "optics.wavelengths.bins": 4})
+    result = wc.render(scene, device="cpu")
+    result.save(tmp_path)
+    components, spec = colour.io.read_spectral_image_Fichet2021(tmp_path / "frame_0000.exr",
+                                                                additional_data=True)
+    wavelengths, values = components["S0"]
+    assert spec.is_emissive and not spec.is_polarised
+    np.testing.assert_allclose(wavelengths, result.wavelengths_nm)
+    np.testing.assert_allclose(np.moveaxis(values, -1, 0), result.floor_irradiance[:, ::-1], rtol=1e-6)
