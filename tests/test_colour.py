@@ -45,3 +45,24 @@ def test_explicit_and_rgb_wavelengths():
     np.testing.assert_allclose(colour_out.xyz_to_linear_srgb(xyz) / xyz[1], 1.0, atol=0.05)
     with pytest.raises(wc.WarpcausticsError, match="strictly increasing"):
         wc.load_scene(None, {"optics.wavelengths": [600.0, 500.0]})
+
+
+def test_acescg_white_and_sun_white_balance():
+    """D65 maps to ACEScg (1, 1, 1)·Y through CAT02 (1e-3, 5 nm bins); with white balance to the sun
+    the ASTM G173 sun itself comes out neutral in ACEScg (1e-6) and sRGB (1e-3: IEC 61966-2-1's
+    XYZ→sRGB matrix is rounded to four decimals), and without it, not."""
+    from warpcaustics import spectra
+
+    bins = spectra.SpectralBins.uniform(380.0, 780.0, 80)
+    d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
+    d65_bins = bins.average(d65.wavelengths, d65.values, "D65")
+    xyz = colour_out.spectral_to_xyz(d65_bins[:, None, None], bins)[0, 0]
+    np.testing.assert_allclose(colour_out.xyz_to_linear_rgb(xyz, "ACEScg") / xyz[1], 1.0, atol=1e-3)
+
+    sun_bins = spectra.SpectralBins.uniform(400.0, 700.0, 60)
+    sun = colour_out.spectral_to_xyz(spectra.sun_irradiance(sun_bins)[:, None, None], sun_bins)[0, 0]
+    for space, tolerance in (("sRGB", 1e-3), ("ACEScg", 1e-6)):
+        balanced = colour_out.xyz_to_linear_rgb(sun, space, white_xyz=sun)
+        np.testing.assert_allclose(balanced / balanced.mean(), 1.0, atol=tolerance)
+    unbalanced = colour_out.xyz_to_linear_rgb(sun, "sRGB")
+    assert np.ptp(unbalanced / unbalanced.mean()) > 0.02  # the sun is not D65

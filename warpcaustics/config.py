@@ -270,10 +270,27 @@ class CausticsConfig:
     """Texels M per side of the floor irradiance map over the water extent [-]."""
 
 
+class Colourspace(str, enum.Enum):
+    SRGB = "sRGB"
+    ACESCG = "ACEScg"
+
+
+class WhiteBalance(str, enum.Enum):
+    D65 = "d65"
+    SUN = "sun"
+
+
 @dataclass(frozen=True)
 class OutputConfig:
     spectral_exr: bool = True
     """Write the per-band floor irradiance into the EXR (``S0.<λ>nm`` channels) besides RGB."""
+    colourspace: Colourspace = Colourspace.SRGB
+    """Linear RGB of the EXR's R, G, B channels: ``sRGB`` or ``ACEScg`` (the PNG is always sRGB)."""
+    white_balance: WhiteBalance = WhiteBalance.D65
+    """``d65``: colours as a D65-adapted observer sees them; ``sun``: the sun's own spectrum is
+    rendered neutral (von Kries / CAT02)."""
+    exposure_ev: float = field(default=0.0, metadata=_range(-20.0, 20.0))
+    """PNG exposure relative to the automatic one (mean luminance → 0.25) [stops]."""
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics import __version__
-from warpcaustics.config import config_to_dict
+from warpcaustics.config import Colourspace, WhiteBalance, config_to_dict
 from warpcaustics.spectra import SpectralBins
 
 EMISSIVE_UNITS = "W.m^-2.nm^-1"
@@ -101,17 +101,25 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     bins = SpectralBins(np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
                                         result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2]))
+    out_cfg = result.scene.config.output
     image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
     xyz = colour_out.spectral_to_xyz(image, bins)
-    rgb = colour_out.xyz_to_linear_srgb(xyz)
+    white = None
+    if out_cfg.white_balance is WhiteBalance.SUN:
+        white = colour_out.spectral_to_xyz(result.sun_irradiance[:, None, None], bins)[0, 0]
+    rgb = colour_out.xyz_to_linear_rgb(xyz, out_cfg.colourspace.value, white)
+    srgb = rgb
+    if out_cfg.colourspace is not Colourspace.SRGB:  # the PNG preview is always sRGB
+        srgb = colour_out.xyz_to_linear_rgb(xyz, "sRGB", white)
     stem = f"frame_{frame:04d}"
     paths = {"exr": out_dir / f"{stem}.exr", "png": out_dir / f"{stem}.png"}
-    write_exr(paths["exr"], rgb, image if result.scene.config.output.spectral_exr else None,
-              result.wavelengths_nm,
+    write_exr(paths["exr"], rgb, image if out_cfg.spectral_exr else None, result.wavelengths_nm,
               {"warpcaustics.quantity": "floor spectral irradiance",
                "warpcaustics.extent_m": f"{result.extent_m:g}",
-               "warpcaustics.time_s": f"{result.time_s:g}"})
-    write_png(paths["png"], colour_out.tone_map_srgb8(rgb, xyz[..., 1]))
+               "warpcaustics.time_s": f"{result.time_s:g}",
+               "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance "
+                                   f"{out_cfg.white_balance.value}"})
+    write_png(paths["png"], colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
     return paths
 
 
