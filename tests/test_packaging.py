@@ -37,8 +37,21 @@ def test_kernels_import_as_subpackage():
 
 
 @pytest.mark.parametrize("config", sorted((ROOT / "configs").glob("*.toml")), ids=lambda p: p.name)
-def test_shipped_configs_render(config):
-    """Each file in configs/ validates and renders (at a reduced size) with flux conserved."""
+def test_shipped_configs_render(config, tmp_path):
+    """Each file in configs/ validates and renders (at a reduced size) with flux conserved; a study
+    file runs its study (at a reduced size)."""
+    if "scene" in tomllib.loads(config.read_text()):
+        import dataclasses
+
+        from warpcaustics.study import load_study, run_study
+
+        pytest.importorskip("matplotlib")
+        study = load_study(config)
+        small = dataclasses.replace(study, depths_m=study.depths_m[:2], overrides={
+            "water.resolution": 32, "caustics.map_resolution": 32, "optics.wavelengths.bins": 4})
+        paths = run_study(small, tmp_path, device="cpu")
+        assert all(p.exists() for p in paths.values())
+        return
     overrides = {"caustics.map_resolution": 64, "optics.wavelengths.bins": 4}
     if wc.load_scene(config).config.water.model.value != "heightfield":
         overrides["water.resolution"] = 32

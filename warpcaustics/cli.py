@@ -35,6 +35,13 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--fps", type=float, default=30.0, metavar="F",
                    help="frames per second of an animation (default 30)")
 
+    st = sub.add_parser("study", help="water-type study: irradiance, contrast and colour vs depth",
+                        description="Render a base scene for each water type × depth × sun elevation "
+                                    "of a study TOML; write study.csv, kd.csv and a plot into DIR.")
+    st.add_argument("study", metavar="STUDY", help="study TOML, e.g. configs/study.toml")
+    st.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    st.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+
     sub.add_parser("info", help="versions and the devices Warp sees",
                    description="Print package versions and the compute devices Warp can use.")
     return p
@@ -81,6 +88,18 @@ def _render(args: argparse.Namespace) -> int:
     return 0
 
 
+def _study(args: argparse.Namespace) -> int:
+    from warpcaustics.study import load_study, run_study
+
+    study = load_study(args.study)
+    t0 = time.perf_counter()
+    paths = run_study(study, Path(args.out), device=args.device)
+    count = len(study.water_types) * len(study.depths_m) * len(study.sun_elevations_deg)
+    print(f"{count} renders in {time.perf_counter() - t0:.1f} s; wrote "
+          + ", ".join(str(p) for p in paths.values()))
+    return 0
+
+
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
     from warpcaustics.output import versions
@@ -107,6 +126,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "render":
             return _render(args)
+        if args.command == "study":
+            return _study(args)
         return _info()
     except WarpcausticsError as exc:
         print(f"warpcaustics: error: {exc}", file=sys.stderr)
