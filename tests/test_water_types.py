@@ -133,3 +133,22 @@ def test_more_chlorophyll_darkens_the_floor():
     clear = wc.render(wc.load_scene(None, {**base, "optics.chlorophyll_mg_m3": 0.05}), device="cpu")
     green = wc.render(wc.load_scene(None, {**base, "optics.chlorophyll_mg_m3": 5.0}), device="cpu")
     assert np.all(green.floor_irradiance.mean(axis=(1, 2)) < clear.floor_irradiance.mean(axis=(1, 2)))
+
+
+def test_shipped_data_are_the_shared_files_and_load_unchanged():
+    """Every CSV shipped in warpcaustics/data is byte-identical to its source in shared/data (where
+    the provenance is written), and the loaders return the CSV's own numbers."""
+    data = Path(spectra.DATA_DIR)
+    if not SHARED.exists():
+        pytest.skip("shared/data not beside this checkout")
+    shipped = sorted(data.glob("*.csv"))
+    assert len(shipped) >= 6
+    for path in shipped:
+        assert path.read_bytes() == (SHARED / path.name).read_bytes(), path.name
+    rows = list(csv.DictReader((SHARED / "aw_pope_fry_1997.csv").open()))
+    wl, a = spectra.pure_absorption_table()
+    np.testing.assert_array_equal(wl, [float(r["wavelength_nm"]) for r in rows])
+    np.testing.assert_array_equal(a, [float(r["a_w_per_m"]) for r in rows])
+    rows = list(csv.DictReader((SHARED / "solar_astm_g173_03.csv").open()))
+    wl, e = spectra.sun_table()
+    np.testing.assert_array_equal(e, [float(r["E_direct_circumsolar_W_m2_nm"]) for r in rows])
