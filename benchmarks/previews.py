@@ -17,11 +17,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _preview(result) -> np.ndarray:
     from warpcaustics import colour_out
-    from warpcaustics.spectra import SpectralBins
 
-    edges = np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
-                            result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2])
-    xyz = colour_out.spectral_to_xyz(result.floor_irradiance[:, ::-1, :], SpectralBins(edges))
+    xyz = colour_out.spectral_to_xyz(result.floor_irradiance[:, ::-1, :], result.bins)
     return colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1])
 
 

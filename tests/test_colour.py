@@ -27,24 +27,30 @@ def test_equal_energy_spectrum_gives_illuminant_e():
 
 
 def test_explicit_and_rgb_wavelengths():
-    """optics.wavelengths as a list of centres gives bins reaching half-way to the neighbours (outer
-    bins symmetric); "rgb" is three equal bins over 400–700 nm; D65 through them stays within 5 % of
-    white (the documented price of three bins)."""
+    """optics.wavelengths as a list samples exactly those wavelengths (the thesis's a(550) comes out
+    as published), with widths reaching half-way to the neighbours for integrals; "rgb" is three equal
+    bins over 400–700 nm; D65 through them stays within 5 % of white (the price of three bins)."""
     import warpcaustics as wc
     from warpcaustics import spectra
 
-    scene = wc.load_scene(None, {"optics.wavelengths": [420.0, 500.0, 600.0]})
+    scene = wc.load_scene(None, {"optics.wavelengths": [450.0, 550.0, 700.0],
+                                 "optics.water_type": "clear_ocean"})
     bins = spectra.bins_for(scene.config.optics)
-    np.testing.assert_allclose(bins.edges_nm, [380.0, 460.0, 550.0, 650.0])
-    np.testing.assert_allclose(bins.centres_nm[1:], [505.0, 600.0])  # bin centres, not the listed ones
+    np.testing.assert_allclose(bins.centres_nm, [450.0, 550.0, 700.0])
+    np.testing.assert_allclose(bins.widths_nm, [100.0, 125.0, 150.0])
+    optics = spectra.water_optics(scene.config.optics, bins)
+    np.testing.assert_allclose(optics.absorption_per_m[:2], [0.0150, 0.0638], rtol=1e-12)
+    np.testing.assert_allclose(optics.scattering_per_m[:2], [0.039, 0.035], rtol=1e-12)
     rgb = spectra.bins_for(wc.load_scene(None, {"optics.wavelengths": "rgb"}).config.optics)
     np.testing.assert_allclose(rgb.edges_nm, [400.0, 500.0, 600.0, 700.0])
     d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
     d65_bins = rgb.average(d65.wavelengths, d65.values, "D65")
     xyz = colour_out.spectral_to_xyz(d65_bins[:, None, None], rgb)[0, 0]
     np.testing.assert_allclose(colour_out.xyz_to_linear_srgb(xyz) / xyz[1], 1.0, atol=0.05)
-    with pytest.raises(wc.WarpcausticsError, match="strictly increasing"):
-        wc.load_scene(None, {"optics.wavelengths": [600.0, 500.0]})
+    for bad, message in (([600.0, 500.0], "strictly increasing"), ([], "at least one"),
+                         ([355.0, 365.0], "out of range")):
+        with pytest.raises(wc.WarpcausticsError, match=message):
+            wc.load_scene(None, {"optics.wavelengths": bad, "optics.water_type": "none"})
 
 
 def test_acescg_white_and_sun_white_balance():

@@ -218,11 +218,11 @@ class WavelengthConfig:
     """Upper edge of the last bin [nm]."""
     bins: int = field(default=16, metadata=_range(1, 400))
     """Number K of equal bins; values are bin averages per nm."""
-    list_nm: tuple[float, ...] = field(default=(), metadata=_range(300.0, 1000.0))
-    """Explicit bin centres [nm], strictly increasing, instead of equal bins: each bin reaches
-    half-way to its neighbours (the outer bins are symmetric about their centres). In TOML write
-    ``optics.wavelengths = [450.0, 550.0, 650.0]``; ``optics.wavelengths = "rgb"`` means three
-    equal bins over 400–700 nm."""
+    list_nm: tuple[float, ...] = field(default=(), metadata=_range(380.0, 780.0))
+    """Listed wavelengths [nm], strictly increasing, sampled exactly (point values, not bin
+    averages); for integrals each reaches half-way to its neighbours (the outer ones symmetric).
+    Overrides min_nm/max_nm/bins. In TOML write ``optics.wavelengths = [450.0, 550.0, 650.0]``;
+    ``optics.wavelengths = "rgb"`` means three equal bins over 400–700 nm."""
 
 
 @dataclass(frozen=True)
@@ -491,6 +491,8 @@ def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Co
         wavelengths = optics.get("wavelengths")
         # Shorthands: a list of centres, or "rgb" (three equal bins over 400-700 nm).
         if isinstance(wavelengths, list):
+            if not wavelengths:
+                raise ConfigError("optics.wavelengths = [] needs at least one wavelength [nm]")
             optics["wavelengths"] = {"list_nm": wavelengths}
         elif wavelengths == "rgb":
             optics["wavelengths"] = {"min_nm": 400.0, "max_nm": 700.0, "bins": 3}

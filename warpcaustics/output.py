@@ -19,7 +19,6 @@ import numpy as np
 
 from warpcaustics import __version__
 from warpcaustics.config import Colourspace, WhiteBalance, config_to_dict
-from warpcaustics.spectra import SpectralBins
 
 EMISSIVE_UNITS = "W.m^-2.nm^-1"
 
@@ -99,8 +98,7 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     from warpcaustics import colour_out
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    bins = SpectralBins(np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
-                                        result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2]))
+    bins = result.bins
     out_cfg = result.scene.config.output
     image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
     xyz = colour_out.spectral_to_xyz(image, bins)

@@ -45,6 +45,8 @@ class RenderResult:
     """(N, N, 3) water surface vertices [m]."""
     surface_normals: np.ndarray
     """(N, N, 3) unit surface normals."""
+    bins: spectra.SpectralBins | None = None
+    """The spectral bins (edges, and the listed wavelengths when point-sampled)."""
     fold_fraction: float = 0.0
     """Fraction of surface vertices where choppy displacement folds the surface (Jacobian ≤ 0)."""
     timings_s: dict[str, float] = field(default_factory=dict)
@@ -169,7 +171,7 @@ class Renderer:
             bin_widths_nm=self.bins.widths_nm, floor_irradiance=floor_np,
             attenuation_per_m=self.attenuation_per_m, ior=self.ior,
             sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
-            surface_positions=positions, surface_normals=normals, fold_fraction=folds,
+            surface_positions=positions, surface_normals=normals, bins=self.bins, fold_fraction=folds,
             timings_s=watch.timings)
 
 

@@ -55,9 +55,11 @@ def _check_spectral_data(cfg: Config, base_dir: Path) -> None:
     """Fail at load time, not at render time, when the bins leave the optical data's range or
     the sun's spectrum cannot be read."""
     from warpcaustics import spectra
+    from warpcaustics.colour_out import bin_cmfs
 
     bins = spectra.bins_for(cfg.optics)
     spectra.sun_irradiance(bins, cfg.sun, base_dir)
+    bin_cmfs(bins)  # the colour-matching functions must cover the bins too
     spectra.water_optics(cfg.optics, bins)
 
 

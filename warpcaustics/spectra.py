@@ -57,40 +57,64 @@ def pure_scattering_table() -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class SpectralBins:
-    """K equal wavelength bins."""
+    """K wavelength bins: equal bins whose values are bin averages, or listed wavelengths whose
+    values are point samples (their bins only give the widths Δλ used in integrals)."""
 
     edges_nm: np.ndarray
     """(K+1,) bin edges [nm]."""
+    samples_nm: np.ndarray | None = None
+    """(K,) listed wavelengths [nm] for point sampling; None for bin averages."""
 
     @classmethod
     def uniform(cls, min_nm: float, max_nm: float, bins: int) -> SpectralBins:
         return cls(np.linspace(min_nm, max_nm, bins + 1))
 
     @classmethod
-    def around(cls, centres_nm: np.ndarray) -> SpectralBins:
-        """Bins around given centres: inner edges half-way between neighbours, outer bins symmetric
-        about their centres (one centre alone gets a 10 nm bin)."""
-        c = np.asarray(centres_nm, dtype=np.float64)
+    def at(cls, wavelengths_nm: np.ndarray) -> SpectralBins:
+        """Point samples at listed wavelengths; each bin (for Δλ) reaches half-way to its neighbours,
+        the outer bins are symmetric about their wavelengths (a single wavelength gets 10 nm)."""
+        c = np.asarray(wavelengths_nm, dtype=np.float64)
         if len(c) == 1:
-            return cls(np.array([c[0] - 5.0, c[0] + 5.0]))
+            return cls(np.array([c[0] - 5.0, c[0] + 5.0]), c)
         inner = 0.5 * (c[1:] + c[:-1])
-        return cls(np.concatenate([[2 * c[0] - inner[0]], inner, [2 * c[-1] - inner[-1]]]))
+        return cls(np.concatenate([[2 * c[0] - inner[0]], inner, [2 * c[-1] - inner[-1]]]), c)
 
     @property
     def centres_nm(self) -> np.ndarray:
+        """The wavelengths the values belong to: listed wavelengths, or the bin centres."""
+        if self.samples_nm is not None:
+            return self.samples_nm
         return 0.5 * (self.edges_nm[1:] + self.edges_nm[:-1])
 
     @property
     def widths_nm(self) -> np.ndarray:
         return np.diff(self.edges_nm)
 
-    def average(self, wavelength_nm: np.ndarray, values: np.ndarray, what: str) -> np.ndarray:
-        """Average of the linear interpolant of a table over each bin."""
-        lo, hi = self.edges_nm[0], self.edges_nm[-1]
-        if lo < wavelength_nm[0] or hi > wavelength_nm[-1]:
+    @property
+    def span_nm(self) -> tuple[float, float]:
+        """Wavelengths a table must cover: the bin edges, or the listed wavelengths."""
+        if self.samples_nm is not None:
+            return float(self.samples_nm[0]), float(self.samples_nm[-1])
+        return float(self.edges_nm[0]), float(self.edges_nm[-1])
+
+    def fine_grid(self) -> np.ndarray:
+        """A 0.1 nm grid over the span (endpoints exact), for sampling functions of λ."""
+        lo, hi = self.span_nm
+        return np.linspace(lo, hi, max(2, int(round((hi - lo) * 10)) + 1))
+
+    def check_covered(self, lo_nm: float, hi_nm: float, what: str) -> None:
+        lo, hi = self.span_nm
+        if lo < lo_nm or hi > hi_nm:
             raise ConfigError(
                 f"optics.wavelengths = {lo:g}..{hi:g} nm lies outside the {what} data "
-                f"({wavelength_nm[0]:g}..{wavelength_nm[-1]:g} nm); narrow optics.wavelengths")
+                f"({lo_nm:g}..{hi_nm:g} nm); narrow optics.wavelengths")
+
+    def average(self, wavelength_nm: np.ndarray, values: np.ndarray, what: str) -> np.ndarray:
+        """Per bin: the average of the table's linear interpolant over the bin, or its value at the
+        listed wavelength."""
+        self.check_covered(wavelength_nm[0], wavelength_nm[-1], what)
+        if self.samples_nm is not None:
+            return np.interp(self.samples_nm, wavelength_nm, values)
         out = np.empty(len(self.edges_nm) - 1)
         for k, (a, b) in enumerate(zip(self.edges_nm[:-1], self.edges_nm[1:])):
             n = max(2, int(np.ceil((b - a) * _SAMPLES_PER_NM)))
@@ -116,7 +140,7 @@ def bins_for(optics: OpticsConfig) -> SpectralBins:
     """The render's bins: K equal bins, or bins around an explicit list of centres."""
     w = optics.wavelengths
     if w.list_nm:
-        return SpectralBins.around(np.array(w.list_nm, dtype=np.float64))
+        return SpectralBins.at(np.array(w.list_nm, dtype=np.float64))
     return SpectralBins.uniform(w.min_nm, w.max_nm, w.bins)
 
 
@@ -141,7 +165,7 @@ def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
     elif sun.spectrum is SunSpectrum.BLACKBODY:
         from warpcaustics.colour_out import _colour
 
-        fine = np.linspace(bins.edges_nm[0], bins.edges_nm[-1], int(round(np.ptp(bins.edges_nm) * 10)) + 1)
+        fine = bins.fine_grid()
         planck = _colour().colorimetry.planck_law(fine * 1e-9, sun.temperature_k)
         shape = bins.average(fine, planck, what="Planck")
     else:
@@ -280,8 +304,8 @@ def water_optics(optics: OpticsConfig, bins: SpectralBins) -> WaterOptics:
         a = bins.average(*pure_absorption_table(), what="Pope & Fry 1997 absorption")
         b = bins.average(*pure_scattering_table(), what="Zhang 2009 scattering")
         return WaterOptics(a, b)
-    lo_nm, hi_nm = bins.edges_nm[0], bins.edges_nm[-1]
-    fine = np.linspace(lo_nm, hi_nm, int(round((hi_nm - lo_nm) * 10)) + 1)  # endpoints exact
+    lo_nm, hi_nm = bins.span_nm
+    fine = bins.fine_grid()
     if water_type is WaterType.BIO_OPTICAL:
         if lo_nm < 400.0 or hi_nm > 700.0:
             raise ConfigError(f"optics.wavelengths = {lo_nm:g}..{hi_nm:g} nm lies outside the Bricaud "
@@ -290,15 +314,13 @@ def water_optics(optics: OpticsConfig, bins: SpectralBins) -> WaterOptics:
                                         optics.cdom_slope_per_nm, fine)
         return WaterOptics(bins.average(fine, a, "bio-optical"), bins.average(fine, b, "bio-optical"))
     if water_type in THESIS_SCATTERING_PER_M:
+        pf_lam = pure_absorption_table()[0]
+        bins.check_covered(pf_lam[0], pf_lam[-1], "Pope & Fry 1997 absorption (the thesis types' shape)")
         a, b = thesis_coefficients(water_type, fine)
         return WaterOptics(bins.average(fine, a, "thesis"), bins.average(fine, b, "thesis"))
     water = jerlov_water(water_type, jerlov_source)
     jerlov_source = water.source.key
-    lo, hi = water.range_nm
-    if bins.edges_nm[0] < lo or bins.edges_nm[-1] > hi:
-        raise ConfigError(f"optics.wavelengths = {bins.edges_nm[0]:g}..{bins.edges_nm[-1]:g} nm lies "
-                          f"outside the {jerlov_source} data for {water_type.value} ({lo:g}..{hi:g} nm); "
-                          f"narrow optics.wavelengths")
+    bins.check_covered(*water.range_nm, f"{jerlov_source} {water_type.value}")
     with warnings.catch_warnings():
         # The package warns where its values are interpolated or extrapolated; docs/physics.md
         # lists those caveats per source.

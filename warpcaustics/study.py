@@ -67,7 +67,6 @@ def floor_colour_hex(spectrum: np.ndarray, bins) -> str:
 def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> dict[str, Path]:
     """Render every combination; write study.csv, kd.csv and the plot. Returns the paths."""
     import warpcaustics as wc
-    from warpcaustics.spectra import SpectralBins
 
     rows, spectra_by = [], {}
     for water_type, elevation, depth in itertools.product(study.water_types, study.sun_elevations_deg,
@@ -75,8 +74,7 @@ def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> d
         scene = wc.load_scene(study.scene, {**study.overrides, "optics.water_type": water_type,
                                             "floor.depth_m": depth, "sun.elevation_deg": elevation})
         result = wc.render(scene, device=device)
-        bins = SpectralBins(np.concatenate([result.wavelengths_nm - result.bin_widths_nm / 2,
-                                            result.wavelengths_nm[-1:] + result.bin_widths_nm[-1:] / 2]))
+        bins = result.bins
         mean = result.floor_irradiance.mean(axis=(1, 2), dtype=np.float64)
         broadband = np.tensordot(result.bin_widths_nm, result.floor_irradiance.astype(np.float64), axes=1)
         spectra_by[(water_type, elevation, depth)] = (mean, result)
