@@ -16,15 +16,16 @@ def henyey_greenstein(cos_theta: float, g: float) -> float:
 
 @wp.func
 def tabulated_phase(angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.float32],
-                    cos_theta: float) -> float:
-    """Phase function [1/sr] from a table: ln p linear in θ between nodes, clamped at the ends.
+                    cone_phase: float, cos_theta: float) -> float:
+    """Phase function [1/sr] from a table: ln p linear in θ between nodes; ``cone_phase`` inside
+    the forward cone below the first node.
 
     Taking cos θ in float32 limits θ to ~0.02° near the forward direction (cos θ = 1 − θ²/2).
     """
     theta = wp.acos(wp.clamp(cos_theta, -1.0, 1.0))
     count = angles_rad.shape[0]
-    if theta <= angles_rad[0]:
-        return wp.exp(log_phase[0])
+    if theta < angles_rad[0]:
+        return cone_phase
     for i in range(1, count):
         if theta <= angles_rad[i]:
             t = (theta - angles_rad[i - 1]) / (angles_rad[i] - angles_rad[i - 1])
@@ -34,11 +35,11 @@ def tabulated_phase(angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.flo
 
 @wp.kernel
 def evaluate_phase(cos_theta: wp.array[wp.float32], kind: int, g: float,
-                   angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.float32],
+                   angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.float32], cone_phase: float,
                    out: wp.array[wp.float32]):
     """out[i] = p(cos θ_i): kind 0 = Henyey–Greenstein(g), 1 = the table."""
     i = wp.tid()
     if kind == 0:
         out[i] = henyey_greenstein(cos_theta[i], g)
     else:
-        out[i] = tabulated_phase(angles_rad, log_phase, cos_theta[i])
+        out[i] = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta[i])

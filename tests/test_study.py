@@ -1,6 +1,7 @@
 """The water-type study: its tables, and its effective attenuation against Beer–Lambert."""
 
 import csv
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -42,3 +43,36 @@ def test_bad_study_file_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'muddy' is not a water type" in err[0]
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(("body", "needle"), [
+    ("water_types = []\ndepths_m = [1.0, 2.0]\nsun_elevations_deg = [60.0]\n", "non-empty list of names"),
+    ("water_types = 'jerlov_I'\ndepths_m = [1.0, 2.0]\nsun_elevations_deg = [60.0]\n", "list of names"),
+    ("water_types = ['none']\ndepths_m = [1, 'x']\nsun_elevations_deg = [60.0]\n", "list of numbers"),
+    ("water_types = ['none']\ndepths_m = [1.0, 2.0]\nsun_elevations_deg = [true]\n", "list of numbers"),
+    ("water_types = ['none']\ndepths_m = [1.0, 2.0]\nsun_elevations_deg = [60.0]\noverrides = 3\n", "table"),
+])
+def test_study_input_errors_are_one_line(tmp_path, capsys, body, needle):
+    """Malformed study files stop before any render, with one line naming the key."""
+    study = tmp_path / "study.toml"
+    study.write_text("scene = 'x.toml'\n" + body)
+    assert main(["study", str(study), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err
+    assert not (tmp_path / "out").exists()
+
+
+def test_nested_overrides_set_keys_not_sections(tmp_path):
+    """[overrides.water] resolution = 32 changes one key and keeps the scene's other water keys."""
+    import warpcaustics as wc
+    from warpcaustics.study import load_study
+
+    root = Path(__file__).resolve().parents[1]
+    study = tmp_path / "study.toml"
+    study.write_text(f"scene = '{root / 'configs' / 'ocean.toml'}'\nwater_types = ['none']\n"
+                     "depths_m = [1.0, 2.0]\nsun_elevations_deg = [60.0]\n"
+                     "[overrides.water]\nresolution = 32\n")
+    loaded = load_study(study)
+    assert loaded.overrides == {"water.resolution": 32}
+    scene = wc.load_scene(loaded.scene, loaded.overrides)
+    assert scene.config.water.resolution == 32 and scene.config.water.seed == 7  # the rest is kept

@@ -67,3 +67,13 @@ def test_floor_scales_with_the_sun():
     one = wc.render(wc.load_scene(None, {**base, "sun.irradiance_w_m2": 300.0}), device="cpu")
     two = wc.render(wc.load_scene(None, {**base, "sun.irradiance_w_m2": 600.0}), device="cpu")
     np.testing.assert_allclose(two.floor_irradiance, 2.0 * one.floor_irradiance, rtol=1e-6)
+
+
+def test_d65_sun_has_the_d65_shape():
+    """The d65 sun is colour-science's CIE D65 averaged over each bin, up to the overall scale."""
+    from warpcaustics.colour_out import _colour
+
+    d65 = _colour().SDS_ILLUMINANTS["D65"]
+    ours = spectra.sun_irradiance(BINS, _sun(spectrum="d65"))
+    reference = BINS.average(d65.wavelengths, d65.values, "D65")
+    np.testing.assert_allclose(ours / reference, (ours / reference).mean(), rtol=1e-12)

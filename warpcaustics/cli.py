@@ -92,6 +92,9 @@ def _study(args: argparse.Namespace) -> int:
     from warpcaustics.study import load_study, run_study
 
     study = load_study(args.study)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     t0 = time.perf_counter()
     paths = run_study(study, Path(args.out), device=args.device)
     count = len(study.water_types) * len(study.depths_m) * len(study.sun_elevations_deg)

@@ -182,7 +182,9 @@ def _read_spectrum_csv(name: str, base_dir: Path | None) -> tuple[np.ndarray, np
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an empty file: numpy warns, then we say it in one line
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (OSError, ValueError) as exc:
         raise ConfigError(f"sun.file = {str(path)!r} cannot be read as CSV (header line, then "
                           f"wavelength_nm,irradiance): {exc}") from None
@@ -278,7 +280,8 @@ def bio_optical_coefficients(chlorophyll_mg_m3: float, cdom_440_per_m: float, cd
     a = a_w (Pope & Fry 1997) + A_p(λ)·Chl^E_p(λ) (particles, Bricaud et al. 1998)
         + a_CDOM(440)·exp(−S(λ − 440));
     b = b_w (Zhang et al. 2009, seawater) + b_p, with b_p(550) = 0.416·Chl^0.766 (Morel & Maritorena
-    2001). The sourced data give no spectral shape for b_p, so it is held at its 550 nm value.
+    2001). The sourced data give no spectral shape for b_p itself (their exponent ν belongs to the
+    backscattering ratio), so b_p is held at its 550 nm value.
     """
     lam = np.asarray(wavelength_nm, dtype=np.float64)
     wl, a_p, e_p = bricaud_1998_table()

@@ -31,6 +31,26 @@ class StudyConfig:
     overrides: dict
 
 
+def _numbers(key: str, value, *, positive: bool = False) -> tuple[float, ...]:
+    if not isinstance(value, list) or not value or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+        raise ConfigError(f"study key {key} = {value!r} must be a non-empty list of numbers")
+    if positive and any(v <= 0 for v in value):
+        raise ConfigError(f"study key {key} = {value!r} must hold positive numbers")
+    return tuple(float(v) for v in value)
+
+
+def _flatten(table: dict, prefix: str = "") -> dict:
+    """Nested override tables → dotted keys, so ``[overrides.water]`` sets keys, not the section."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
 def load_study(path: str | Path) -> StudyConfig:
     """Read a study TOML; errors are one line naming the key."""
     path = Path(path)
@@ -41,16 +61,26 @@ def load_study(path: str | Path) -> StudyConfig:
     for key in ("scene", "water_types", "depths_m", "sun_elevations_deg"):
         if key not in table:
             raise ConfigError(f"study key {key!r} is missing in {str(path)!r}")
+    if not isinstance(table["scene"], str):
+        raise ConfigError(f"study key scene = {table['scene']!r} must be the path of a scene TOML")
+    water_types = table["water_types"]
+    if not (isinstance(water_types, list) and water_types and all(isinstance(t, str) for t in water_types)):
+        raise ConfigError(f"study key water_types = {water_types!r} must be a non-empty list of names")
     allowed = {t.value for t in WaterType}
-    for t in table["water_types"]:
+    for t in water_types:
         if t not in allowed:
             raise ConfigError(f"water_types: {t!r} is not a water type; allowed: "
                               f"{', '.join(sorted(allowed))}")
-    depths = tuple(float(d) for d in table["depths_m"])
-    if len(depths) < 2 or any(d <= 0 for d in depths):
-        raise ConfigError("depths_m needs at least two positive depths (the attenuation is fitted over them)")
-    return StudyConfig(path.parent / table["scene"], tuple(table["water_types"]), depths,
-                       tuple(float(e) for e in table["sun_elevations_deg"]), dict(table.get("overrides", {})))
+    depths = _numbers("depths_m", table["depths_m"], positive=True)
+    if len(depths) < 2:
+        raise ConfigError("study key depths_m needs at least two depths (the attenuation is fitted "
+                          "over them)")
+    elevations = _numbers("sun_elevations_deg", table["sun_elevations_deg"], positive=True)
+    overrides = table.get("overrides", {})
+    if not isinstance(overrides, dict):
+        raise ConfigError(f"study key overrides = {overrides!r} must be a table of scene keys")
+    return StudyConfig(path.parent / table["scene"], tuple(water_types), depths, elevations,
+                       _flatten(overrides))
 
 
 def floor_colour_hex(spectrum: np.ndarray, bins) -> str:
