@@ -58,3 +58,11 @@ def test_shipped_configs_render(config, tmp_path):
     result = wc.render(wc.load_scene(config, overrides), device="cpu")
     assert result.floor_irradiance.shape == (4, 64, 64)
     assert (result.floor_irradiance >= 0).all() and result.floor_flux_w_nm.min() > 0
+
+
+def test_every_config_key_is_documented():
+    """docs/config.md names every key of the configuration (drops' fields under `water.drops`)."""
+    from warpcaustics.config import all_keys
+
+    doc = (ROOT / "docs" / "config.md").read_text()
+    assert [k for k in all_keys() if f"`{k.split('[]')[0]}" not in doc] == []
