@@ -48,10 +48,6 @@ def _init_filtering_stderr(wp) -> None:
     sys.stderr.flush()
 
 
-def cuda_available() -> bool:
-    return _warp().get_cuda_device_count() > 0
-
-
 def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
     """Pick a Warp device name from (in order) the argument, ``$WARPCAUSTICS_DEVICE``, the config.
 
