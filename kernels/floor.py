@@ -50,6 +50,13 @@ def quad_corner(qx: int, qy: int, half: int, corner: int, n: int, extent_m: floa
             dx = 1
         if corner >= 1:
             dy = 1
+    return grid_corner(qx, qy, dx, dy, n, extent_m, periodic)
+
+
+@wp.func
+def grid_corner(qx: int, qy: int, dx: int, dy: int, n: int, extent_m: float, periodic: int):
+    """Grid index of corner (dx, dy) ∈ {0, 1}² of quad (qx, qy) and the shift [m] to add to that
+    vertex (the periodic wrap or the wall offset described in :func:`quad_corner`)."""
     shift = wp.vec2(0.0)
     if periodic != 0:
         cx = qx + dx

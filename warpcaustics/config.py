@@ -93,6 +93,19 @@ class JerlovSource(str, enum.Enum):
 
 class CausticsMethod(str, enum.Enum):
     FLUXRATIO = "fluxratio"
+    PHOTONS = "photons"
+
+
+class Intersection(str, enum.Enum):
+    NEWTON = "newton"
+    EXACT = "exact"
+
+
+class FloorShape(str, enum.Enum):
+    FLAT = "flat"
+    SLOPE = "slope"
+    RIPPLES = "ripples"
+    FILE = "file"
 
 
 class DeviceChoice(str, enum.Enum):
@@ -103,7 +116,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("photons", "beams", "both", "sunmap", "eikonal", "wave3d"),
+    "caustics.method": ("beams", "both", "sunmap", "eikonal", "wave3d"),
     "water.model": ("procedural",),
 }
 
@@ -188,7 +201,26 @@ class WaterConfig:
 @dataclass(frozen=True)
 class FloorConfig:
     depth_m: float = field(default=4.0, metadata=_range(0.0, None, lo_open=True))
-    """Depth of the flat floor below the water at rest (floor at z = -depth_m) [m]."""
+    """Depth of the floor below the water at rest at the origin (floor at z = -depth_m + relief) [m]."""
+    shape: FloorShape = FloorShape.FLAT
+    """Relief of the floor: ``flat``, ``slope`` (a plane), ``ripples`` (sand ripples, a sine) or
+    ``file`` (``floor.file``); anything but ``flat`` needs ``caustics.method = "photons"``."""
+    slope_deg: float = field(default=5.0, metadata=_range(0.0, 60.0))
+    """Inclination of the ``slope`` [deg]."""
+    slope_azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Direction in which the ``slope`` descends (gets deeper), from +x towards +y [deg]."""
+    ripple_amplitude_m: float = field(default=0.03, metadata=_range(0.0, None))
+    """Half the crest-to-trough height of the ``ripples`` [m]."""
+    ripple_wavelength_m: float = field(default=0.5, metadata=_range(0.0, None, lo_open=True))
+    """Crest-to-crest distance of the ``ripples`` [m]."""
+    ripple_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Direction across the ripple crests, from +x towards +y [deg]."""
+    file: str | None = None
+    """``.npy`` 2-D square float array of floor relief [m] (added to z = -depth_m), ``h[iy, ix]`` at
+    cell centres over the water extent; relative paths start at the config file's folder."""
+    albedo: tuple[float, ...] = field(default=(0.6, 0.55, 0.45), metadata=_range(0.0, 1.0))
+    """Diffuse albedo of the floor: one value (grey) or three (linear sRGB, turned into a
+    reflectance spectrum by Mallett & Yuksel 2019 through colour-science) [-]."""
 
 
 @dataclass(frozen=True)
@@ -265,9 +297,54 @@ class OpticsConfig:
 @dataclass(frozen=True)
 class CausticsConfig:
     method: CausticsMethod = CausticsMethod.FLUXRATIO
-    """Caustics method: ``fluxratio`` (refracted triangle footprints on the floor)."""
+    """Caustics method: ``fluxratio`` (refracted triangle footprints on a flat floor) or
+    ``photons`` (photon splatting onto every receiver, Shah et al. 2007)."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
+    intersection: Intersection = Intersection.EXACT
+    """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
+    ``newton`` (Shah's iteration on a receiver-position buffer rendered from the sun)."""
+    photon_subdivisions: int = field(default=4, metadata=_range(1, 64))
+    """s: photons per surface cell are s×s [-]."""
+    newton_iterations: int = field(default=3, metadata=_range(0, 64))
+    """Iterations k of the ``newton`` intersection [-]."""
+    newton_buffer_resolution: int = field(default=1024, metadata=_range(16, 16384))
+    """Texels per side of the ``newton`` receiver-position buffer seen from the sun [-]."""
+    shafts: bool = True
+    """Add photon light shafts (single scattering along each photon's path) to the camera image."""
+
+
+@dataclass(frozen=True)
+class ReceiverConfig:
+    mesh: str = "sphere"
+    """A triangle mesh: ``sphere``, ``cube``, ``cylinder`` or ``cone`` (pyvista's unit-size
+    primitives) or a file (OBJ, PLY, STL, VTK, VTP; relative to the config file's folder)."""
+    scale: tuple[float, ...] = field(default=(1.0,), metadata=_range(0.0, None, lo_open=True))
+    """Scale factor: one value or (sx, sy, sz) [-]; applied first."""
+    rotate_deg: tuple[float, ...] = field(default=(0.0, 0.0, 0.0), metadata=_range(-360.0, 360.0))
+    """Rotations about x, then y, then z [deg]; applied after scaling."""
+    translate_m: tuple[float, ...] = (0.0, 0.0, -2.0)
+    """Translation (x, y, z) [m]; applied last."""
+    albedo: tuple[float, ...] = field(default=(0.7, 0.7, 0.7), metadata=_range(0.0, 1.0))
+    """Diffuse albedo: one value (grey) or three (linear sRGB, as for the floor) [-]."""
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    enabled: bool = False
+    """Render a camera image (needs ``caustics.method = "photons"``); the camera is under water."""
+    position_m: tuple[float, ...] = (0.0, -6.0, -1.0)
+    """Pinhole position (x, y, z) [m]; must be below the water surface."""
+    look_at_m: tuple[float, ...] = (0.0, 0.0, -3.0)
+    """Point the camera looks at (x, y, z) [m]."""
+    up: tuple[float, ...] = (0.0, 0.0, 1.0)
+    """Up direction of the image (x, y, z) [-]."""
+    fov_deg: float = field(default=60.0, metadata=_range(1.0, 170.0))
+    """Vertical field of view [deg]."""
+    width: int = field(default=320, metadata=_range(8, 8192))
+    """Image width [pixels]."""
+    height: int = field(default=240, metadata=_range(8, 8192))
+    """Image height [pixels]."""
 
 
 class Colourspace(str, enum.Enum):
@@ -305,6 +382,10 @@ class Config:
     """Water optics and spectral sampling."""
     caustics: CausticsConfig = field(default_factory=CausticsConfig)
     """Caustics method and map."""
+    receivers: tuple[ReceiverConfig, ...] = ()
+    """Meshes under the water that receive caustics: ``[[receivers]]`` tables (``photons`` only)."""
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    """A pinhole camera under the water (``photons`` only)."""
     output: OutputConfig = field(default_factory=OutputConfig)
     """What is written."""
     device: DeviceChoice = DeviceChoice.AUTO
@@ -374,6 +455,8 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
                               f"{', '.join(allowed)}")
         raise ConfigError(f"{key} = {_describe(value)} is not allowed; allowed: {', '.join(allowed)}")
     if typing.get_origin(tp) is tuple and typing.get_args(tp) == (float, Ellipsis):
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            value = [value]  # one number stands for a one-value list (a grey albedo, a uniform scale)
         if not isinstance(value, (list, tuple)) or not all(
                 isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
             raise ConfigError(f"{key} = {_describe(value)} must be a list of numbers")
@@ -452,10 +535,54 @@ def _check_consistency(cfg: Config) -> None:
     if cfg.sun.spectrum is SunSpectrum.FILE and not cfg.sun.file:
         raise ConfigError("sun.file is missing; sun.spectrum = 'file' needs a CSV of wavelength [nm], "
                           "irradiance (set sun.file = \"sun.csv\")")
+    _check_photon_scene(cfg)
     n = cfg.water.resolution
     if cfg.water.model is WaterModel.FFT and n is not None and (n & (n - 1)):
         raise ConfigError(f"water.resolution = {n} must be a power of two for water.model = 'fft' "
                           f"(e.g. {1 << max(2, round(math.log2(n)))})")
+
+
+def _check_vector(key: str, value: tuple[float, ...], lengths: tuple[int, ...]) -> None:
+    if len(value) not in lengths:
+        raise ConfigError(f"{key} = {list(value)} must have {' or '.join(map(str, lengths))} values")
+
+
+def _check_photon_scene(cfg: Config) -> None:
+    """Receivers other than a flat floor, and the camera, need the photon method."""
+    photons = cfg.caustics.method is CausticsMethod.PHOTONS
+    needs = []
+    if cfg.floor.shape is not FloorShape.FLAT:
+        needs.append(f"floor.shape = {cfg.floor.shape.value!r}")
+    if cfg.receivers:
+        needs.append("[[receivers]]")
+    if cfg.camera.enabled:
+        needs.append("camera.enabled = true")
+    if needs and not photons:
+        raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" (the method is "
+                          f"{cfg.caustics.method.value!r})")
+    if cfg.floor.shape is FloorShape.FILE and not cfg.floor.file:
+        raise ConfigError("floor.file is missing; floor.shape = 'file' needs a .npy file of floor relief "
+                          "(set floor.file = \"floor.npy\")")
+    if cfg.floor.shape is not FloorShape.FILE and cfg.floor.file:
+        raise ConfigError(f"floor.file = {cfg.floor.file!r} is only read by floor.shape = 'file'; remove "
+                          "it or set floor.shape = \"file\"")
+    _check_vector("floor.albedo", cfg.floor.albedo, (1, 3))
+    for i, r in enumerate(cfg.receivers):
+        _check_vector(f"receivers[{i}].scale", r.scale, (1, 3))
+        _check_vector(f"receivers[{i}].rotate_deg", r.rotate_deg, (3,))
+        _check_vector(f"receivers[{i}].translate_m", r.translate_m, (3,))
+        _check_vector(f"receivers[{i}].albedo", r.albedo, (1, 3))
+    cam = cfg.camera
+    for name in ("position_m", "look_at_m", "up"):
+        _check_vector(f"camera.{name}", getattr(cam, name), (3,))
+    view = [b - a for a, b in zip(cam.position_m, cam.look_at_m)]
+    if math.hypot(*view) == 0.0:
+        raise ConfigError("camera.look_at_m equals camera.position_m; look at another point")
+    up = cam.up
+    cross = (view[1] * up[2] - view[2] * up[1], view[2] * up[0] - view[0] * up[2],
+             view[0] * up[1] - view[1] * up[0])
+    if math.hypot(*cross) <= 1e-9 * math.hypot(*view) * max(math.hypot(*up), 1e-300):
+        raise ConfigError(f"camera.up = {list(up)} is parallel to the view direction; choose another up")
 
 
 def _set_dotted(table: dict, key: str, value: Any) -> None:

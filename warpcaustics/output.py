@@ -21,6 +21,7 @@ from warpcaustics import __version__
 from warpcaustics.config import Colourspace, WhiteBalance, config_to_dict
 
 EMISSIVE_UNITS = "W.m^-2.nm^-1"
+RADIANCE_UNITS = "W.m^-2.sr^-1.nm^-1"
 
 
 @contextmanager
@@ -41,7 +42,7 @@ def spectral_channel_name(wavelength_nm: float) -> str:
 
 
 def write_exr(path: Path, rgb: np.ndarray, spectral: np.ndarray | None, wavelengths_nm: np.ndarray,
-              extra_header: dict[str, str]) -> None:
+              extra_header: dict[str, str], units: str = EMISSIVE_UNITS) -> None:
     import OpenEXR
 
     channels = {name: np.ascontiguousarray(rgb[..., i], dtype=np.float32) for i, name in enumerate("RGB")}
@@ -50,7 +51,7 @@ def write_exr(path: Path, rgb: np.ndarray, spectral: np.ndarray | None, waveleng
         for k, wl in enumerate(wavelengths_nm):
             channels[spectral_channel_name(wl)] = np.ascontiguousarray(spectral[k], dtype=np.float32)
         header["spectralLayoutVersion"] = "1.0"
-        header["emissiveUnits"] = EMISSIVE_UNITS
+        header["emissiveUnits"] = units
     header.update(extra_header)
     with atomic_path(path) as tmp, OpenEXR.File(header, channels) as exr:
         exr.write(str(tmp))
@@ -98,9 +99,28 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     from warpcaustics import colour_out
 
     out_dir.mkdir(parents=True, exist_ok=True)
+    image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
+    stem = f"frame_{frame:04d}"
+    paths = {"exr": out_dir / f"{stem}.exr", "png": out_dir / f"{stem}.png"}
+    _write_spectral_image(result, image, paths["exr"], paths["png"], {
+        "warpcaustics.quantity": "floor spectral irradiance",
+        "warpcaustics.extent_m": f"{result.extent_m:g}"}, EMISSIVE_UNITS)
+    if result.camera_radiance is not None:
+        stem = f"camera_{frame:04d}"
+        paths["camera_exr"] = out_dir / f"{stem}.exr"
+        paths["camera_png"] = out_dir / f"{stem}.png"
+        _write_spectral_image(result, result.camera_radiance, paths["camera_exr"], paths["camera_png"], {
+            "warpcaustics.quantity": "spectral radiance at the camera"}, RADIANCE_UNITS)
+    return paths
+
+
+def _write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, header: dict[str, str],
+                          units: str) -> None:
+    """(K, H, W) spectral image (row 0 at the top) → EXR (RGB + bands) and an sRGB PNG preview."""
+    from warpcaustics import colour_out
+
     bins = result.bins
     out_cfg = result.scene.config.output
-    image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
     xyz = colour_out.spectral_to_xyz(image, bins)
     white = None
     if out_cfg.white_balance is WhiteBalance.SUN:
@@ -109,16 +129,11 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     srgb = rgb
     if out_cfg.colourspace is not Colourspace.SRGB:  # the PNG preview is always sRGB
         srgb = colour_out.xyz_to_linear_rgb(xyz, "sRGB", white)
-    stem = f"frame_{frame:04d}"
-    paths = {"exr": out_dir / f"{stem}.exr", "png": out_dir / f"{stem}.png"}
-    write_exr(paths["exr"], rgb, image if out_cfg.spectral_exr else None, result.wavelengths_nm,
-              {"warpcaustics.quantity": "floor spectral irradiance",
-               "warpcaustics.extent_m": f"{result.extent_m:g}",
-               "warpcaustics.time_s": f"{result.time_s:g}",
-               "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance "
-                                   f"{out_cfg.white_balance.value}"})
-    write_png(paths["png"], colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
-    return paths
+    write_exr(exr, rgb, image if out_cfg.spectral_exr else None, result.wavelengths_nm, {
+        **header, "warpcaustics.time_s": f"{result.time_s:g}",
+        "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance {out_cfg.white_balance.value}"},
+        units=units)
+    write_png(png, colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
 
 
 def write_run_json(out_dir: Path, results: list) -> Path:
@@ -141,12 +156,14 @@ def write_run_json(out_dir: Path, results: list) -> Path:
         "frames": [{
             "frame": i,
             "time_s": r.time_s,
-            "files": [f"frame_{i:04d}.exr", f"frame_{i:04d}.png"],
+            "files": [f"frame_{i:04d}.exr", f"frame_{i:04d}.png"] + (
+                [f"camera_{i:04d}.exr", f"camera_{i:04d}.png"] if r.camera_radiance is not None else []),
             "timings_s": r.timings_s,
             "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
             "floor_flux_w_nm": r.floor_flux_w_nm,
             "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
             "fold_fraction": r.fold_fraction,
+            **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
         } for i, r in enumerate(results)],
     })
     return path

@@ -11,9 +11,13 @@ from pathlib import Path
 import numpy as np
 import warp as wp
 
-from warpcaustics import caustics, spectra
+from warpcaustics import caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.errors import WarpcausticsError
+from warpcaustics.camera import UnderwaterCamera, camera_bytes
+from warpcaustics.config import CausticsMethod
+from warpcaustics.phase import PhaseFunction
+from warpcaustics.receivers import Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
 from warpcaustics.water import make_water, water_bytes
@@ -40,7 +44,8 @@ class RenderResult:
     sun_irradiance: np.ndarray
     """(K,) solar spectral irradiance on a plane perpendicular to the beam [W m^-2 nm^-1]."""
     transmitted_flux_w_nm: np.ndarray
-    """(K,) flux that enters the water and heads for the floor (after attenuation) [W nm^-1]."""
+    """(K,) flux that enters the water [W nm^-1]: ``fluxratio`` counts it after attenuation on the
+    way to the floor, ``photons`` at the surface (before attenuation)."""
     surface_positions: np.ndarray
     """(N, N, 3) water surface vertices [m]."""
     surface_normals: np.ndarray
@@ -51,6 +56,29 @@ class RenderResult:
     """Fraction of surface vertices where choppy displacement folds the surface (Jacobian ≤ 0)."""
     timings_s: dict[str, float] = field(default_factory=dict)
     """Wall time of each stage [s] (device synchronised)."""
+    face_flux_w_nm: np.ndarray | None = None
+    """``photons``: (F, K) flux on each receiver face that is not floor [W nm^-1], faces ordered
+    walls, then ``receivers[i]`` (see :attr:`face_receiver`)."""
+    face_receiver: np.ndarray | None = None
+    """``photons``: (F,) receiver id of each of those faces (1 = walls, 2 + i = ``receivers[i]``)."""
+    face_area_m2: np.ndarray | None = None
+    """``photons``: (F,) area of each of those faces [m²]."""
+    face_centres_m: np.ndarray | None = None
+    """``photons``: (F, 3) centroid of each of those faces [m]."""
+    photon_stats: dict[str, int] | None = None
+    """``photons``: photons emitted, carrying flux, and landed on a receiver."""
+    camera_radiance: np.ndarray | None = None
+    """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
+    camera_gbuffer: dict[str, np.ndarray] | None = None
+    """Per camera pixel: ``position`` (H, W, 3) [m], ``normal`` (H, W, 3), ``depth`` (H, W) [m] along
+    the ray (inf: no receiver), ``receiver`` (H, W) id (−1: none)."""
+
+    def receiver_irradiance(self, receiver: int) -> np.ndarray:
+        """(F_r, K) irradiance on the faces of receiver id ``receiver`` [W m^-2 nm^-1]."""
+        if self.face_flux_w_nm is None:
+            raise ValueError("receiver irradiance needs caustics.method = 'photons'")
+        sel = self.face_receiver == receiver
+        return self.face_flux_w_nm[sel] / self.face_area_m2[sel, None]
 
     @property
     def extent_m(self) -> float:
@@ -100,9 +128,30 @@ def scene_bytes(scene: Scene) -> int:
     """Device memory one frame of this scene needs [bytes]."""
     cfg = scene.config
     n = scene.water_resolution
-    k = cfg.optics.wavelengths.bins
+    k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
+    if cfg.caustics.method is CausticsMethod.PHOTONS:
+        periodic = water_is_periodic(cfg)
+        faces = receiver_face_estimate(scene, periodic)
+        cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
+        return water_bytes(cfg, n) + photons.photons_bytes(cfg, n, k, groups, periodic, faces) + cam
     return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
+
+
+def water_is_periodic(cfg) -> bool:
+    from warpcaustics.config import WaterModel
+
+    return cfg.water.model not in (WaterModel.POOL, WaterModel.WAVEPOOL)
+
+
+def receiver_face_estimate(scene: Scene, periodic: bool) -> int:
+    """Faces of the receivers' BVH (the floor grid with its margin, walls, meshes)."""
+    from warpcaustics.config import FloorShape
+
+    cfg = scene.config
+    cells = 4 if cfg.floor.shape in (FloorShape.FLAT, FloorShape.SLOPE) else cfg.caustics.map_resolution
+    floor = 2 * int(cells * (1.5 if periodic else 1.0)) ** 2
+    return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + (0 if periodic else 4 * 2 * 32 * 8)
 
 
 class Renderer:
@@ -120,18 +169,36 @@ class Renderer:
         devices.check_fits(self.device, self.bytes_needed, _MEMORY_FIX)
         self.bins = spectra.bins_for(cfg.optics)
         self.sun_irradiance = spectra.sun_irradiance(self.bins, cfg.sun, scene.base_dir)
-        self.attenuation_per_m = spectra.water_optics(cfg.optics, self.bins).attenuation_per_m
+        optics = spectra.water_optics(cfg.optics, self.bins)
+        self.attenuation_per_m = optics.attenuation_per_m
         self.ior = spectra.refractive_index(cfg.optics, self.bins)
         # One refraction per distinct index: K groups with dispersion, else one shared by all bins.
         self.group_ior = self.ior if cfg.optics.dispersion else self.ior[:1]
         with _memory_errors(self.device, self.bytes_needed):
             self.water = make_water(cfg, self.device, scene.heights)
             n = scene.water_resolution
-            self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
-            self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
-                                                self.attenuation_per_m, self.device,
-                                                periodic=self.water.periodic)
+            self.photons = None
+            if cfg.caustics.method is CausticsMethod.PHOTONS:
+                self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
+                                           relief=scene.floor_relief, meshes=scene.receiver_meshes,
+                                           water_top_z=_WALL_TOP_M)
+                self.photons = photons.PhotonCaustics(cfg, self.receivers, n, self.sun_irradiance,
+                                                      self.attenuation_per_m, len(self.group_ior),
+                                                      scene.sun_direction, self.device,
+                                                      periodic=self.water.periodic)
+                self.floor_top_z = self.receivers.floor_top_z
+                self.camera = None
+                if cfg.camera.enabled:
+                    self.camera = UnderwaterCamera(cfg.camera, self.receivers, optics.scattering_per_m,
+                                                   PhaseFunction.from_optics(cfg.optics, self.device),
+                                                   self.device)
+            else:
+                self.floor_top_z = -cfg.floor.depth_m
+                self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
+                self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
+                                                    self.attenuation_per_m, self.device,
+                                                    periodic=self.water.periodic)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
@@ -148,21 +215,48 @@ class Renderer:
         with watch.stage("water"):
             surface = self.water.at(time_s)
             lowest, highest = height_range(surface, dev)
-        if lowest <= -cfg.floor.depth_m:
+        if lowest <= self.floor_top_z:
             raise WarpcausticsError(
                 f"floor.depth_m = {cfg.floor.depth_m} is too shallow: the water surface reaches "
-                f"z = {lowest:.3f} m at t = {time_s:g} s; make the floor deeper or the waves lower")
+                f"z = {lowest:.3f} m at t = {time_s:g} s, the floor z = {self.floor_top_z:.3f} m; make "
+                "the floor deeper or the waves lower")
         with watch.stage("shading"):
             visible = sun_visibility(surface, sun_dir, highest, dev, out=self.visible)
-        with watch.stage("refraction"):
-            refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,
-                                         -cfg.floor.depth_m, dev, out=self.refracted)
-        with watch.stage("floor_caustics"):
-            floor = self.floor.run(surface, refracted, sun_dir)
-        with watch.stage("readback"):
-            # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
-            floor_np = floor.numpy().copy()
-            transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+        extra = {}
+        if self.photons is not None:
+            with watch.stage("photons"):
+                floor = self.photons.run(surface, visible, self.group_ior)
+            if self.camera is not None:
+                if self.camera.position_z >= lowest:
+                    raise WarpcausticsError(
+                        f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
+                        f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
+                        "above the water is not implemented yet: lower the camera")
+                with watch.stage("camera"):
+                    spacing = cfg.water.extent_m / self.scene.water_resolution / cfg.caustics.photon_subdivisions
+                    self.camera.render(self.photons, spacing, cfg.caustics.shafts)
+                    extra["camera_radiance"] = self.camera.radiance.numpy().copy()
+                    extra["camera_gbuffer"] = self.camera.gbuffer()
+            with watch.stage("readback"):
+                floor_np = floor.numpy().copy()
+                transmitted = self.photons.transmitted_flux()
+                rec = self.receivers
+                extra.update(face_flux_w_nm=self.photons.face_flux.numpy()[: rec.face_count - rec.floor_face_count].copy(),
+                             face_receiver=rec.face_receiver_np[rec.floor_face_count:],
+                             face_area_m2=rec.face_area_m2[rec.floor_face_count:],
+                             face_centres_m=rec.face_centres_m[rec.floor_face_count:],
+                             photon_stats=vars(self.photons.stats()))
+        else:
+            with watch.stage("refraction"):
+                refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,
+                                             -cfg.floor.depth_m, dev, out=self.refracted)
+            with watch.stage("floor_caustics"):
+                floor = self.floor.run(surface, refracted, sun_dir)
+            with watch.stage("readback"):
+                # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
+                floor_np = floor.numpy().copy()
+                transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+        with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
             folds = float(np.mean(surface.jacobian.numpy() <= 0.0)) if surface.jacobian is not None else 0.0
@@ -172,8 +266,11 @@ class Renderer:
             attenuation_per_m=self.attenuation_per_m, ior=self.ior,
             sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
             surface_positions=positions, surface_normals=normals, bins=self.bins, fold_fraction=folds,
-            timings_s=watch.timings)
+            timings_s=watch.timings, **extra)
 
+
+_WALL_TOP_M = 1.0
+"""Height of a walled pool's walls above the water at rest [m]."""
 
 _MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
 

@@ -10,8 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from warpcaustics.config import Config, WaterModel, config_from_dict, read_toml
+from warpcaustics.config import Config, FloorShape, WaterModel, config_from_dict, read_toml
 from warpcaustics.heights import DEFAULT_RESOLUTION, load_heights
+from warpcaustics.receivers import load_floor_relief, load_receiver_mesh
 
 
 @dataclass(frozen=True)
@@ -25,6 +26,10 @@ class Scene:
     """``water.file``'s heights [m] for ``water.model = "heightfield"``."""
     source: str | None = None
     """The file the scene came from, if any."""
+    floor_relief: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``floor.file``'s relief [m] for ``floor.shape = "file"``."""
+    receiver_meshes: tuple = field(default=(), repr=False, compare=False)
+    """The ``[[receivers]]`` meshes in world space (:class:`warpcaustics.receivers.TriangleMesh`)."""
 
     @property
     def water_resolution(self) -> int:
@@ -48,7 +53,12 @@ def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) ->
         n = heights.shape[0]
     cfg = dataclasses.replace(cfg, water=dataclasses.replace(cfg.water, resolution=n))
     _check_spectral_data(cfg, base_dir)
-    return Scene(cfg, base_dir, heights, source)
+    relief = None
+    if cfg.floor.shape is FloorShape.FILE:
+        path = Path(cfg.floor.file)
+        relief = load_floor_relief(path if path.is_absolute() else base_dir / path)
+    meshes = tuple(load_receiver_mesh(r, base_dir, f"receivers[{i}]") for i, r in enumerate(cfg.receivers))
+    return Scene(cfg, base_dir, heights, source, relief, meshes)
 
 
 def _check_spectral_data(cfg: Config, base_dir: Path) -> None:

@@ -1,0 +1,298 @@
+"""The under-water pinhole camera: G-buffer by ray casting, photon splats, light shafts, shading.
+
+Pixel (j, i) (row j from the top) looks along
+``normalize(forward + x_i tan(fov/2) aspect right + y_j tan(fov/2) up)`` with
+``x_i = 2 (i + ½)/W − 1`` and ``y_j = 1 − 2 (j + ½)/H``. Its solid angle is
+``(2 tan(fov/2)/H)² cos³α`` (α off the optical axis), its footprint on a receiver at distance r
+with normal n is ``r² Ω / |cos(ray, n)|``.
+"""
+
+import warp as wp
+
+from warpcaustics.kernels.phase import henyey_greenstein, tabulated_phase
+
+wp.set_module_options({"enable_backward": False})
+
+INV_PI = 0.3183098861837907
+
+MAX_SPLAT_RADIUS = 6
+"""Largest photon splat radius [pixels]."""
+
+MAX_SHAFT_STEPS = 2048
+"""Most samples along one photon's light-shaft line."""
+
+
+@wp.struct
+class PinholeCamera:
+    position: wp.vec3
+    right: wp.vec3
+    up: wp.vec3
+    forward: wp.vec3
+    tan_half_fov: float
+    aspect: float
+    """Width / height."""
+    width: int
+    height: int
+
+
+@wp.func
+def pixel_ray(cam: PinholeCamera, i: int, j: int) -> wp.vec3:
+    x = 2.0 * (float(i) + 0.5) / float(cam.width) - 1.0
+    y = 1.0 - 2.0 * (float(j) + 0.5) / float(cam.height)
+    return wp.normalize(cam.forward + (x * cam.tan_half_fov * cam.aspect) * cam.right
+                        + (y * cam.tan_half_fov) * cam.up)
+
+
+@wp.func
+def pixel_solid_angle(cam: PinholeCamera, ray: wp.vec3) -> float:
+    side = 2.0 * cam.tan_half_fov / float(cam.height)
+    c = wp.dot(ray, cam.forward)
+    return side * side * c * c * c
+
+
+@wp.func
+def project(cam: PinholeCamera, x: wp.vec3) -> wp.vec3:
+    """(column, row, distance) of point x: continuous pixel coordinates; distance < 0 behind."""
+    v = x - cam.position
+    z = wp.dot(v, cam.forward)
+    if z <= 1.0e-6:
+        return wp.vec3(-1.0, -1.0, -1.0)
+    px = (wp.dot(v, cam.right) / (z * cam.tan_half_fov * cam.aspect) + 1.0) * 0.5 * float(cam.width)
+    py = (1.0 - wp.dot(v, cam.up) / (z * cam.tan_half_fov)) * 0.5 * float(cam.height)
+    return wp.vec3(px, py, wp.length(v))
+
+
+@wp.kernel
+def gbuffer(
+    cam: PinholeCamera,
+    mesh: wp.uint64,
+    face_receiver: wp.array[wp.int32],
+    position: wp.array2d[wp.vec3],
+    normal: wp.array2d[wp.vec3],
+    depth: wp.array2d[wp.float32],
+    receiver: wp.array2d[wp.int32],
+    inv_footprint: wp.array2d[wp.float32],
+):
+    """First receiver along each pixel's ray: position, normal facing the camera, distance,
+    receiver id (−1 and depth 1e30 for none) and 1 / the pixel's footprint area there [m^-2]."""
+    j, i = wp.tid()
+    ray = pixel_ray(cam, i, j)
+    q = wp.mesh_query_ray(mesh, cam.position, ray, 1.0e5)
+    if q.result:
+        n = q.normal
+        if wp.dot(n, ray) > 0.0:
+            n = -n
+        position[j, i] = cam.position + q.t * ray
+        normal[j, i] = n
+        depth[j, i] = q.t
+        receiver[j, i] = face_receiver[q.face]
+        cos_r = wp.max(-wp.dot(n, ray), 0.02)
+        inv_footprint[j, i] = cos_r / (q.t * q.t * pixel_solid_angle(cam, ray))
+    else:
+        position[j, i] = cam.position + 1.0e5 * ray
+        normal[j, i] = -ray
+        depth[j, i] = 1.0e30
+        receiver[j, i] = -1
+        inv_footprint[j, i] = 0.0
+
+
+@wp.func
+def same_surface(depth_pixel: float, distance: float, tolerance: float) -> bool:
+    return wp.abs(depth_pixel - distance) <= tolerance * depth_pixel + 1.0e-3
+
+
+@wp.kernel
+def splat_photons(
+    cam: PinholeCamera,
+    hit: wp.array[wp.vec3],
+    face: wp.array[wp.int32],
+    origin: wp.array[wp.vec3],
+    weight: wp.array[wp.float32],
+    photons_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    wavelengths_per_group: int,
+    photon_spacing_m: float,
+    depth: wp.array2d[wp.float32],
+    inv_footprint: wp.array2d[wp.float32],
+    depth_tolerance: float,
+    caustic: wp.array3d[wp.float32],
+):
+    """Splat photon i into the camera caustic map (K, H, W) [W m^-2 nm^-1]: a Gaussian whose width
+    in pixels is the photon spacing seen at its distance (de la Fuente 2011 §4.5), over the pixels
+    that see the same surface (depth test: occluded photons add nothing); its weights are
+    renormalised over those pixels, so the splat conserves the photon's flux."""
+    p = wp.tid()
+    f = face[p]
+    if f < 0:
+        return
+    x = hit[p]
+    c = project(cam, x)
+    if c[2] < 0.0:
+        return
+    ci = int(wp.floor(c[0]))
+    cj = int(wp.floor(c[1]))
+    if ci < 0 or cj < 0 or ci >= cam.width or cj >= cam.height:
+        return
+    if not same_surface(depth[cj, ci], c[2], depth_tolerance):
+        return  # hidden behind something nearer the camera
+    angle = 2.0 * cam.tan_half_fov / float(cam.height)
+    sigma = wp.max(0.5, photon_spacing_m / (c[2] * angle))
+    r = wp.min(int(wp.ceil(2.0 * sigma)), MAX_SPLAT_RADIUS)
+    inv2s2 = 0.5 / (sigma * sigma)
+    total = float(0.0)
+    for dj in range(-r, r + 1):
+        for di in range(-r, r + 1):
+            i = ci + di
+            j = cj + dj
+            if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
+                if same_surface(depth[j, i], c[2], depth_tolerance):
+                    dx = float(i) + 0.5 - c[0]
+                    dy = float(j) + 0.5 - c[1]
+                    total += wp.exp(-(dx * dx + dy * dy) * inv2s2)
+    if total <= 0.0:
+        return
+    ell = wp.length(x - origin[p])
+    g = p / photons_per_group
+    for dj in range(-r, r + 1):
+        for di in range(-r, r + 1):
+            i = ci + di
+            j = cj + dj
+            if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
+                if same_surface(depth[j, i], c[2], depth_tolerance):
+                    dx = float(i) + 0.5 - c[0]
+                    dy = float(j) + 0.5 - c[1]
+                    share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total * inv_footprint[j, i]
+                    for jj in range(wavelengths_per_group):
+                        k = g * wavelengths_per_group + jj
+                        wp.atomic_add(caustic, k, j, i,
+                                      share * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
+
+
+@wp.kernel
+def shaft_lines(
+    cam: PinholeCamera,
+    hit: wp.array[wp.vec3],
+    face: wp.array[wp.int32],
+    origin: wp.array[wp.vec3],
+    direction: wp.array[wp.vec3],
+    weight: wp.array[wp.float32],
+    stride: int,
+    tube_width_m: float,
+    photons_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    scattering_per_m: wp.array[wp.float32],
+    wavelengths_per_group: int,
+    phase_kind: int,
+    hg_g: float,
+    angles_rad: wp.array[wp.float32],
+    log_phase: wp.array[wp.float32],
+    cone_phase: float,
+    depth: wp.array2d[wp.float32],
+    shafts: wp.array3d[wp.float32],
+):
+    """Light shafts (de la Fuente 2011 §4.6; Papadopoulos & Papaioannou 2009): photon ``i·stride``
+    stands for ``stride`` photons and its path from the surface to its receiver is a line of
+    scattering sources. A step dℓ at ℓ from the surface and s from the camera adds
+    ``Φ(λ) σ_s(λ) p(cosθ) e^{−c(ℓ+s)} dℓ / (s² Ω_pixel)`` to the radiance of the pixel it falls in
+    [W m^-2 sr^-1 nm^-1], unless the G-buffer says a receiver hides it. Where the line's tube
+    (``tube_width_m`` across) looks wider than a pixel, each step is spread evenly over a square of
+    pixels as wide as the tube (at most 2·MAX_SPLAT_RADIUS + 1), so near lines do not streak."""
+    t = wp.tid()
+    p = t * stride
+    if face[p] < 0:
+        return
+    o = origin[p]
+    x1 = hit[p]
+    d = direction[p]
+    length = wp.length(x1 - o)
+    a = project(cam, o)
+    b = project(cam, x1)
+    pixels = float(MAX_SHAFT_STEPS)
+    if a[2] > 0.0 and b[2] > 0.0:
+        pixels = wp.length(wp.vec2(b[0] - a[0], b[1] - a[1]))
+    steps = wp.clamp(int(wp.ceil(2.0 * pixels)) + 1, 1, MAX_SHAFT_STEPS)
+    dl = length / float(steps)
+    g = p / photons_per_group
+    w = weight[p] * float(stride) * dl
+    angle = 2.0 * cam.tan_half_fov / float(cam.height)
+    for step in range(steps):
+        ell = (float(step) + 0.5) * dl
+        x = o + ell * d
+        c = project(cam, x)
+        if c[2] > 0.0:
+            s = c[2]
+            to_cam = (cam.position - x) / s
+            cos_theta = wp.dot(d, to_cam)
+            phase = float(0.0)
+            if phase_kind == 0:
+                phase = henyey_greenstein(cos_theta, hg_g)
+            else:
+                phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+            geometry = w * phase / (s * s * pixel_solid_angle(cam, -to_cam))
+            r = wp.min(int(0.5 * tube_width_m / (s * angle)), MAX_SPLAT_RADIUS)
+            ci = int(wp.floor(c[0]))
+            cj = int(wp.floor(c[1]))
+            seen = int(0)
+            for dj in range(-r, r + 1):
+                for di in range(-r, r + 1):
+                    if in_front(depth, ci + di, cj + dj, s):
+                        seen += 1
+            for dj in range(-r, r + 1):
+                for di in range(-r, r + 1):
+                    i = ci + di
+                    j = cj + dj
+                    if in_front(depth, i, j, s):
+                        share = geometry / float(seen)
+                        for jj in range(wavelengths_per_group):
+                            k = g * wavelengths_per_group + jj
+                            wp.atomic_add(shafts, k, j, i, share * sun_irradiance[k] * scattering_per_m[k]
+                                          * wp.exp(-attenuation_per_m[k] * (ell + s)))
+
+
+@wp.func
+def in_front(depth: wp.array2d[wp.float32], i: int, j: int, s: float) -> bool:
+    """Pixel (j, i) exists and its receiver lies beyond distance s."""
+    if i < 0 or j < 0 or i >= depth.shape[1] or j >= depth.shape[0]:
+        return False
+    return s < depth[j, i]
+
+
+@wp.kernel
+def blur3(src: wp.array3d[wp.float32], dst: wp.array3d[wp.float32]):
+    """3×3 binomial filter [1 2 1]ᵀ[1 2 1]/16 per band, edges renormalised (flux kept)."""
+    k, j, i = wp.tid()
+    h = src.shape[1]
+    w = src.shape[2]
+    total = float(0.0)
+    norm = float(0.0)
+    for dj in range(-1, 2):
+        for di in range(-1, 2):
+            jj = j + dj
+            ii = i + di
+            if jj >= 0 and ii >= 0 and jj < h and ii < w:
+                wgt = float((2 - wp.abs(dj)) * (2 - wp.abs(di)))
+                total += wgt * src[k, jj, ii]
+                norm += wgt
+    dst[k, j, i] = total / norm
+
+
+@wp.kernel
+def shade(
+    receiver: wp.array2d[wp.int32],
+    depth: wp.array2d[wp.float32],
+    caustic: wp.array3d[wp.float32],
+    shafts: wp.array3d[wp.float32],
+    albedo: wp.array2d[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    radiance: wp.array3d[wp.float32],
+):
+    """Radiance at the camera: a Lambertian receiver's ``albedo · E / π`` attenuated over the
+    distance to the camera, plus the light shafts in front of it."""
+    k, j, i = wp.tid()
+    value = shafts[k, j, i]
+    r = receiver[j, i]
+    if r >= 0:
+        value += albedo[r, k] * caustic[k, j, i] * INV_PI * wp.exp(-attenuation_per_m[k] * depth[j, i])
+    radiance[k, j, i] = value

@@ -1,0 +1,120 @@
+"""The under-water pinhole camera (host side): G-buffer, photon caustic map, light shafts, shading.
+
+The camera looks at the receivers from inside the water; viewing from above the water through the
+refracting surface is not implemented yet. Receivers are static, so the G-buffer is cast once per
+scene; each frame splats the photons into a camera caustic map, draws their light shafts and
+shades (``kernels/camera.py`` has the equations).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import CameraConfig
+from warpcaustics.kernels import camera as camera_kernels
+from warpcaustics.phase import PhaseFunction
+from warpcaustics.photons import PhotonCaustics
+from warpcaustics.receivers import Receivers
+
+DEPTH_TOLERANCE = 0.02
+"""A photon counts as seen at a pixel if its distance is within 2 % of the G-buffer depth there."""
+
+
+def pinhole(cfg: CameraConfig) -> camera_kernels.PinholeCamera:
+    position = np.asarray(cfg.position_m, np.float64)
+    forward = np.asarray(cfg.look_at_m, np.float64) - position
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(cfg.up, np.float64))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    cam = camera_kernels.PinholeCamera()
+    cam.position = wp.vec3(*position.astype(np.float32))
+    cam.right = wp.vec3(*right.astype(np.float32))
+    cam.up = wp.vec3(*up.astype(np.float32))
+    cam.forward = wp.vec3(*forward.astype(np.float32))
+    cam.tan_half_fov = math.tan(math.radians(cfg.fov_deg) / 2.0)
+    cam.aspect = cfg.width / cfg.height
+    cam.width = cfg.width
+    cam.height = cfg.height
+    return cam
+
+
+def camera_bytes(cfg: CameraConfig, k: int) -> int:
+    """Device memory of the camera buffers [bytes]."""
+    return cfg.width * cfg.height * (12 + 12 + 4 + 4 + 4 + 4 * k * 4)
+
+
+class UnderwaterCamera:
+    """A pinhole camera's buffers for one scene on one device."""
+
+    def __init__(self, cfg: CameraConfig, receivers: Receivers, scattering_per_m: np.ndarray,
+                 phase: PhaseFunction, device: str):
+        self.cfg = cfg
+        self.device = device
+        self.receivers = receivers
+        self.phase = phase
+        self.cam = pinhole(cfg)
+        h, w = cfg.height, cfg.width
+        k = receivers.albedo.shape[1]
+        self.scattering_per_m = wp.array(np.asarray(scattering_per_m, np.float32), dtype=wp.float32, device=device)
+        self.position = wp.empty((h, w), dtype=wp.vec3, device=device)
+        self.normal = wp.empty((h, w), dtype=wp.vec3, device=device)
+        self.depth = wp.empty((h, w), dtype=wp.float32, device=device)
+        self.receiver = wp.empty((h, w), dtype=wp.int32, device=device)
+        self.inv_footprint = wp.empty((h, w), dtype=wp.float32, device=device)
+        self.caustic = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        """Irradiance on the receiver seen in each pixel (K, H, W) [W m^-2 nm^-1]."""
+        self.shafts = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        self.shafts_raw = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        self.radiance = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        wp.launch(camera_kernels.gbuffer, dim=(h, w),
+                  inputs=[self.cam, receivers.mesh.id, receivers.face_receiver],
+                  outputs=[self.position, self.normal, self.depth, self.receiver, self.inv_footprint],
+                  device=device)
+
+    @property
+    def position_z(self) -> float:
+        return float(self.cfg.position_m[2])
+
+    def render(self, photons: PhotonCaustics, photon_spacing_m: float, shafts: bool) -> wp.array3d:
+        """Splat ``photons``' last frame into the camera, add their shafts, shade: (K, H, W)
+        radiance [W m^-2 sr^-1 nm^-1]."""
+        dev = self.device
+        k = photons.sun_irradiance.shape[0]
+        per_group = k // photons.groups
+        count = photons.weight.shape[0]
+        self.caustic.zero_()
+        wp.launch(camera_kernels.splat_photons, dim=count,
+                  inputs=[self.cam, photons.hit, photons.face, photons.origin, photons.weight,
+                          photons.photons_per_group, photons.sun_irradiance, photons.attenuation_per_m,
+                          per_group, float(photon_spacing_m), self.depth, self.inv_footprint,
+                          DEPTH_TOLERANCE],
+                  outputs=[self.caustic], device=dev)
+        self.shafts_raw.zero_()
+        if shafts:
+            stride = photons.subdivisions**2  # one line per surface cell, carrying the cell's photons
+            ph = self.phase
+            wp.launch(camera_kernels.shaft_lines, dim=count // stride,
+                      inputs=[self.cam, photons.hit, photons.face, photons.origin, photons.direction,
+                              photons.weight, stride, float(photon_spacing_m * photons.subdivisions),
+                              photons.photons_per_group, photons.sun_irradiance, photons.attenuation_per_m,
+                              self.scattering_per_m, per_group, ph.kind, ph.g, ph.angles_rad, ph.log_phase,
+                              ph.cone_phase, self.depth],
+                      outputs=[self.shafts_raw], device=dev)
+        h, w = self.cfg.height, self.cfg.width
+        wp.launch(camera_kernels.blur3, dim=(k, h, w), inputs=[self.shafts_raw], outputs=[self.shafts],
+                  device=dev)
+        wp.launch(camera_kernels.shade, dim=(k, h, w),
+                  inputs=[self.receiver, self.depth, self.caustic, self.shafts, self.receivers.albedo_wp,
+                          photons.attenuation_per_m],
+                  outputs=[self.radiance], device=dev)
+        return self.radiance
+
+    def gbuffer(self) -> dict[str, np.ndarray]:
+        depth = self.depth.numpy().copy()
+        depth[depth >= 1.0e29] = np.inf
+        return {"position": self.position.numpy().copy(), "normal": self.normal.numpy().copy(),
+                "depth": depth, "receiver": self.receiver.numpy().copy()}

@@ -1,0 +1,167 @@
+"""Photon caustics (host side): emit, refract, intersect (BVH or Shah's iteration), deposit.
+
+See ``warpcaustics/kernels/photons.py`` for the method. The stage owns its photon buffers and the
+receivers' light view; both are reused from frame to frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config, Intersection
+from warpcaustics.kernels import floor as floor_kernels
+from warpcaustics.kernels import photons as photon_kernels
+from warpcaustics.receivers import Receivers
+from warpcaustics.water import Surface
+
+PHOTON_BYTES = 12 + 12 + 4 + 12 + 4
+"""Per photon: origin, direction, weight, hit, face."""
+
+
+def photon_count(cfg: Config, n: int, groups: int, periodic: bool) -> int:
+    quads = n if periodic else n + 1
+    return groups * quads * quads * cfg.caustics.photon_subdivisions**2
+
+
+def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int) -> int:
+    """Device memory of the photon stage, receivers included [bytes]."""
+    m = cfg.caustics.map_resolution
+    r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
+    return (photon_count(cfg, n, groups, periodic) * PHOTON_BYTES + 2 * k * m * m * 4 + m * m * 4
+            + r * r * 16 + face_count * (k * 4 + 4 + 12 + 64) + n * n * 4)
+
+
+@dataclass
+class PhotonStats:
+    emitted: int
+    """Photons launched (all index groups)."""
+    carrying: int
+    """Photons with non-zero weight (lit from the front, refracted downwards)."""
+    landed: int
+    """Photons that found a receiver."""
+
+
+def light_view_frame(points: np.ndarray, sun_dir: np.ndarray, resolution: int):
+    """(origin, u, v, texel) of an orthographic sun view covering all ``points``; u, v ⊥ sun."""
+    s = np.asarray(sun_dir, np.float64)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(s[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(helper, s)
+    u /= np.linalg.norm(u)
+    v = np.cross(s, u)
+    a, b = points @ u, points @ v
+    span = max(np.ptp(a), np.ptp(b))
+    texel = span * (1.0 + 2.0 / resolution) / resolution
+    origin = u * (a.min() - texel) + v * (b.min() - texel)
+    return origin, u, v, texel
+
+
+class PhotonCaustics:
+    """Owns the photon stage's device buffers for one scene, reused from frame to frame."""
+
+    def __init__(self, cfg: Config, receivers: Receivers, n: int, sun_irradiance: np.ndarray,
+                 attenuation_per_m: np.ndarray, groups: int, sun_dir: np.ndarray, device: str, *,
+                 periodic: bool):
+        self.cfg = cfg
+        self.device = device
+        self.receivers = receivers
+        self.periodic = periodic
+        self.subdivisions = cfg.caustics.photon_subdivisions
+        self.quads = n if periodic else n + 1
+        self.groups = groups
+        count = photon_count(cfg, n, groups, periodic)
+        self.photons_per_group = count // groups
+        k = len(sun_irradiance)
+        m = cfg.caustics.map_resolution
+        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device)
+        self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
+                                          device=device)
+        self.origin = wp.empty(count, dtype=wp.vec3, device=device)
+        self.direction = wp.empty(count, dtype=wp.vec3, device=device)
+        self.weight = wp.empty(count, dtype=wp.float32, device=device)
+        """A⊥·T per photon [m²]."""
+        self.hit = wp.empty(count, dtype=wp.vec3, device=device)
+        self.face = wp.empty(count, dtype=wp.int32, device=device)
+        self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
+        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
+        other_faces = max(receivers.face_count - receivers.floor_face_count, 1)
+        self.face_flux = wp.empty((other_faces, k), dtype=wp.float32, device=device)
+        """Flux on each non-floor face (F_other, K) [W nm^-1]."""
+        self.floor_inv_area = wp.array((1.0 / receivers.floor_texel_area_m2).astype(np.float32),
+                                       dtype=wp.float32, device=device)
+        sun = np.asarray(sun_dir, np.float64)
+        self.sun_dir = wp.vec3(*sun.astype(np.float32))
+        # A flat-floor plane for moving periodic photons by whole periods before they are traced.
+        self.plane_z = -cfg.floor.depth_m
+        self.view = self._light_view(sun, cfg.caustics.newton_buffer_resolution
+                                     if cfg.caustics.intersection is Intersection.NEWTON else 1)
+        self.newton_iterations = (cfg.caustics.newton_iterations
+                                  if cfg.caustics.intersection is Intersection.NEWTON else -1)
+
+    def _light_view(self, sun: np.ndarray, resolution: int) -> photon_kernels.LightView:
+        # The view needs the receivers where photons land: on a periodic sea that is the patch
+        # (photons are moved by whole periods first), not the floor's margin beyond it.
+        points = self.receivers.points
+        if self.periodic:
+            reach = 0.55 * self.cfg.water.extent_m
+            points = points[np.all(np.abs(points[:, :2]) <= reach, axis=1)
+                            | (np.arange(len(points)) >= self.receivers.floor_vertex_count)]
+        origin, u, v, texel = light_view_frame(points, sun, resolution)
+        view = photon_kernels.LightView()
+        view.origin = wp.vec3(*origin.astype(np.float32))
+        view.u = wp.vec3(*u.astype(np.float32))
+        view.v = wp.vec3(*v.astype(np.float32))
+        view.texel_m = float(texel)
+        view.positions = wp.empty((resolution, resolution), dtype=wp.vec3, device=self.device)
+        view.faces = wp.empty((resolution, resolution), dtype=wp.int32, device=self.device)
+        if resolution > 1:
+            distance = float(np.abs(self.receivers.points @ sun).max() + 1.0)
+            wp.launch(photon_kernels.render_light_view, dim=(resolution, resolution),
+                      inputs=[self.receivers.mesh.id, self.sun_dir, distance, view], device=self.device)
+        return view
+
+    def run(self, surface: Surface, visible: wp.array2d, group_ior: np.ndarray) -> wp.array3d:
+        """Emit, trace and deposit every photon; fills :attr:`irradiance` and :attr:`face_flux`."""
+        dev = self.device
+        s = self.subdivisions
+        ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=dev)
+        extent = float(surface.extent_m)
+        wp.launch(photon_kernels.emit_photons, dim=(self.groups, self.quads, self.quads, s * s),
+                  inputs=[surface.positions, surface.normals, visible, ior, self.sun_dir, s, extent,
+                          int(self.periodic)],
+                  outputs=[self.origin, self.direction, self.weight], device=dev)
+        wp.launch(photon_kernels.trace_photons, dim=self.weight.shape[0],
+                  inputs=[self.receivers.mesh.id, self.view, self.receivers.face_receiver, self.newton_iterations, extent,
+                          int(self.periodic), float(self.plane_z), self.origin, self.direction, self.weight],
+                  outputs=[self.hit, self.face], device=dev)
+        self.texels.zero_()
+        self.face_flux.zero_()
+        k = self.sun_irradiance.shape[0]
+        wp.launch(photon_kernels.deposit_photons, dim=self.weight.shape[0],
+                  inputs=[self.hit, self.face, self.origin, self.weight, self.photons_per_group,
+                          self.sun_irradiance, self.attenuation_per_m, k // self.groups,
+                          self.receivers.floor_face_count, extent, int(self.periodic), self.floor_inv_area],
+                  outputs=[self.texels, self.face_flux], device=dev)
+        m = self.texels.shape[0]
+        wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels], outputs=[self.irradiance],
+                  device=dev)
+        return self.irradiance
+
+    def transmitted_flux(self) -> np.ndarray:
+        """(K,) flux the photons carry into the water before attenuation [W nm^-1] (float64)."""
+        w = self.weight.numpy().astype(np.float64).reshape(self.groups, -1).sum(axis=1)
+        e = self.sun_irradiance.numpy().astype(np.float64)
+        return e * np.repeat(w, len(e) // self.groups)
+
+    def stats(self) -> PhotonStats:
+        w = self.weight.numpy()
+        return PhotonStats(emitted=len(w), carrying=int(np.count_nonzero(w > 0)),
+                           landed=int(np.count_nonzero(self.face.numpy() >= 0)))
+
+
+def photons_per_texel(cfg: Config, n: int) -> float:
+    """Photons per floor map texel on average (one index group)."""
+    return n * n * cfg.caustics.photon_subdivisions**2 / cfg.caustics.map_resolution**2
