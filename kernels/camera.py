@@ -39,8 +39,9 @@ class PinholeCamera:
 def pixel_ray(cam: PinholeCamera, i: int, j: int) -> wp.vec3:
     x = 2.0 * (float(i) + 0.5) / float(cam.width) - 1.0
     y = 1.0 - 2.0 * (float(j) + 0.5) / float(cam.height)
-    return wp.normalize(cam.forward + (x * cam.tan_half_fov * cam.aspect) * cam.right
-                        + (y * cam.tan_half_fov) * cam.up)
+    return wp.normalize(
+        cam.forward + (x * cam.tan_half_fov * cam.aspect) * cam.right + (y * cam.tan_half_fov) * cam.up
+    )
 
 
 @wp.func
@@ -165,8 +166,9 @@ def splat_photons(
                     share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total * inv_footprint[j, i]
                     for jj in range(wavelengths_per_group):
                         k = g * wavelengths_per_group + jj
-                        wp.atomic_add(caustic, k, j, i,
-                                      share * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
+                        wp.atomic_add(
+                            caustic, k, j, i, share * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell)
+                        )
 
 
 @wp.kernel
@@ -247,8 +249,16 @@ def shaft_lines(
                         share = geometry / float(seen)
                         for jj in range(wavelengths_per_group):
                             k = g * wavelengths_per_group + jj
-                            wp.atomic_add(shafts, k, j, i, share * sun_irradiance[k] * scattering_per_m[k]
-                                          * wp.exp(-attenuation_per_m[k] * (ell + s)))
+                            wp.atomic_add(
+                                shafts,
+                                k,
+                                j,
+                                i,
+                                share
+                                * sun_irradiance[k]
+                                * scattering_per_m[k]
+                                * wp.exp(-attenuation_per_m[k] * (ell + s)),
+                            )
 
 
 @wp.func

@@ -51,7 +51,9 @@ def render_light_view(mesh: wp.uint64, sun_dir: wp.vec3, distance_m: float, view
     """Fill the light view: the first receiver point seen along −s through each texel (face −1:
     none)."""
     j, i = wp.tid()
-    centre = view.origin + ((float(i) + 0.5) * view.texel_m) * view.u + ((float(j) + 0.5) * view.texel_m) * view.v
+    centre = (
+        view.origin + ((float(i) + 0.5) * view.texel_m) * view.u + ((float(j) + 0.5) * view.texel_m) * view.v
+    )
     start = centre + distance_m * sun_dir
     q = wp.mesh_query_ray(mesh, start, -sun_dir, RAY_LENGTH_M)
     if q.result:
@@ -92,16 +94,33 @@ def look_up(view: LightView, face_receiver: wp.array[wp.int32], x: wp.vec3):
     f11 = view.faces[j0 + 1, i0 + 1]
     if f00 < 0 or f10 < 0 or f01 < 0 or f11 < 0:
         return view.positions[j, i], f
-    if face_receiver[f00] != r or face_receiver[f10] != r or face_receiver[f01] != r or face_receiver[f11] != r:
+    if (
+        face_receiver[f00] != r
+        or face_receiver[f10] != r
+        or face_receiver[f01] != r
+        or face_receiver[f11] != r
+    ):
         return view.positions[j, i], f
-    p = bilinear_vec3(view.positions[j0, i0], view.positions[j0, i0 + 1], view.positions[j0 + 1, i0],
-                      view.positions[j0 + 1, i0 + 1], fa - float(i0), fb - float(j0))
+    p = bilinear_vec3(
+        view.positions[j0, i0],
+        view.positions[j0, i0 + 1],
+        view.positions[j0 + 1, i0],
+        view.positions[j0 + 1, i0 + 1],
+        fa - float(i0),
+        fb - float(j0),
+    )
     return p, f
 
 
 @wp.func
-def newton_hit(view: LightView, face_receiver: wp.array[wp.int32], o: wp.vec3, d: wp.vec3, plane_z: float,
-               iterations: int):
+def newton_hit(
+    view: LightView,
+    face_receiver: wp.array[wp.int32],
+    o: wp.vec3,
+    d: wp.vec3,
+    plane_z: float,
+    iterations: int,
+):
     """Shah's iteration for the ray o + t d: returns (t, face) with face −1 if the ray left the
     light view. Starts where the ray meets the plane z = plane_z (the floor at rest)."""
     t = (plane_z - o[2]) / d[2]
@@ -151,10 +170,12 @@ def emit_photons(
     dp_du = (1.0 - tv) * (p10 - p00) + tv * (p11 - p01)
     dp_dv = (1.0 - tu) * (p01 - p00) + tu * (p11 - p10)
     a_perp = wp.max(wp.dot(wp.cross(dp_du, dp_dv), sun_dir), 0.0) / float(s * s)
-    normal = wp.normalize(bilinear_vec3(normals[y00, x00], normals[y10, x10], normals[y01, x01],
-                                        normals[y11, x11], tu, tv))
+    normal = wp.normalize(
+        bilinear_vec3(normals[y00, x00], normals[y10, x10], normals[y01, x01], normals[y11, x11], tu, tv)
+    )
     seen = (1.0 - tv) * ((1.0 - tu) * visible[y00, x00] + tu * visible[y10, x10]) + tv * (
-        (1.0 - tu) * visible[y01, x01] + tu * visible[y11, x11])
+        (1.0 - tu) * visible[y01, x01] + tu * visible[y11, x11]
+    )
     eta = 1.0 / ior[g]
     cos_i = wp.dot(normal, sun_dir)
     d = wp.vec3(0.0, 0.0, -1.0)
@@ -258,10 +279,15 @@ def deposit_photons(
         scale = w * floor_inv_area[ty, tx]
         for j in range(wavelengths_per_group):
             k = k0 + j
-            wp.atomic_add(floor_texels, ty, tx, k,
-                          scale * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
+            wp.atomic_add(
+                floor_texels, ty, tx, k, scale * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell)
+            )
     else:
         for j in range(wavelengths_per_group):
             k = k0 + j
-            wp.atomic_add(face_flux, f - floor_face_count, k,
-                          w * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
+            wp.atomic_add(
+                face_flux,
+                f - floor_face_count,
+                k,
+                w * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell),
+            )

@@ -15,10 +15,19 @@ PHOTONS = {"caustics.method": "photons"}
 
 
 def _flat(elevation_deg, depth_m, water_type="pure", **extra):
-    overrides = {**PHOTONS, "water.model": "flat", "water.resolution": 32, "water.extent_m": 8.0,
-                 "caustics.map_resolution": 32, "caustics.photon_subdivisions": 2,
-                 "sun.elevation_deg": elevation_deg, "sun.azimuth_deg": 37.0, "floor.depth_m": depth_m,
-                 "optics.water_type": water_type, "optics.wavelengths.bins": 8}
+    overrides = {
+        **PHOTONS,
+        "water.model": "flat",
+        "water.resolution": 32,
+        "water.extent_m": 8.0,
+        "caustics.map_resolution": 32,
+        "caustics.photon_subdivisions": 2,
+        "sun.elevation_deg": elevation_deg,
+        "sun.azimuth_deg": 37.0,
+        "floor.depth_m": depth_m,
+        "optics.water_type": water_type,
+        "optics.wavelengths.bins": 8,
+    }
     overrides.update(extra)
     return wc.load_scene(None, overrides)
 
@@ -35,8 +44,12 @@ def test_flat_water_photons_match_analytic_irradiance(device, intersection, elev
     result = wc.render(_flat(elevation_deg, depth, **{"caustics.intersection": intersection}), device=device)
     theta = np.radians(90.0 - elevation_deg)
     cos_t = np.sqrt(1.0 - (np.sin(theta) / 1.333) ** 2)
-    expected = result.sun_irradiance * np.cos(theta) * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0] \
+    expected = (
+        result.sun_irradiance
+        * np.cos(theta)
+        * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
         * np.exp(-result.attenuation_per_m * depth / cos_t)
+    )
     floor = result.floor_irradiance.astype(np.float64)
     # Newton's hits sit on the light view's texel centres, so its path lengths (hence attenuation)
     # are off by up to half a texel of that buffer: ~1e-4 here; the exact hits agree to float32.
@@ -46,9 +59,18 @@ def test_flat_water_photons_match_analytic_irradiance(device, intersection, elev
 
 def test_photon_flux_is_conserved_on_a_rough_ocean(device):
     """water_type = none: flux deposited on the floor = flux the photons carry through the surface."""
-    scene = wc.load_scene("configs/ocean.toml", {
-        **PHOTONS, "water.resolution": 64, "water.wind_speed_m_s": 9.0, "water.choppiness": 0.8,
-        "caustics.map_resolution": 48, "optics.water_type": "none", "optics.wavelengths": "rgb"})
+    scene = wc.load_scene(
+        "configs/ocean.toml",
+        {
+            **PHOTONS,
+            "water.resolution": 64,
+            "water.wind_speed_m_s": 9.0,
+            "water.choppiness": 0.8,
+            "caustics.map_resolution": 48,
+            "optics.water_type": "none",
+            "optics.wavelengths": "rgb",
+        },
+    )
     result = wc.render(scene, device=device)
     assert result.photon_stats["landed"] == result.photon_stats["carrying"] > 0
     # float32 atomic sums of ~1e4 photons per band into texels, then a float64 total: 1e-4 is the
@@ -59,10 +81,18 @@ def test_photon_flux_is_conserved_on_a_rough_ocean(device):
 def test_photon_flux_is_conserved_in_a_walled_pool_with_an_object(device):
     """In a pool every transmitted photon lands on the floor, a wall or the object: their fluxes
     add up to what entered the water (water_type = none)."""
-    scene = wc.load_scene("configs/pool.toml", {
-        **PHOTONS, "water.resolution": 48, "caustics.map_resolution": 48, "optics.water_type": "none",
-        "optics.wavelengths": "rgb", "sun.elevation_deg": 40.0,
-        "receivers": [{"mesh": "sphere", "scale": 0.8, "translate_m": [0.3, -0.2, -1.0]}]})
+    scene = wc.load_scene(
+        "configs/pool.toml",
+        {
+            **PHOTONS,
+            "water.resolution": 48,
+            "caustics.map_resolution": 48,
+            "optics.water_type": "none",
+            "optics.wavelengths": "rgb",
+            "sun.elevation_deg": 40.0,
+            "receivers": [{"mesh": "sphere", "scale": 0.8, "translate_m": [0.3, -0.2, -1.0]}],
+        },
+    )
     renderer = wc.Renderer(scene, device)
     result = renderer.render(0.6)
     assert result.photon_stats["landed"] == result.photon_stats["carrying"]
@@ -77,23 +107,41 @@ def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
     """Statistics of |Newton hit − exact hit| [m] for each k in ``iterations`` over the photons whose
     exact hit is on receiver id ``receiver``: dicts of mean, median, p95 and ``within_texel`` (the
     share closer than one light-view texel); and that texel's size [m]."""
-    base = {**PHOTONS, "water.resolution": 64, "caustics.map_resolution": 64, "optics.wavelengths": "rgb",
-            "caustics.photon_subdivisions": 2, **scene_overrides}
-    exact = wc.Renderer(wc.load_scene("configs/ocean.toml", {**base, "caustics.intersection": "exact"}), device)
+    base = {
+        **PHOTONS,
+        "water.resolution": 64,
+        "caustics.map_resolution": 64,
+        "optics.wavelengths": "rgb",
+        "caustics.photon_subdivisions": 2,
+        **scene_overrides,
+    }
+    exact = wc.Renderer(
+        wc.load_scene("configs/ocean.toml", {**base, "caustics.intersection": "exact"}), device
+    )
     exact.render(0.0)
     hit = exact.photons.hit.numpy().copy()
     face = exact.photons.face.numpy().copy()
     on_receiver = exact.receivers.face_receiver_np[np.maximum(face, 0)] == receiver
     out = []
     for k in iterations:
-        r = wc.Renderer(wc.load_scene("configs/ocean.toml", {
-            **base, "caustics.intersection": "newton", "caustics.newton_iterations": k}), device)
+        r = wc.Renderer(
+            wc.load_scene(
+                "configs/ocean.toml",
+                {**base, "caustics.intersection": "newton", "caustics.newton_iterations": k},
+            ),
+            device,
+        )
         r.render(0.0)
         ok = (face >= 0) & on_receiver & (r.photons.face.numpy() >= 0)
         err = np.linalg.norm(r.photons.hit.numpy()[ok] - hit[ok], axis=1)
-        out.append({"mean": float(err.mean()), "median": float(np.median(err)),
-                    "p95": float(np.percentile(err, 95)),
-                    "within_texel": float(np.mean(err < r.photons.view.texel_m))})
+        out.append(
+            {
+                "mean": float(err.mean()),
+                "median": float(np.median(err)),
+                "p95": float(np.percentile(err, 95)),
+                "within_texel": float(np.mean(err < r.photons.view.texel_m)),
+            }
+        )
     return out, r.photons.view.texel_m
 
 
@@ -124,34 +172,50 @@ def test_newton_hits_approach_the_exact_hits_on_a_mesh():
 def test_occluded_floor_receives_no_caustic_light():
     """A box above the floor, sun at the zenith over flat water: the floor under it is dark, its top
     receives E_sun T(0) (water_type = none)."""
-    scene = _flat(90.0, 3.0, "none", **{"caustics.map_resolution": 64, "receivers": [
-        {"mesh": "cube", "scale": [2.0, 2.0, 1.0], "translate_m": [0.0, 0.0, -2.0]}]})
+    scene = _flat(
+        90.0,
+        3.0,
+        "none",
+        **{
+            "caustics.map_resolution": 64,
+            "receivers": [{"mesh": "cube", "scale": [2.0, 2.0, 1.0], "translate_m": [0.0, 0.0, -2.0]}],
+        },
+    )
     result = wc.render(scene, device="cpu")
     x = (np.arange(64) + 0.5) * 8.0 / 64 - 4.0
     under = (np.abs(x)[:, None] < 0.99) & (np.abs(x)[None, :] < 0.99)
     assert np.all(result.floor_irradiance[:, under] == 0.0)
     open_floor = (np.abs(x)[:, None] > 1.01) | (np.abs(x)[None, :] > 1.01)
     t0 = fresnel_t_angles(np.array([0.0]), 1.0, 1.333)[0]
-    np.testing.assert_allclose(result.floor_irradiance[:, open_floor].mean(axis=1, dtype=np.float64),
-                               result.sun_irradiance * t0,
-                               rtol=1e-5)
+    np.testing.assert_allclose(
+        result.floor_irradiance[:, open_floor].mean(axis=1, dtype=np.float64),
+        result.sun_irradiance * t0,
+        rtol=1e-5,
+    )
     # The cube's top faces (normal +z, z = -1.5) get the full beam; its sides none.
     faces = result.face_receiver == 2
     irr = result.receiver_irradiance(2)
     top = np.isclose(result.face_centres_m[faces][:, 2], -1.5, atol=1e-6)
     assert top.sum() > 0
     top_flux = result.face_flux_w_nm[faces][top].sum(axis=0, dtype=np.float64)
-    np.testing.assert_allclose(top_flux / result.face_area_m2[faces][top].sum(), result.sun_irradiance * t0,
-                               rtol=1e-4)
+    np.testing.assert_allclose(
+        top_flux / result.face_area_m2[faces][top].sum(), result.sun_irradiance * t0, rtol=1e-4
+    )
     assert irr[~top].max() == 0.0
 
 
 def test_camera_gbuffer_sees_a_box_at_its_analytic_depth():
     """G-buffer of a box face: depth along each pixel ray = plane distance / cos(ray, axis)."""
-    overrides = {"camera.enabled": True, "camera.position_m": [0.0, -3.0, -2.0],
-                 "camera.look_at_m": [0.0, 0.0, -2.0], "camera.width": 40, "camera.height": 30,
-                 "camera.fov_deg": 20.0, "caustics.shafts": False,
-                 "receivers": [{"mesh": "cube", "scale": 2.0, "translate_m": [0.0, 0.0, -2.0]}]}
+    overrides = {
+        "camera.enabled": True,
+        "camera.position_m": [0.0, -3.0, -2.0],
+        "camera.look_at_m": [0.0, 0.0, -2.0],
+        "camera.width": 40,
+        "camera.height": 30,
+        "camera.fov_deg": 20.0,
+        "caustics.shafts": False,
+        "receivers": [{"mesh": "cube", "scale": 2.0, "translate_m": [0.0, 0.0, -2.0]}],
+    }
     result = wc.render(_flat(60.0, 4.0, **overrides), device="cpu")
     g = result.camera_gbuffer
     # The face y = -1 fills the view (it spans ±1 m at 2 m: ±26.6° > the ±10° field of view).
@@ -166,11 +230,23 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool():
     """Sun at the zenith over a still pool: the shaft radiance seen along a near-horizontal ray is
     ∫ σ_s p(θ) E_sun T e^{-c(ℓ(s) + s)} ds, integrated analytically per pixel to the far wall."""
     z_cam = -0.75
-    overrides = {**PHOTONS, "water.model": "pool", "water.resolution": 64, "water.extent_m": 4.0,
-                 "floor.depth_m": 1.5, "caustics.map_resolution": 64, "sun.elevation_deg": 90.0,
-                 "optics.water_type": "clear_ocean", "optics.wavelengths": "rgb", "camera.enabled": True,
-                 "camera.position_m": [-1.9, 0.0, z_cam], "camera.look_at_m": [0.0, 0.0, z_cam],
-                 "camera.width": 64, "camera.height": 48, "camera.fov_deg": 30.0}
+    overrides = {
+        **PHOTONS,
+        "water.model": "pool",
+        "water.resolution": 64,
+        "water.extent_m": 4.0,
+        "floor.depth_m": 1.5,
+        "caustics.map_resolution": 64,
+        "sun.elevation_deg": 90.0,
+        "optics.water_type": "clear_ocean",
+        "optics.wavelengths": "rgb",
+        "camera.enabled": True,
+        "camera.position_m": [-1.9, 0.0, z_cam],
+        "camera.look_at_m": [0.0, 0.0, z_cam],
+        "camera.width": 64,
+        "camera.height": 48,
+        "camera.fov_deg": 30.0,
+    }
     scene = wc.load_scene(None, overrides)
     result = wc.render(scene, device="cpu")
     g = result.camera_gbuffer
@@ -187,8 +263,15 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool():
     phase = PhaseFunction.from_optics(cfg.optics, "cpu").evaluate(-vz.ravel(), "cpu").reshape(vz.shape)
     # Along the ray ℓ(s) = -(z_cam + s v_z) (light comes straight down from z = 0).
     k = c[:, None, None] * (1.0 - vz)
-    expected = (b[:, None, None] * phase * result.sun_irradiance[:, None, None] * t0 * np.exp(c[:, None, None] * z_cam)
-                * (1.0 - np.exp(-k * dist)) / k)
+    expected = (
+        b[:, None, None]
+        * phase
+        * result.sun_irradiance[:, None, None]
+        * t0
+        * np.exp(c[:, None, None] * z_cam)
+        * (1.0 - np.exp(-k * dist))
+        / k
+    )
     # The far wall gets no direct light (vertical rays graze it), so this is all shaft radiance.
     measured = result.camera_radiance[:, rows, cols]
     # Photon lines are 6.25 cm apart, pixels ~2-4 cm across at these distances: single pixels
@@ -203,8 +286,10 @@ def test_photons_agree_with_the_flux_ratio_map():
     reference = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu").floor_irradiance
     l1 = []
     for s in (1, 4):
-        f = wc.render(wc.load_scene("configs/ocean.toml", {**base, **PHOTONS, "caustics.photon_subdivisions": s}),
-                      device="cpu").floor_irradiance
+        f = wc.render(
+            wc.load_scene("configs/ocean.toml", {**base, **PHOTONS, "caustics.photon_subdivisions": s}),
+            device="cpu",
+        ).floor_irradiance
         l1.append(np.abs(f - reference).sum() / np.abs(reference).sum())
     assert l1[1] < 0.03 and l1[1] < l1[0]
 
@@ -223,8 +308,15 @@ def test_photon_scene_errors_are_one_line():
     with pytest.raises(ConfigError, match=r"receivers\[0\].translate_m .* must have 3 values"):
         wc.load_scene(None, {**PHOTONS, "receivers": [{"translate_m": [1.0, 2.0]}]})
     with pytest.raises(ConfigError, match="camera.up .* parallel"):
-        wc.load_scene(None, {**PHOTONS, "camera.enabled": True, "camera.position_m": [0, 0, -1],
-                             "camera.look_at_m": [0, 0, -3]})
+        wc.load_scene(
+            None,
+            {
+                **PHOTONS,
+                "camera.enabled": True,
+                "camera.position_m": [0, 0, -1],
+                "camera.look_at_m": [0, 0, -3],
+            },
+        )
     scene = _flat(60.0, 3.0, **{"camera.enabled": True, "camera.position_m": [0.0, -2.0, 0.5]})
     with pytest.raises(WarpcausticsError, match="not under the water"):
         wc.render(scene, device="cpu")

@@ -50,8 +50,14 @@ def camera_bytes(cfg: CameraConfig, k: int) -> int:
 class UnderwaterCamera:
     """A pinhole camera's buffers for one scene on one device."""
 
-    def __init__(self, cfg: CameraConfig, receivers: Receivers, scattering_per_m: np.ndarray,
-                 phase: PhaseFunction, device: str):
+    def __init__(
+        self,
+        cfg: CameraConfig,
+        receivers: Receivers,
+        scattering_per_m: np.ndarray,
+        phase: PhaseFunction,
+        device: str,
+    ):
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -59,7 +65,9 @@ class UnderwaterCamera:
         self.cam = pinhole(cfg)
         h, w = cfg.height, cfg.width
         k = receivers.albedo.shape[1]
-        self.scattering_per_m = wp.array(np.asarray(scattering_per_m, np.float32), dtype=wp.float32, device=device)
+        self.scattering_per_m = wp.array(
+            np.asarray(scattering_per_m, np.float32), dtype=wp.float32, device=device
+        )
         self.position = wp.empty((h, w), dtype=wp.vec3, device=device)
         self.normal = wp.empty((h, w), dtype=wp.vec3, device=device)
         self.depth = wp.empty((h, w), dtype=wp.float32, device=device)
@@ -70,10 +78,13 @@ class UnderwaterCamera:
         self.shafts = wp.empty((k, h, w), dtype=wp.float32, device=device)
         self.shafts_raw = wp.empty((k, h, w), dtype=wp.float32, device=device)
         self.radiance = wp.empty((k, h, w), dtype=wp.float32, device=device)
-        wp.launch(camera_kernels.gbuffer, dim=(h, w),
-                  inputs=[self.cam, receivers.mesh.id, receivers.face_receiver],
-                  outputs=[self.position, self.normal, self.depth, self.receiver, self.inv_footprint],
-                  device=device)
+        wp.launch(
+            camera_kernels.gbuffer,
+            dim=(h, w),
+            inputs=[self.cam, receivers.mesh.id, receivers.face_receiver],
+            outputs=[self.position, self.normal, self.depth, self.receiver, self.inv_footprint],
+            device=device,
+        )
 
     @property
     def position_z(self) -> float:
@@ -87,34 +98,84 @@ class UnderwaterCamera:
         per_group = k // photons.groups
         count = photons.weight.shape[0]
         self.caustic.zero_()
-        wp.launch(camera_kernels.splat_photons, dim=count,
-                  inputs=[self.cam, photons.hit, photons.face, photons.origin, photons.weight,
-                          photons.photons_per_group, photons.sun_irradiance, photons.attenuation_per_m,
-                          per_group, float(photon_spacing_m), self.depth, self.inv_footprint,
-                          DEPTH_TOLERANCE],
-                  outputs=[self.caustic], device=dev)
+        wp.launch(
+            camera_kernels.splat_photons,
+            dim=count,
+            inputs=[
+                self.cam,
+                photons.hit,
+                photons.face,
+                photons.origin,
+                photons.weight,
+                photons.photons_per_group,
+                photons.sun_irradiance,
+                photons.attenuation_per_m,
+                per_group,
+                float(photon_spacing_m),
+                self.depth,
+                self.inv_footprint,
+                DEPTH_TOLERANCE,
+            ],
+            outputs=[self.caustic],
+            device=dev,
+        )
         self.shafts_raw.zero_()
         if shafts:
             stride = photons.subdivisions**2  # one line per surface cell, carrying the cell's photons
             ph = self.phase
-            wp.launch(camera_kernels.shaft_lines, dim=count // stride,
-                      inputs=[self.cam, photons.hit, photons.face, photons.origin, photons.direction,
-                              photons.weight, stride, float(photon_spacing_m * photons.subdivisions),
-                              photons.photons_per_group, photons.sun_irradiance, photons.attenuation_per_m,
-                              self.scattering_per_m, per_group, ph.kind, ph.g, ph.angles_rad, ph.log_phase,
-                              ph.cone_phase, self.depth],
-                      outputs=[self.shafts_raw], device=dev)
+            wp.launch(
+                camera_kernels.shaft_lines,
+                dim=count // stride,
+                inputs=[
+                    self.cam,
+                    photons.hit,
+                    photons.face,
+                    photons.origin,
+                    photons.direction,
+                    photons.weight,
+                    stride,
+                    float(photon_spacing_m * photons.subdivisions),
+                    photons.photons_per_group,
+                    photons.sun_irradiance,
+                    photons.attenuation_per_m,
+                    self.scattering_per_m,
+                    per_group,
+                    ph.kind,
+                    ph.g,
+                    ph.angles_rad,
+                    ph.log_phase,
+                    ph.cone_phase,
+                    self.depth,
+                ],
+                outputs=[self.shafts_raw],
+                device=dev,
+            )
         h, w = self.cfg.height, self.cfg.width
-        wp.launch(camera_kernels.blur3, dim=(k, h, w), inputs=[self.shafts_raw], outputs=[self.shafts],
-                  device=dev)
-        wp.launch(camera_kernels.shade, dim=(k, h, w),
-                  inputs=[self.receiver, self.depth, self.caustic, self.shafts, self.receivers.albedo_wp,
-                          photons.attenuation_per_m],
-                  outputs=[self.radiance], device=dev)
+        wp.launch(
+            camera_kernels.blur3, dim=(k, h, w), inputs=[self.shafts_raw], outputs=[self.shafts], device=dev
+        )
+        wp.launch(
+            camera_kernels.shade,
+            dim=(k, h, w),
+            inputs=[
+                self.receiver,
+                self.depth,
+                self.caustic,
+                self.shafts,
+                self.receivers.albedo_wp,
+                photons.attenuation_per_m,
+            ],
+            outputs=[self.radiance],
+            device=dev,
+        )
         return self.radiance
 
     def gbuffer(self) -> dict[str, np.ndarray]:
         depth = self.depth.numpy().copy()
         depth[depth >= 1.0e29] = np.inf
-        return {"position": self.position.numpy().copy(), "normal": self.normal.numpy().copy(),
-                "depth": depth, "receiver": self.receiver.numpy().copy()}
+        return {
+            "position": self.position.numpy().copy(),
+            "normal": self.normal.numpy().copy(),
+            "depth": depth,
+            "receiver": self.receiver.numpy().copy(),
+        }

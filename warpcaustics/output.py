@@ -96,7 +96,6 @@ def versions() -> dict[str, str]:
 
 def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     """Write one frame's ``frame_NNNN.exr`` (RGB + spectral bands) and ``frame_NNNN.png``."""
-    from warpcaustics import colour_out
 
     out_dir.mkdir(parents=True, exist_ok=True)
     image = result.floor_irradiance[:, ::-1, :]  # image row 0 = largest y
@@ -131,7 +130,8 @@ def _write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, heade
         srgb = colour_out.xyz_to_linear_rgb(xyz, "sRGB", white)
     write_exr(exr, rgb, image if out_cfg.spectral_exr else None, result.wavelengths_nm, {
         **header, "warpcaustics.time_s": f"{result.time_s:g}",
-        "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance {out_cfg.white_balance.value}"},
+        "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance "
+                            f"{out_cfg.white_balance.value}"},
         units=units)
     write_png(png, colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
 

@@ -30,8 +30,14 @@ def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face
     """Device memory of the photon stage, receivers included [bytes]."""
     m = cfg.caustics.map_resolution
     r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
-    return (photon_count(cfg, n, groups, periodic) * PHOTON_BYTES + 2 * k * m * m * 4 + m * m * 4
-            + r * r * 16 + face_count * (k * 4 + 4 + 12 + 64) + n * n * 4)
+    return (
+        photon_count(cfg, n, groups, periodic) * PHOTON_BYTES
+        + 2 * k * m * m * 4
+        + m * m * 4
+        + r * r * 16
+        + face_count * (k * 4 + 4 + 12 + 64)
+        + n * n * 4
+    )
 
 
 @dataclass
@@ -61,9 +67,19 @@ def light_view_frame(points: np.ndarray, sun_dir: np.ndarray, resolution: int):
 class PhotonCaustics:
     """Owns the photon stage's device buffers for one scene, reused from frame to frame."""
 
-    def __init__(self, cfg: Config, receivers: Receivers, n: int, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, groups: int, sun_dir: np.ndarray, device: str, *,
-                 periodic: bool):
+    def __init__(
+        self,
+        cfg: Config,
+        receivers: Receivers,
+        n: int,
+        sun_irradiance: np.ndarray,
+        attenuation_per_m: np.ndarray,
+        groups: int,
+        sun_dir: np.ndarray,
+        device: str,
+        *,
+        periodic: bool,
+    ):
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -75,9 +91,12 @@ class PhotonCaustics:
         self.photons_per_group = count // groups
         k = len(sun_irradiance)
         m = cfg.caustics.map_resolution
-        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device)
-        self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
-                                          device=device)
+        self.sun_irradiance = wp.array(
+            np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device
+        )
+        self.attenuation_per_m = wp.array(
+            np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
+        )
         self.origin = wp.empty(count, dtype=wp.vec3, device=device)
         self.direction = wp.empty(count, dtype=wp.vec3, device=device)
         self.weight = wp.empty(count, dtype=wp.float32, device=device)
@@ -90,16 +109,20 @@ class PhotonCaustics:
         other_faces = max(receivers.face_count - receivers.floor_face_count, 1)
         self.face_flux = wp.empty((other_faces, k), dtype=wp.float32, device=device)
         """Flux on each non-floor face (F_other, K) [W nm^-1]."""
-        self.floor_inv_area = wp.array((1.0 / receivers.floor_texel_area_m2).astype(np.float32),
-                                       dtype=wp.float32, device=device)
+        self.floor_inv_area = wp.array(
+            (1.0 / receivers.floor_texel_area_m2).astype(np.float32), dtype=wp.float32, device=device
+        )
         sun = np.asarray(sun_dir, np.float64)
         self.sun_dir = wp.vec3(*sun.astype(np.float32))
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
-        self.view = self._light_view(sun, cfg.caustics.newton_buffer_resolution
-                                     if cfg.caustics.intersection is Intersection.NEWTON else 1)
-        self.newton_iterations = (cfg.caustics.newton_iterations
-                                  if cfg.caustics.intersection is Intersection.NEWTON else -1)
+        self.view = self._light_view(
+            sun,
+            cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 1,
+        )
+        self.newton_iterations = (
+            cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
+        )
 
     def _light_view(self, sun: np.ndarray, resolution: int) -> photon_kernels.LightView:
         # The view needs the receivers where photons land: on a periodic sea that is the patch
@@ -107,8 +130,10 @@ class PhotonCaustics:
         points = self.receivers.points
         if self.periodic:
             reach = 0.55 * self.cfg.water.extent_m
-            points = points[np.all(np.abs(points[:, :2]) <= reach, axis=1)
-                            | (np.arange(len(points)) >= self.receivers.floor_vertex_count)]
+            points = points[
+                np.all(np.abs(points[:, :2]) <= reach, axis=1)
+                | (np.arange(len(points)) >= self.receivers.floor_vertex_count)
+            ]
         origin, u, v, texel = light_view_frame(points, sun, resolution)
         view = photon_kernels.LightView()
         view.origin = wp.vec3(*origin.astype(np.float32))
@@ -119,8 +144,12 @@ class PhotonCaustics:
         view.faces = wp.empty((resolution, resolution), dtype=wp.int32, device=self.device)
         if resolution > 1:
             distance = float(np.abs(self.receivers.points @ sun).max() + 1.0)
-            wp.launch(photon_kernels.render_light_view, dim=(resolution, resolution),
-                      inputs=[self.receivers.mesh.id, self.sun_dir, distance, view], device=self.device)
+            wp.launch(
+                photon_kernels.render_light_view,
+                dim=(resolution, resolution),
+                inputs=[self.receivers.mesh.id, self.sun_dir, distance, view],
+                device=self.device,
+            )
         return view
 
     def run(self, surface: Surface, visible: wp.array2d, group_ior: np.ndarray) -> wp.array3d:
@@ -129,25 +158,71 @@ class PhotonCaustics:
         s = self.subdivisions
         ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=dev)
         extent = float(surface.extent_m)
-        wp.launch(photon_kernels.emit_photons, dim=(self.groups, self.quads, self.quads, s * s),
-                  inputs=[surface.positions, surface.normals, visible, ior, self.sun_dir, s, extent,
-                          int(self.periodic)],
-                  outputs=[self.origin, self.direction, self.weight], device=dev)
-        wp.launch(photon_kernels.trace_photons, dim=self.weight.shape[0],
-                  inputs=[self.receivers.mesh.id, self.view, self.receivers.face_receiver, self.newton_iterations, extent,
-                          int(self.periodic), float(self.plane_z), self.origin, self.direction, self.weight],
-                  outputs=[self.hit, self.face], device=dev)
+        wp.launch(
+            photon_kernels.emit_photons,
+            dim=(self.groups, self.quads, self.quads, s * s),
+            inputs=[
+                surface.positions,
+                surface.normals,
+                visible,
+                ior,
+                self.sun_dir,
+                s,
+                extent,
+                int(self.periodic),
+            ],
+            outputs=[self.origin, self.direction, self.weight],
+            device=dev,
+        )
+        wp.launch(
+            photon_kernels.trace_photons,
+            dim=self.weight.shape[0],
+            inputs=[
+                self.receivers.mesh.id,
+                self.view,
+                self.receivers.face_receiver,
+                self.newton_iterations,
+                extent,
+                int(self.periodic),
+                float(self.plane_z),
+                self.origin,
+                self.direction,
+                self.weight,
+            ],
+            outputs=[self.hit, self.face],
+            device=dev,
+        )
         self.texels.zero_()
         self.face_flux.zero_()
         k = self.sun_irradiance.shape[0]
-        wp.launch(photon_kernels.deposit_photons, dim=self.weight.shape[0],
-                  inputs=[self.hit, self.face, self.origin, self.weight, self.photons_per_group,
-                          self.sun_irradiance, self.attenuation_per_m, k // self.groups,
-                          self.receivers.floor_face_count, extent, int(self.periodic), self.floor_inv_area],
-                  outputs=[self.texels, self.face_flux], device=dev)
+        wp.launch(
+            photon_kernels.deposit_photons,
+            dim=self.weight.shape[0],
+            inputs=[
+                self.hit,
+                self.face,
+                self.origin,
+                self.weight,
+                self.photons_per_group,
+                self.sun_irradiance,
+                self.attenuation_per_m,
+                k // self.groups,
+                self.receivers.floor_face_count,
+                extent,
+                int(self.periodic),
+                self.floor_inv_area,
+            ],
+            outputs=[self.texels, self.face_flux],
+            device=dev,
+        )
         m = self.texels.shape[0]
-        wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels], outputs=[self.irradiance],
-                  device=dev)
+        wp.launch(
+            floor_kernels.texels_to_bands,
+            dim=(m, m),
+            inputs=[self.texels],
+            outputs=[self.irradiance],
+            device=dev,
+        )
         return self.irradiance
 
     def transmitted_flux(self) -> np.ndarray:
@@ -158,8 +233,11 @@ class PhotonCaustics:
 
     def stats(self) -> PhotonStats:
         w = self.weight.numpy()
-        return PhotonStats(emitted=len(w), carrying=int(np.count_nonzero(w > 0)),
-                           landed=int(np.count_nonzero(self.face.numpy() >= 0)))
+        return PhotonStats(
+            emitted=len(w),
+            carrying=int(np.count_nonzero(w > 0)),
+            landed=int(np.count_nonzero(self.face.numpy() >= 0)),
+        )
 
 
 def photons_per_texel(cfg: Config, n: int) -> float:

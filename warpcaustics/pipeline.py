@@ -13,9 +13,9 @@ import warp as wp
 
 from warpcaustics import caustics, photons, spectra
 from warpcaustics import device as devices
-from warpcaustics.errors import WarpcausticsError
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.config import CausticsMethod
+from warpcaustics.errors import WarpcausticsError
 from warpcaustics.phase import PhaseFunction
 from warpcaustics.receivers import Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
@@ -233,7 +233,8 @@ class Renderer:
                         f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
                         "above the water is not implemented yet: lower the camera")
                 with watch.stage("camera"):
-                    spacing = cfg.water.extent_m / self.scene.water_resolution / cfg.caustics.photon_subdivisions
+                    n = self.scene.water_resolution
+                    spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
                     self.camera.render(self.photons, spacing, cfg.caustics.shafts)
                     extra["camera_radiance"] = self.camera.radiance.numpy().copy()
                     extra["camera_gbuffer"] = self.camera.gbuffer()
@@ -241,7 +242,8 @@ class Renderer:
                 floor_np = floor.numpy().copy()
                 transmitted = self.photons.transmitted_flux()
                 rec = self.receivers
-                extra.update(face_flux_w_nm=self.photons.face_flux.numpy()[: rec.face_count - rec.floor_face_count].copy(),
+                other = rec.face_count - rec.floor_face_count
+                extra.update(face_flux_w_nm=self.photons.face_flux.numpy()[:other].copy(),
                              face_receiver=rec.face_receiver_np[rec.floor_face_count:],
                              face_area_m2=rec.face_area_m2[rec.floor_face_count:],
                              face_centres_m=rec.face_centres_m[rec.floor_face_count:],

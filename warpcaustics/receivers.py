@@ -31,8 +31,9 @@ WALL_CELLS = 32
 """Wall quads per side along the wall (and 8 up it)."""
 
 
-def floor_relief_height(floor: FloorConfig, relief: np.ndarray | None, extent_m: float, x: np.ndarray,
-                        y: np.ndarray) -> np.ndarray:
+def floor_relief_height(
+    floor: FloorConfig, relief: np.ndarray | None, extent_m: float, x: np.ndarray, y: np.ndarray
+) -> np.ndarray:
     """Floor height z(x, y) [m] (float64): -depth_m plus the relief of ``floor.shape``."""
     x = np.asarray(x, np.float64)
     y = np.asarray(y, np.float64)
@@ -59,7 +60,7 @@ def _periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndar
     tu, tv = u - i0, v - j0
     i0, j0 = i0 % n, j0 % n
     i1, j1 = (i0 + 1) % n, (j0 + 1) % n
-    return ((1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1]) + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1]))
+    return (1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1]) + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1])
 
 
 def load_floor_relief(path: Path) -> np.ndarray:
@@ -71,8 +72,10 @@ def load_floor_relief(path: Path) -> np.ndarray:
     except (OSError, ValueError) as exc:
         raise ConfigError(f"floor.file = {str(path)!r} is not a readable .npy array: {exc}") from None
     if relief.ndim != 2 or relief.shape[0] != relief.shape[1] or relief.shape[0] < 2:
-        raise ConfigError(f"floor.file = {str(path)!r} has shape {relief.shape}; expected a square 2-D "
-                          "array of at least 2×2 heights")
+        raise ConfigError(
+            f"floor.file = {str(path)!r} has shape {relief.shape}; expected a square 2-D "
+            "array of at least 2×2 heights"
+        )
     if not np.issubdtype(relief.dtype, np.floating) or not np.all(np.isfinite(relief)):
         raise ConfigError(f"floor.file = {str(path)!r} must hold finite float heights [m]")
     return relief.astype(np.float64)
@@ -98,13 +101,17 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
             path = Path(receiver.mesh)
             path = path if path.is_absolute() else base_dir / path
             if not path.is_file():
-                raise ConfigError(f"{key}.mesh = {receiver.mesh!r} is neither a built-in mesh "
-                                  f"({', '.join(PRIMITIVES)}) nor an existing file")
+                raise ConfigError(
+                    f"{key}.mesh = {receiver.mesh!r} is neither a built-in mesh "
+                    f"({', '.join(PRIMITIVES)}) nor an existing file"
+                )
             try:
                 poly = pv.read(str(path))
             except Exception as exc:  # pyvista raises many kinds for unreadable files
-                raise ConfigError(f"{key}.mesh = {receiver.mesh!r} cannot be read by pyvista: "
-                                  f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+                raise ConfigError(
+                    f"{key}.mesh = {receiver.mesh!r} cannot be read by pyvista: "
+                    f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}"
+                ) from None
         poly = poly.extract_surface().triangulate().clean()
     if poly.n_cells == 0:
         raise ConfigError(f"{key}.mesh = {receiver.mesh!r} has no triangles")
@@ -151,7 +158,9 @@ def _grid_mesh(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> TriangleMesh:
     points = np.stack([x, y, z], axis=-1).reshape(-1, 3)
     idx = np.arange(ny * nx).reshape(ny, nx)
     a, b, c, d = idx[:-1, :-1], idx[:-1, 1:], idx[1:, :-1], idx[1:, 1:]
-    triangles = np.concatenate([np.stack([a, b, d], -1).reshape(-1, 3), np.stack([a, d, c], -1).reshape(-1, 3)])
+    triangles = np.concatenate(
+        [np.stack([a, b, d], -1).reshape(-1, 3), np.stack([a, d, c], -1).reshape(-1, 3)]
+    )
     return TriangleMesh(points, triangles)
 
 
@@ -165,9 +174,23 @@ def floor_mesh(cfg: Config, relief: np.ndarray | None, periodic: bool) -> Triang
     cell = extent / cells
     margin_cells = 0
     if periodic:
-        relief_range = 0.0 if planar else float(np.ptp(floor_relief_height(
-            floor, relief, extent, *np.meshgrid(np.linspace(-extent / 2, extent / 2, 257),
-                                                np.linspace(-extent / 2, extent / 2, 257)))))
+        relief_range = (
+            0.0
+            if planar
+            else float(
+                np.ptp(
+                    floor_relief_height(
+                        floor,
+                        relief,
+                        extent,
+                        *np.meshgrid(
+                            np.linspace(-extent / 2, extent / 2, 257),
+                            np.linspace(-extent / 2, extent / 2, 257),
+                        ),
+                    )
+                )
+            )
+        )
         margin_cells = math.ceil((0.05 * extent + 4.0 * relief_range) / cell)
     coords = (np.arange(-margin_cells, cells + margin_cells + 1) * cell) - 0.5 * extent
     x, y = np.meshgrid(coords, coords)
@@ -225,14 +248,25 @@ def floor_texel_area(cfg: Config, relief: np.ndarray | None) -> np.ndarray:
     x, y = np.meshgrid(coords, coords)
     p = np.stack([x, y, floor_relief_height(cfg.floor, relief, extent, x, y)], axis=-1)
     a, b, c, d = p[:-1, :-1], p[:-1, 1:], p[1:, :-1], p[1:, 1:]
-    return 0.5 * (np.linalg.norm(np.cross(b - a, d - a), axis=-1) + np.linalg.norm(np.cross(d - a, c - a), axis=-1))
+    return 0.5 * (
+        np.linalg.norm(np.cross(b - a, d - a), axis=-1) + np.linalg.norm(np.cross(d - a, c - a), axis=-1)
+    )
 
 
 class Receivers:
     """All receivers of a scene on one device: the BVH, face → receiver ids, albedos per band."""
 
-    def __init__(self, cfg: Config, bins: SpectralBins, device: str, *, periodic: bool,
-                 relief: np.ndarray | None, meshes: tuple[TriangleMesh, ...], water_top_z: float):
+    def __init__(
+        self,
+        cfg: Config,
+        bins: SpectralBins,
+        device: str,
+        *,
+        periodic: bool,
+        relief: np.ndarray | None,
+        meshes: tuple[TriangleMesh, ...],
+        water_top_z: float,
+    ):
         floor = floor_mesh(cfg, relief, periodic)
         parts = [floor]
         ids = [np.full(len(floor.triangles), FLOOR_ID)]
@@ -260,7 +294,9 @@ class Receivers:
         self.face_receiver_np = np.concatenate(ids).astype(np.int32)
         tri = whole.points[whole.triangles]
         self.face_centres_m = tri.mean(axis=1)
-        self.face_area_m2 = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=-1)
+        self.face_area_m2 = 0.5 * np.linalg.norm(
+            np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=-1
+        )
         grey_walls = (0.8,)
         albedos = [cfg.floor.albedo, grey_walls] + [r.albedo for r in cfg.receivers]
         self.albedo = np.stack([albedo_spectrum(a, bins) for a in albedos])
