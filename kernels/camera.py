@@ -102,6 +102,70 @@ def same_surface(depth_pixel: float, distance: float, tolerance: float) -> bool:
     return wp.abs(depth_pixel - distance) <= tolerance * depth_pixel + 1.0e-3
 
 
+@wp.func
+def unwrap(a: wp.vec3, b: wp.vec3, periodic: int, extent_m: float) -> wp.vec3:
+    """b − a, with whole periods removed on a periodic sea (neighbours may be shifted differently)."""
+    e = b - a
+    if periodic != 0:
+        e = e - wp.vec3(extent_m * wp.round(e[0] / extent_m), extent_m * wp.round(e[1] / extent_m), 0.0)
+    return e
+
+
+@wp.func
+def grid_neighbour(p: int, along_v: int, quads: int, s: int, periodic: int) -> int:
+    """Index of the next photon of the light-space grid along u (along_v = 0) or v; −1 at a wall."""
+    sub = p % (s * s)
+    cell = p / (s * s)
+    qx = cell % quads
+    qy = (cell / quads) % quads
+    base = cell - qx - qy * quads  # first cell of this index group
+    a = sub % s
+    b = sub / s
+    if along_v == 0:
+        a += 1
+        if a == s:
+            a = 0
+            qx += 1
+    else:
+        b += 1
+        if b == s:
+            b = 0
+            qy += 1
+    if qx == quads or qy == quads:
+        if periodic == 0:
+            return -1
+        qx = qx % quads
+        qy = qy % quads
+    return (base + qy * quads + qx) * s * s + b * s + a
+
+
+@wp.func
+def photon_spacing_on_receiver(
+    hit: wp.array[wp.vec3],
+    face: wp.array[wp.int32],
+    p: int,
+    quads: int,
+    s: int,
+    periodic: int,
+    extent_m: float,
+    fallback_m: float,
+) -> float:
+    """√(area between photon p and its two grid neighbours' hits) [m]; ``fallback_m`` where a
+    neighbour is missing or the parallelogram collapses (a focus)."""
+    nu = grid_neighbour(p, 0, quads, s, periodic)
+    nv = grid_neighbour(p, 1, quads, s, periodic)
+    if nu < 0 or nv < 0:
+        return fallback_m
+    if face[nu] < 0 or face[nv] < 0:
+        return fallback_m
+    eu = unwrap(hit[p], hit[nu], periodic, extent_m)
+    ev = unwrap(hit[p], hit[nv], periodic, extent_m)
+    area = wp.length(wp.cross(eu, ev))
+    if area <= 0.0:
+        return fallback_m
+    return wp.min(wp.sqrt(area), 8.0 * fallback_m)
+
+
 @wp.kernel
 def splat_photons(
     cam: PinholeCamera,
@@ -114,15 +178,22 @@ def splat_photons(
     attenuation_per_m: wp.array[wp.float32],
     wavelengths_per_group: int,
     photon_spacing_m: float,
+    quads: int,
+    subdivisions: int,
+    periodic: int,
+    extent_m: float,
     depth: wp.array2d[wp.float32],
     inv_footprint: wp.array2d[wp.float32],
     depth_tolerance: float,
     caustic: wp.array3d[wp.float32],
 ):
     """Splat photon i into the camera caustic map (K, H, W) [W m^-2 nm^-1]: a Gaussian whose width
-    in pixels is the photon spacing seen at its distance (de la Fuente 2011 §4.5), over the pixels
-    that see the same surface (depth test: occluded photons add nothing); its weights are
-    renormalised over those pixels, so the splat conserves the photon's flux."""
+    in pixels is the photon's spacing on the receiver seen at its distance (de la Fuente 2011 §4.5;
+    the spacing comes from its grid neighbours' hits, so splats shrink in focused light and widen
+    where it spreads), over the pixels that see the same surface (depth test: occluded photons add
+    nothing). The kernel is a density on the receiver: pixel q gets irradiance
+    ``Φ G_q / Σ_q' G_q' A_q'`` (A: pixel footprint), so Σ_q E_q A_q = Φ whatever the viewing angle,
+    and a uniformly lit surface stays uniform across pixels of different footprint."""
     p = wp.tid()
     f = face[p]
     if f < 0:
@@ -138,7 +209,10 @@ def splat_photons(
     if not same_surface(depth[cj, ci], c[2], depth_tolerance):
         return  # hidden behind something nearer the camera
     angle = 2.0 * cam.tan_half_fov / float(cam.height)
-    sigma = wp.max(0.5, photon_spacing_m / (c[2] * angle))
+    spacing = photon_spacing_on_receiver(
+        hit, face, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
+    )
+    sigma = wp.max(0.5, spacing / (c[2] * angle))
     r = wp.min(int(wp.ceil(2.0 * sigma)), MAX_SPLAT_RADIUS)
     inv2s2 = 0.5 / (sigma * sigma)
     total = float(0.0)
@@ -150,7 +224,7 @@ def splat_photons(
                 if same_surface(depth[j, i], c[2], depth_tolerance):
                     dx = float(i) + 0.5 - c[0]
                     dy = float(j) + 0.5 - c[1]
-                    total += wp.exp(-(dx * dx + dy * dy) * inv2s2)
+                    total += wp.exp(-(dx * dx + dy * dy) * inv2s2) / inv_footprint[j, i]
     if total <= 0.0:
         return
     ell = wp.length(x - origin[p])
@@ -163,12 +237,31 @@ def splat_photons(
                 if same_surface(depth[j, i], c[2], depth_tolerance):
                     dx = float(i) + 0.5 - c[0]
                     dy = float(j) + 0.5 - c[1]
-                    share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total * inv_footprint[j, i]
+                    share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total
                     for jj in range(wavelengths_per_group):
                         k = g * wavelengths_per_group + jj
                         wp.atomic_add(
                             caustic, k, j, i, share * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell)
                         )
+
+
+SHAFT_LEVELS = 7
+"""Levels of the shaft pyramid: level l has pixels 2^l fine pixels wide."""
+
+
+@wp.func
+def level_size(n: int, level: int) -> int:
+    """Pixels along one side of level ``level`` of an n-pixel side: ceil(n / 2^level)."""
+    return (n + (1 << level) - 1) >> level
+
+
+@wp.func
+def level_offset(width: int, height: int, level: int) -> int:
+    """Start of level ``level`` in the packed pyramid (levels stored one after the other)."""
+    offset = int(0)
+    for l in range(level):
+        offset += level_size(width, l) * level_size(height, l)
+    return offset
 
 
 @wp.kernel
@@ -192,15 +285,19 @@ def shaft_lines(
     log_phase: wp.array[wp.float32],
     cone_phase: float,
     depth: wp.array2d[wp.float32],
-    shafts: wp.array3d[wp.float32],
+    pyramid: wp.array2d[wp.float32],
 ):
     """Light shafts (de la Fuente 2011 §4.6; Papadopoulos & Papaioannou 2009): photon ``i·stride``
     stands for ``stride`` photons and its path from the surface to its receiver is a line of
     scattering sources. A step dℓ at ℓ from the surface and s from the camera adds
-    ``Φ(λ) σ_s(λ) p(cosθ) e^{−c(ℓ+s)} dℓ / (s² Ω_pixel)`` to the radiance of the pixel it falls in
-    [W m^-2 sr^-1 nm^-1], unless the G-buffer says a receiver hides it. Where the line's tube
-    (``tube_width_m`` across) looks wider than a pixel, each step is spread evenly over a square of
-    pixels as wide as the tube (at most 2·MAX_SPLAT_RADIUS + 1), so near lines do not streak."""
+    ``Φ(λ) σ_s(λ) p(cosθ) e^{−c(ℓ+s)} dℓ / (s² Ω)`` to the radiance of the pixel it falls in
+    [W m^-2 sr^-1 nm^-1], unless the G-buffer says a receiver hides it.
+
+    The line stands for a tube ``tube_width_m`` across. Where the tube looks wider than a pixel
+    (near the camera), the step goes into the level of a pixel pyramid (``pyramid``: (K, packed
+    levels)) whose pixels are at least as wide as the tube, Ω being that coarse pixel's solid angle;
+    :func:`collapse_pyramid` adds the levels back up, so near lines neither streak nor spike.
+    """
     t = wp.tid()
     p = t * stride
     if face[p] < 0:
@@ -224,41 +321,39 @@ def shaft_lines(
         x = o + ell * d
         c = project(cam, x)
         if c[2] > 0.0:
-            s = c[2]
-            to_cam = (cam.position - x) / s
-            cos_theta = wp.dot(d, to_cam)
-            phase = float(0.0)
-            if phase_kind == 0:
-                phase = henyey_greenstein(cos_theta, hg_g)
-            else:
-                phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
-            geometry = w * phase / (s * s * pixel_solid_angle(cam, -to_cam))
-            r = wp.min(int(0.5 * tube_width_m / (s * angle)), MAX_SPLAT_RADIUS)
-            ci = int(wp.floor(c[0]))
-            cj = int(wp.floor(c[1]))
-            seen = int(0)
-            for dj in range(-r, r + 1):
-                for di in range(-r, r + 1):
-                    if in_front(depth, ci + di, cj + dj, s):
-                        seen += 1
-            for dj in range(-r, r + 1):
-                for di in range(-r, r + 1):
-                    i = ci + di
-                    j = cj + dj
-                    if in_front(depth, i, j, s):
-                        share = geometry / float(seen)
-                        for jj in range(wavelengths_per_group):
-                            k = g * wavelengths_per_group + jj
-                            wp.atomic_add(
-                                shafts,
-                                k,
-                                j,
-                                i,
-                                share
-                                * sun_irradiance[k]
-                                * scattering_per_m[k]
-                                * wp.exp(-attenuation_per_m[k] * (ell + s)),
-                            )
+            i = int(wp.floor(c[0]))
+            j = int(wp.floor(c[1]))
+            if in_front(depth, i, j, c[2]):
+                s = c[2]
+                to_cam = (cam.position - x) / s
+                cos_theta = wp.dot(d, to_cam)
+                phase = float(0.0)
+                if phase_kind == 0:
+                    phase = henyey_greenstein(cos_theta, hg_g)
+                else:
+                    phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+                level = int(0)
+                tube_pixels = tube_width_m / (s * angle)
+                while level < SHAFT_LEVELS - 1 and float(1 << level) < tube_pixels:
+                    level += 1
+                scale = float(1 << level)
+                geometry = w * phase / (s * s * pixel_solid_angle(cam, -to_cam) * scale * scale)
+                index = (
+                    level_offset(cam.width, cam.height, level)
+                    + (j >> level) * level_size(cam.width, level)
+                    + (i >> level)
+                )
+                for jj in range(wavelengths_per_group):
+                    k = g * wavelengths_per_group + jj
+                    wp.atomic_add(
+                        pyramid,
+                        k,
+                        index,
+                        geometry
+                        * sun_irradiance[k]
+                        * scattering_per_m[k]
+                        * wp.exp(-attenuation_per_m[k] * (ell + s)),
+                    )
 
 
 @wp.func
@@ -267,6 +362,33 @@ def in_front(depth: wp.array2d[wp.float32], i: int, j: int, s: float) -> bool:
     if i < 0 or j < 0 or i >= depth.shape[1] or j >= depth.shape[0]:
         return False
     return s < depth[j, i]
+
+
+@wp.kernel
+def collapse_pyramid(pyramid: wp.array2d[wp.float32], shafts: wp.array3d[wp.float32]):
+    """shafts[k, j, i] = Σ_l level l bilinearly interpolated at the pixel's centre (coarse pixels
+    hold mean radiance over their block, so every level adds radiance, not flux)."""
+    k, j, i = wp.tid()
+    height = shafts.shape[1]
+    width = shafts.shape[2]
+    total = float(0.0)
+    for level in range(SHAFT_LEVELS):
+        w = level_size(width, level)
+        h = level_size(height, level)
+        offset = level_offset(width, height, level)
+        scale = 1.0 / float(1 << level)
+        u = (float(i) + 0.5) * scale - 0.5
+        v = (float(j) + 0.5) * scale - 0.5
+        i0 = wp.clamp(int(wp.floor(u)), 0, w - 1)
+        j0 = wp.clamp(int(wp.floor(v)), 0, h - 1)
+        i1 = wp.min(i0 + 1, w - 1)
+        j1 = wp.min(j0 + 1, h - 1)
+        tu = wp.clamp(u - float(i0), 0.0, 1.0)
+        tv = wp.clamp(v - float(j0), 0.0, 1.0)
+        total += (1.0 - tv) * (
+            (1.0 - tu) * pyramid[k, offset + j0 * w + i0] + tu * pyramid[k, offset + j0 * w + i1]
+        ) + tv * ((1.0 - tu) * pyramid[k, offset + j1 * w + i0] + tu * pyramid[k, offset + j1 * w + i1])
+    shafts[k, j, i] = total
 
 
 @wp.kernel

@@ -42,9 +42,16 @@ def pinhole(cfg: CameraConfig) -> camera_kernels.PinholeCamera:
     return cam
 
 
+def pyramid_pixels(width: int, height: int) -> int:
+    """Pixels of the light-shaft pyramid: all its levels, packed."""
+    levels = camera_kernels.SHAFT_LEVELS
+    return sum(-(-width // 2**level) * -(-height // 2**level) for level in range(levels))
+
+
 def camera_bytes(cfg: CameraConfig, k: int) -> int:
     """Device memory of the camera buffers [bytes]."""
-    return cfg.width * cfg.height * (12 + 12 + 4 + 4 + 4 + 4 * k * 4)
+    pixels = cfg.width * cfg.height
+    return pixels * (12 + 12 + 4 + 4 + 4 + 4 * k * 4) + 4 * k * pyramid_pixels(cfg.width, cfg.height)
 
 
 class UnderwaterCamera:
@@ -77,6 +84,7 @@ class UnderwaterCamera:
         """Irradiance on the receiver seen in each pixel (K, H, W) [W m^-2 nm^-1]."""
         self.shafts = wp.empty((k, h, w), dtype=wp.float32, device=device)
         self.shafts_raw = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        self.pyramid = wp.empty((k, pyramid_pixels(w, h)), dtype=wp.float32, device=device)
         self.radiance = wp.empty((k, h, w), dtype=wp.float32, device=device)
         wp.launch(
             camera_kernels.gbuffer,
@@ -112,6 +120,10 @@ class UnderwaterCamera:
                 photons.attenuation_per_m,
                 per_group,
                 float(photon_spacing_m),
+                photons.quads,
+                photons.subdivisions,
+                int(photons.periodic),
+                float(photons.cfg.water.extent_m),
                 self.depth,
                 self.inv_footprint,
                 DEPTH_TOLERANCE,
@@ -119,7 +131,7 @@ class UnderwaterCamera:
             outputs=[self.caustic],
             device=dev,
         )
-        self.shafts_raw.zero_()
+        self.pyramid.zero_()
         if shafts:
             stride = photons.subdivisions**2  # one line per surface cell, carrying the cell's photons
             ph = self.phase
@@ -147,10 +159,17 @@ class UnderwaterCamera:
                     ph.cone_phase,
                     self.depth,
                 ],
-                outputs=[self.shafts_raw],
+                outputs=[self.pyramid],
                 device=dev,
             )
         h, w = self.cfg.height, self.cfg.width
+        wp.launch(
+            camera_kernels.collapse_pyramid,
+            dim=(k, h, w),
+            inputs=[self.pyramid],
+            outputs=[self.shafts_raw],
+            device=dev,
+        )
         wp.launch(
             camera_kernels.blur3, dim=(k, h, w), inputs=[self.shafts_raw], outputs=[self.shafts], device=dev
         )
