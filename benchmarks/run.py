@@ -163,6 +163,9 @@ def main(argv: list[str] | None = None) -> int:
             _plot_steps(steps[module], f"{title}, {args.device}",
                         ROOT / "docs" / "images" / f"{module}_scaling_{device_tag}.png")
 
+    # Photon splatting vs its numpy twin, both in one child process (benchmarks/photons.py).
+    photons = _in_child("run", args.quick, args.device, module="photons")
+
     record = {
         "benchmark": "ocean_frame_floor_caustics",
         "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
@@ -176,6 +179,7 @@ def main(argv: list[str] | None = None) -> int:
         "results": rows,
         "steps": steps,
         "bins": bins_rows,
+        "photons": photons,
     }
     out = args.out or ROOT / "benchmarks" / "results" / (
         f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")

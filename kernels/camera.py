@@ -18,6 +18,10 @@ INV_PI = 0.3183098861837907
 MAX_SPLAT_RADIUS = 6
 """Largest photon splat radius [pixels]."""
 
+MIN_SPLAT_SIGMA = 1.0
+"""Narrowest photon splat (Gaussian σ) [pixels]: photons closer than a pixel apart would alias
+into stripes with anything narrower."""
+
 MAX_SHAFT_STEPS = 2048
 """Most samples along one photon's light-shaft line."""
 
@@ -73,9 +77,12 @@ def gbuffer(
     depth: wp.array2d[wp.float32],
     receiver: wp.array2d[wp.int32],
     inv_footprint: wp.array2d[wp.float32],
+    depth_slack: wp.array2d[wp.float32],
 ):
     """First receiver along each pixel's ray: position, normal facing the camera, distance,
-    receiver id (−1 and depth 1e30 for none) and 1 / the pixel's footprint area there [m^-2]."""
+    receiver id (−1 and depth 1e30 for none) and 1 / the pixel's footprint area there [m^-2].
+    ``depth_slack``: how much the distance of points on the receiver within the pixel's footprint
+    can differ from the centre ray's, 1.5 · r · (pixel angle) · tan(incidence) [m]."""
     j, i = wp.tid()
     ray = pixel_ray(cam, i, j)
     q = wp.mesh_query_ray(mesh, cam.position, ray, 1.0e5)
@@ -89,17 +96,22 @@ def gbuffer(
         receiver[j, i] = face_receiver[q.face]
         cos_r = wp.max(-wp.dot(n, ray), 0.02)
         inv_footprint[j, i] = cos_r / (q.t * q.t * pixel_solid_angle(cam, ray))
+        pixel_angle = 2.0 * cam.tan_half_fov / float(cam.height)
+        depth_slack[j, i] = 1.5 * q.t * pixel_angle * wp.sqrt(1.0 - cos_r * cos_r) / cos_r
     else:
         position[j, i] = cam.position + 1.0e5 * ray
         normal[j, i] = -ray
         depth[j, i] = 1.0e30
         receiver[j, i] = -1
         inv_footprint[j, i] = 0.0
+        depth_slack[j, i] = 0.0
 
 
 @wp.func
-def same_surface(depth_pixel: float, distance: float, tolerance: float) -> bool:
-    return wp.abs(depth_pixel - distance) <= tolerance * depth_pixel + 1.0e-3
+def same_surface(depth_pixel: float, slack: float, distance: float, tolerance: float) -> bool:
+    """A point at ``distance`` from the camera lies on the surface a pixel sees (its depth within
+    the relative ``tolerance`` plus the spread of depths over the pixel's footprint)."""
+    return wp.abs(depth_pixel - distance) <= tolerance * depth_pixel + slack + 1.0e-3
 
 
 @wp.func
@@ -150,8 +162,9 @@ def photon_spacing_on_receiver(
     extent_m: float,
     fallback_m: float,
 ) -> float:
-    """√(area between photon p and its two grid neighbours' hits) [m]; ``fallback_m`` where a
-    neighbour is missing or the parallelogram collapses (a focus)."""
+    """Distance from photon p's hit to the farther of its two grid neighbours' hits [m] (the
+    larger side, so that rows of photons stretched in one direction do not show as stripes);
+    ``fallback_m`` where a neighbour is missing."""
     nu = grid_neighbour(p, 0, quads, s, periodic)
     nv = grid_neighbour(p, 1, quads, s, periodic)
     if nu < 0 or nv < 0:
@@ -160,10 +173,7 @@ def photon_spacing_on_receiver(
         return fallback_m
     eu = unwrap(hit[p], hit[nu], periodic, extent_m)
     ev = unwrap(hit[p], hit[nv], periodic, extent_m)
-    area = wp.length(wp.cross(eu, ev))
-    if area <= 0.0:
-        return fallback_m
-    return wp.min(wp.sqrt(area), 8.0 * fallback_m)
+    return wp.min(wp.max(wp.length(eu), wp.length(ev)), 8.0 * fallback_m)
 
 
 @wp.kernel
@@ -182,8 +192,10 @@ def splat_photons(
     subdivisions: int,
     periodic: int,
     extent_m: float,
+    floor_face_count: int,
     depth: wp.array2d[wp.float32],
     inv_footprint: wp.array2d[wp.float32],
+    depth_slack: wp.array2d[wp.float32],
     depth_tolerance: float,
     caustic: wp.array3d[wp.float32],
 ):
@@ -193,12 +205,18 @@ def splat_photons(
     where it spreads), over the pixels that see the same surface (depth test: occluded photons add
     nothing). The kernel is a density on the receiver: pixel q gets irradiance
     ``Φ G_q / Σ_q' G_q' A_q'`` (A: pixel footprint), so Σ_q E_q A_q = Φ whatever the viewing angle,
-    and a uniformly lit surface stays uniform across pixels of different footprint."""
-    p = wp.tid()
+    and a uniformly lit surface stays uniform across pixels of different footprint.
+
+    On a periodic sea a floor photon is also splatted at its eight copies one period away (the light
+    of the neighbouring tiles), so the floor around the patch is lit and the patch edge does not
+    show; the depth test drops copies that are not on the floor the camera sees."""
+    p, copy = wp.tid()
     f = face[p]
     if f < 0:
         return
-    x = hit[p]
+    if copy != 4 and (periodic == 0 or f >= floor_face_count):
+        return
+    x = hit[p] + wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
     c = project(cam, x)
     if c[2] < 0.0:
         return
@@ -206,13 +224,13 @@ def splat_photons(
     cj = int(wp.floor(c[1]))
     if ci < 0 or cj < 0 or ci >= cam.width or cj >= cam.height:
         return
-    if not same_surface(depth[cj, ci], c[2], depth_tolerance):
+    if not same_surface(depth[cj, ci], depth_slack[cj, ci], c[2], depth_tolerance):
         return  # hidden behind something nearer the camera
     angle = 2.0 * cam.tan_half_fov / float(cam.height)
     spacing = photon_spacing_on_receiver(
         hit, face, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
     )
-    sigma = wp.max(0.5, spacing / (c[2] * angle))
+    sigma = wp.max(MIN_SPLAT_SIGMA, spacing / (c[2] * angle))
     r = wp.min(int(wp.ceil(2.0 * sigma)), MAX_SPLAT_RADIUS)
     inv2s2 = 0.5 / (sigma * sigma)
     total = float(0.0)
@@ -221,7 +239,7 @@ def splat_photons(
             i = ci + di
             j = cj + dj
             if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
-                if same_surface(depth[j, i], c[2], depth_tolerance):
+                if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
                     dx = float(i) + 0.5 - c[0]
                     dy = float(j) + 0.5 - c[1]
                     total += wp.exp(-(dx * dx + dy * dy) * inv2s2) / inv_footprint[j, i]
@@ -234,7 +252,7 @@ def splat_photons(
             i = ci + di
             j = cj + dj
             if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
-                if same_surface(depth[j, i], c[2], depth_tolerance):
+                if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
                     dx = float(i) + 0.5 - c[0]
                     dy = float(j) + 0.5 - c[1]
                     share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total

@@ -24,6 +24,10 @@ MIN_DOWNWARD_COS = 1.0e-3
 RAY_LENGTH_M = 1.0e5
 """Longest ray queried on the BVH [m]."""
 
+MAX_BLEND_DEPTH_TEXELS = 8.0
+"""Light-view texels are blended only if their depths along the sun differ by less than this many
+texel widths (a surface inclined up to ~83° to the view); beyond, the nearest texel is used."""
+
 
 @wp.struct
 class LightView:
@@ -101,15 +105,18 @@ def look_up(view: LightView, face_receiver: wp.array[wp.int32], x: wp.vec3):
         or face_receiver[f11] != r
     ):
         return view.positions[j, i], f
-    p = bilinear_vec3(
-        view.positions[j0, i0],
-        view.positions[j0, i0 + 1],
-        view.positions[j0 + 1, i0],
-        view.positions[j0 + 1, i0 + 1],
-        fa - float(i0),
-        fb - float(j0),
-    )
-    return p, f
+    p00 = view.positions[j0, i0]
+    p10 = view.positions[j0, i0 + 1]
+    p01 = view.positions[j0 + 1, i0]
+    p11 = view.positions[j0 + 1, i0 + 1]
+    # A depth jump (part of a mesh hiding another part from the sun) must not be blended across.
+    s = wp.cross(view.u, view.v)
+    d0 = wp.dot(p00, s)
+    jump = wp.max(wp.abs(wp.dot(p10, s) - d0), wp.abs(wp.dot(p01, s) - d0))
+    jump = wp.max(jump, wp.abs(wp.dot(p11, s) - d0))
+    if jump > MAX_BLEND_DEPTH_TEXELS * view.texel_m:
+        return view.positions[j, i], f
+    return bilinear_vec3(p00, p10, p01, p11, fa - float(i0), fb - float(j0)), f
 
 
 @wp.func

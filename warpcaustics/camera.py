@@ -80,6 +80,7 @@ class UnderwaterCamera:
         self.depth = wp.empty((h, w), dtype=wp.float32, device=device)
         self.receiver = wp.empty((h, w), dtype=wp.int32, device=device)
         self.inv_footprint = wp.empty((h, w), dtype=wp.float32, device=device)
+        self.depth_slack = wp.empty((h, w), dtype=wp.float32, device=device)
         self.caustic = wp.empty((k, h, w), dtype=wp.float32, device=device)
         """Irradiance on the receiver seen in each pixel (K, H, W) [W m^-2 nm^-1]."""
         self.shafts = wp.empty((k, h, w), dtype=wp.float32, device=device)
@@ -90,7 +91,14 @@ class UnderwaterCamera:
             camera_kernels.gbuffer,
             dim=(h, w),
             inputs=[self.cam, receivers.mesh.id, receivers.face_receiver],
-            outputs=[self.position, self.normal, self.depth, self.receiver, self.inv_footprint],
+            outputs=[
+                self.position,
+                self.normal,
+                self.depth,
+                self.receiver,
+                self.inv_footprint,
+                self.depth_slack,
+            ],
             device=device,
         )
 
@@ -108,7 +116,7 @@ class UnderwaterCamera:
         self.caustic.zero_()
         wp.launch(
             camera_kernels.splat_photons,
-            dim=count,
+            dim=(count, 9),
             inputs=[
                 self.cam,
                 photons.hit,
@@ -124,8 +132,10 @@ class UnderwaterCamera:
                 photons.subdivisions,
                 int(photons.periodic),
                 float(photons.cfg.water.extent_m),
+                self.receivers.floor_face_count,
                 self.depth,
                 self.inv_footprint,
+                self.depth_slack,
                 DEPTH_TOLERANCE,
             ],
             outputs=[self.caustic],
