@@ -15,8 +15,11 @@ wp.set_module_options({"enable_backward": False})
 
 INV_PI = 0.3183098861837907
 
-MAX_SPLAT_RADIUS = 6
+MAX_SPLAT_RADIUS = 8
 """Largest photon splat radius [pixels]."""
+
+MAX_TENT_RADIUS = 24
+"""Largest reach of a tent splat [pixels]."""
 
 MIN_SPLAT_SIGMA = 1.0
 """Narrowest photon splat (Gaussian σ) [pixels]: photons closer than a pixel apart would alias
@@ -152,7 +155,7 @@ def grid_neighbour(p: int, along_v: int, quads: int, s: int, periodic: int) -> i
 
 
 @wp.func
-def photon_spacing_on_receiver(
+def photon_lattice(
     hit: wp.array[wp.vec3],
     face: wp.array[wp.int32],
     p: int,
@@ -160,20 +163,35 @@ def photon_spacing_on_receiver(
     s: int,
     periodic: int,
     extent_m: float,
-    fallback_m: float,
-) -> float:
-    """Distance from photon p's hit to the farther of its two grid neighbours' hits [m] (the
-    larger side, so that rows of photons stretched in one direction do not show as stripes);
-    ``fallback_m`` where a neighbour is missing."""
+):
+    """(e_u, e_v, ok): from photon p's hit to its two next grid neighbours' hits [m]; ok = 0 where
+    a neighbour is missing (a wall, a lost photon)."""
     nu = grid_neighbour(p, 0, quads, s, periodic)
     nv = grid_neighbour(p, 1, quads, s, periodic)
     if nu < 0 or nv < 0:
-        return fallback_m
+        return wp.vec3(0.0), wp.vec3(0.0), int(0)
     if face[nu] < 0 or face[nv] < 0:
-        return fallback_m
-    eu = unwrap(hit[p], hit[nu], periodic, extent_m)
-    ev = unwrap(hit[p], hit[nv], periodic, extent_m)
-    return wp.min(wp.max(wp.length(eu), wp.length(ev)), 8.0 * fallback_m)
+        return wp.vec3(0.0), wp.vec3(0.0), int(0)
+    return unwrap(hit[p], hit[nu], periodic, extent_m), unwrap(hit[p], hit[nv], periodic, extent_m), int(1)
+
+
+@wp.func
+def add_flux(
+    caustic: wp.array3d[wp.float32],
+    j: int,
+    i: int,
+    irradiance: float,
+    g: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    ell: float,
+):
+    """Add ``irradiance`` (per unit E_sun) × E_sun(λ) e^{-c(λ) ℓ} to pixel (j, i) in each band of
+    group g."""
+    for jj in range(wavelengths_per_group):
+        k = g * wavelengths_per_group + jj
+        wp.atomic_add(caustic, k, j, i, irradiance * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
 
 
 @wp.kernel
@@ -187,25 +205,32 @@ def splat_photons(
     sun_irradiance: wp.array[wp.float32],
     attenuation_per_m: wp.array[wp.float32],
     wavelengths_per_group: int,
-    photon_spacing_m: float,
     quads: int,
     subdivisions: int,
     periodic: int,
     extent_m: float,
     floor_face_count: int,
+    position: wp.array2d[wp.vec3],
     depth: wp.array2d[wp.float32],
     inv_footprint: wp.array2d[wp.float32],
     depth_slack: wp.array2d[wp.float32],
     depth_tolerance: float,
     caustic: wp.array3d[wp.float32],
 ):
-    """Splat photon i into the camera caustic map (K, H, W) [W m^-2 nm^-1]: a Gaussian whose width
-    in pixels is the photon's spacing on the receiver seen at its distance (de la Fuente 2011 §4.5;
-    the spacing comes from its grid neighbours' hits, so splats shrink in focused light and widen
-    where it spreads), over the pixels that see the same surface (depth test: occluded photons add
-    nothing). The kernel is a density on the receiver: pixel q gets irradiance
-    ``Φ G_q / Σ_q' G_q' A_q'`` (A: pixel footprint), so Σ_q E_q A_q = Φ whatever the viewing angle,
-    and a uniformly lit surface stays uniform across pixels of different footprint.
+    """Splat photon p into the camera caustic map (K, H, W) [W m^-2 nm^-1] over the pixels that see
+    the same surface (depth test: occluded photons add nothing). Point size follows the photon's
+    spacing on the receiver seen at its distance (de la Fuente 2011 §4.5), from its grid neighbours'
+    hits e_u, e_v, so splats shrink in focused light and widen where it spreads:
+
+    - a photon with both neighbours: the tent (bilinear hat) over ±e_u, ±e_v on the receiver,
+      evaluated at each pixel's G-buffer point, irradiance ``Φ hat / |e_u × e_v|``. The hats of a
+      lattice of photons sum to one at every point, so each pixel samples the piecewise-bilinear
+      irradiance exactly, however sparse, sheared (grazing light on a wall) or dense (sub-pixel
+      detail is then point-sampled, as any rasteriser without supersampling does) the photons are;
+      mixing kernels instead leaves seams where the kernel changes;
+    - a photon without neighbours (the edge of the lit region, lost neighbours): a Gaussian of σ =
+      MIN_SPLAT_SIGMA pixels normalised as a density on the receiver, ``Φ G_q / Σ_q' G_q' A_q'``
+      (A: pixel footprint), so its flux is kept.
 
     On a periodic sea a floor photon is also splatted at its eight copies one period away (the light
     of the neighbouring tiles), so the floor around the patch is lit and the patch edge does not
@@ -226,11 +251,49 @@ def splat_photons(
         return
     if not same_surface(depth[cj, ci], depth_slack[cj, ci], c[2], depth_tolerance):
         return  # hidden behind something nearer the camera
-    angle = 2.0 * cam.tan_half_fov / float(cam.height)
-    spacing = photon_spacing_on_receiver(
-        hit, face, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
-    )
-    sigma = wp.max(MIN_SPLAT_SIGMA, spacing / (c[2] * angle))
+    ell = wp.length(x - origin[p])
+    g = p / photons_per_group
+    w = weight[p]
+    eu, ev, ok = photon_lattice(hit, face, p, quads, subdivisions, periodic, extent_m)
+    area = wp.length(wp.cross(eu, ev))
+    longest = wp.max(wp.length(eu), wp.length(ev))
+    # The lattice cell on screen [pixels]: its longer side and its narrower width.
+    su = project(cam, x + eu) - c
+    sv = project(cam, x + ev) - c
+    longest_px = wp.max(wp.length(wp.vec2(su[0], su[1])), wp.length(wp.vec2(sv[0], sv[1])))
+    if ok != 0 and area > 1.0e-6 * longest * longest:
+        # Tent over the photon's lattice cell: α, β solve (X − x) ≈ α e_u + β e_v (least squares).
+        a = wp.dot(eu, eu)
+        b = wp.dot(eu, ev)
+        d = wp.dot(ev, ev)
+        det = a * d - b * b
+        reach = wp.min(int(wp.ceil(2.0 * longest_px)) + 1, MAX_TENT_RADIUS)
+        for dj in range(-reach, reach + 1):
+            for di in range(-reach, reach + 1):
+                i = ci + di
+                j = cj + dj
+                if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
+                    if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
+                        q = position[j, i] - x
+                        pu = wp.dot(q, eu)
+                        pv = wp.dot(q, ev)
+                        alpha = (d * pu - b * pv) / det
+                        beta = (a * pv - b * pu) / det
+                        hat = wp.max(1.0 - wp.abs(alpha), 0.0) * wp.max(1.0 - wp.abs(beta), 0.0)
+                        if hat > 0.0:
+                            add_flux(
+                                caustic,
+                                j,
+                                i,
+                                w * hat / area,
+                                g,
+                                wavelengths_per_group,
+                                sun_irradiance,
+                                attenuation_per_m,
+                                ell,
+                            )
+        return
+    sigma = MIN_SPLAT_SIGMA
     r = wp.min(int(wp.ceil(2.0 * sigma)), MAX_SPLAT_RADIUS)
     inv2s2 = 0.5 / (sigma * sigma)
     total = float(0.0)
@@ -245,8 +308,6 @@ def splat_photons(
                     total += wp.exp(-(dx * dx + dy * dy) * inv2s2) / inv_footprint[j, i]
     if total <= 0.0:
         return
-    ell = wp.length(x - origin[p])
-    g = p / photons_per_group
     for dj in range(-r, r + 1):
         for di in range(-r, r + 1):
             i = ci + di
@@ -255,12 +316,17 @@ def splat_photons(
                 if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
                     dx = float(i) + 0.5 - c[0]
                     dy = float(j) + 0.5 - c[1]
-                    share = weight[p] * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total
-                    for jj in range(wavelengths_per_group):
-                        k = g * wavelengths_per_group + jj
-                        wp.atomic_add(
-                            caustic, k, j, i, share * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell)
-                        )
+                    add_flux(
+                        caustic,
+                        j,
+                        i,
+                        w * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total,
+                        g,
+                        wavelengths_per_group,
+                        sun_irradiance,
+                        attenuation_per_m,
+                        ell,
+                    )
 
 
 SHAFT_LEVELS = 7
