@@ -179,7 +179,128 @@ def main() -> int:
         water.ifft2(a)
         ref = np.fft.ifft2(x) * n * n
         print(f"{n}²: {np.linalg.norm(water.from_vec2(a) - ref) / np.linalg.norm(ref):.2e}")
+
+    _photons()
     return 0
+
+
+def _photons() -> None:
+    """Photon caustics: the figures of docs/validation.md's photon section."""
+    from test_photons import PHOTONS, SLOPE, SPHERE, _flat, newton_errors
+
+    import warpcaustics as wc
+
+    from conftest import fresnel_t_angles
+
+    print("\n## Photons on flat water vs E_sun cosθ T(θ) exp(-c D / cosθ_t)  (pure water, 8 bins, 3 m)")
+    for mode in ("exact", "newton"):
+        worst = 0.0
+        for el in (20.0, 55.0, 90.0):
+            r = wc.render(_flat(el, 3.0, **{"caustics.intersection": mode}), device="cpu")
+            th = np.radians(90 - el)
+            ct = np.sqrt(1 - (np.sin(th) / 1.333) ** 2)
+            e = r.sun_irradiance * np.cos(th) * fresnel_t_angles(np.array([th]), 1, 1.333)[0] * np.exp(
+                -r.attenuation_per_m * 3.0 / ct)
+            worst = max(worst, float(np.abs(r.floor_irradiance / e[:, None, None] - 1).max()))
+        print(f"{mode:6s}: max relative error over elevations 20°, 55°, 90° and all texels {worst:.1e}")
+
+    print("\n## Photon flux conservation (water_type = none)")
+    r = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", {
+        **PHOTONS, "water.resolution": 64, "water.wind_speed_m_s": 9.0, "water.choppiness": 0.8,
+        "caustics.map_resolution": 48, "optics.water_type": "none", "optics.wavelengths": "rgb"}),
+        device="cpu")
+    print(f"rough choppy ocean: floor / transmitted - 1 = "
+          f"{np.abs(r.floor_flux_w_nm / r.transmitted_flux_w_nm - 1).max():.1e}")
+    r = wc.Renderer(wc.load_scene(ROOT / "configs" / "pool.toml", {
+        **PHOTONS, "water.resolution": 48, "caustics.map_resolution": 48, "optics.water_type": "none",
+        "optics.wavelengths": "rgb", "sun.elevation_deg": 40.0,
+        "receivers": [{"mesh": "sphere", "scale": 0.8, "translate_m": [0.3, -0.2, -1.0]}]}),
+        "cpu").render(0.6)
+    total = r.floor_flux_w_nm + r.face_flux_w_nm.sum(axis=0, dtype=np.float64)
+    print(f"pool with a sphere (floor + walls + sphere) / transmitted - 1 = "
+          f"{np.abs(total / r.transmitted_flux_w_nm - 1).max():.1e}")
+
+    print("\n## Shah's Newton–Raphson vs exact BVH hits (ocean 64², 2×2 photons per cell, 1024² buffer)")
+    for name, scene, receiver in (("15° slope", SLOPE, 0), ("sphere r = 1.5 m", SPHERE, 2)):
+        ks = [0, 1, 2, 3, 4, 5]
+        errors, texel = newton_errors(scene, ks, receiver=receiver)
+        print(f"{name} (light-view texel {texel * 1000:.1f} mm): k, mean, median, p95 [mm], "
+              "share within a texel")
+        for k, e in zip(ks, errors):
+            print(f"  k={k}: {e['mean'] * 1000:10.4f} {e['median'] * 1000:10.4f} {e['p95'] * 1000:10.4f}  "
+                  f"{e['within_texel']:.1%}")
+
+    print("\n## Photons vs the flux-ratio map, configs/ocean.toml (256² surface, rgb)")
+    for m in (64, 128):
+        base = {"caustics.map_resolution": m, "optics.wavelengths": "rgb"}
+        ref = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", base), device="cpu").floor_irradiance
+        for s in (1, 2, 4):
+            f = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", {
+                **base, **PHOTONS, "caustics.photon_subdivisions": s}), device="cpu").floor_irradiance
+            per_texel = 256 * 256 * s * s / m / m
+            print(f"map {m}², {s * s:2d} photons per cell ({per_texel:5.0f} per texel): relative L1 "
+                  f"{np.abs(f - ref).sum() / np.abs(ref).sum():.2%}")
+
+    print("\n## Light shafts vs single scattering, sun at the zenith over a still pool (clear_ocean)")
+    for n in (64, 128):
+        _shaft_ratio(n)
+    _camera_floor()
+
+
+def _shaft_ratio(n: int) -> None:
+    from test_photons import PHOTONS
+
+    import warpcaustics as wc
+    from warpcaustics import spectra
+    from warpcaustics.phase import PhaseFunction
+
+    from conftest import fresnel_t_angles
+
+    z_cam = -0.75
+    scene = wc.load_scene(None, {
+        **PHOTONS, "water.model": "pool", "water.resolution": n, "water.extent_m": 4.0, "floor.depth_m": 1.5,
+        "caustics.map_resolution": 64, "sun.elevation_deg": 90.0, "optics.water_type": "clear_ocean",
+        "optics.wavelengths": "rgb", "camera.enabled": True, "camera.position_m": [-1.9, 0.0, z_cam],
+        "camera.look_at_m": [0.0, 0.0, z_cam], "camera.width": 64, "camera.height": 48,
+        "camera.fov_deg": 30.0})
+    r = wc.render(scene, device="cpu")
+    g = r.camera_gbuffer
+    optics = spectra.water_optics(scene.config.optics, spectra.bins_for(scene.config.optics))
+    c, b = optics.attenuation_per_m[:, None, None], optics.scattering_per_m[:, None, None]
+    rows, cols = slice(18, 30), slice(12, 52)
+    ray = g["position"][rows, cols] - np.array([-1.9, 0.0, z_cam])
+    dist = np.linalg.norm(ray, axis=-1)
+    vz = ray[..., 2] / dist
+    ph = PhaseFunction.from_optics(scene.config.optics, "cpu").evaluate(vz.ravel(), "cpu").reshape(vz.shape)
+    t0 = fresnel_t_angles(np.array([0.0]), 1.0, 1.333)[0]
+    k = c * (1 - vz)
+    expected = b * ph * r.sun_irradiance[:, None, None] * t0 * np.exp(c * z_cam) * (1 - np.exp(-k * dist)) / k
+    ratio = r.camera_radiance[:, rows, cols].mean(axis=(1, 2)) / expected.mean(axis=(1, 2))
+    print(f"{n}² surface (one line per cell): block mean / analytic per band: "
+          + ", ".join(f"{x:.3f}" for x in ratio))
+
+
+
+def _camera_floor() -> None:
+    from test_photons import _flat
+
+    import warpcaustics as wc
+
+    from conftest import fresnel_t_angles
+
+    print("\n## Camera: uniformly lit grey floor seen obliquely (flat water, water_type none)")
+    r = wc.render(_flat(60.0, 3.0, "none", **{
+        "water.resolution": 128, "caustics.photon_subdivisions": 4, "floor.albedo": 0.5,
+        "camera.enabled": True,
+        "camera.position_m": [-1.0, -2.0, -1.0], "camera.look_at_m": [0.5, 0.5, -3.0], "camera.width": 96,
+        "camera.height": 64, "camera.fov_deg": 60.0}), device="cpu")
+    th = np.radians(30.0)
+    e = r.sun_irradiance * np.cos(th) * fresnel_t_angles(np.array([th]), 1.0, 1.333)[0]
+    g = r.camera_gbuffer
+    seen = (g["receiver"] == 0) & np.all(np.abs(g["position"][..., :2]) < 3.5, axis=-1)
+    seen[:6], seen[-6:], seen[:, :6], seen[:, -6:] = False, False, False, False
+    err = np.abs(r.camera_radiance[:, seen] * np.pi / 0.5 / e[:, None] - 1).max()
+    print(f"max |L π / (albedo E) - 1| over {seen.sum()} pixels: {err:.1e}")
 
 
 if __name__ == "__main__":

@@ -233,7 +233,7 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool():
     overrides = {
         **PHOTONS,
         "water.model": "pool",
-        "water.resolution": 64,
+        "water.resolution": 128,
         "water.extent_m": 4.0,
         "floor.depth_m": 1.5,
         "caustics.map_resolution": 64,
@@ -260,7 +260,7 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool():
     ray = g["position"][rows, cols] - np.array([-1.9, 0.0, z_cam])
     dist = np.linalg.norm(ray, axis=-1)
     vz = ray[..., 2] / dist
-    phase = PhaseFunction.from_optics(cfg.optics, "cpu").evaluate(-vz.ravel(), "cpu").reshape(vz.shape)
+    phase = PhaseFunction.from_optics(cfg.optics, "cpu").evaluate(vz.ravel(), "cpu").reshape(vz.shape)
     # Along the ray ℓ(s) = -(z_cam + s v_z) (light comes straight down from z = 0).
     k = c[:, None, None] * (1.0 - vz)
     expected = (
@@ -274,9 +274,10 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool():
     )
     # The far wall gets no direct light (vertical rays graze it), so this is all shaft radiance.
     measured = result.camera_radiance[:, rows, cols]
-    # Photon lines are 6.25 cm apart, pixels ~2-4 cm across at these distances: single pixels
-    # alias by tens of percent, so compare the block's mean; 5 % covers the remaining line sampling.
-    np.testing.assert_allclose(measured.mean(axis=(1, 2)), expected.mean(axis=(1, 2)), rtol=0.05)
+    # One line per surface cell (3.1 cm apart): single pixels still alias, so compare the block's
+    # mean. It comes out 1-2 % low at this line density (3-4 % at 64², so the deficit is the lines'
+    # discreteness, shrinking as they get denser); 3 % bounds it.
+    np.testing.assert_allclose(measured.mean(axis=(1, 2)), expected.mean(axis=(1, 2)), rtol=0.03)
 
 
 def test_photons_agree_with_the_flux_ratio_map():
