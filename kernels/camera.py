@@ -293,40 +293,51 @@ def splat_photons(
                                 ell,
                             )
         return
-    sigma = MIN_SPLAT_SIGMA
-    r = wp.min(int(wp.ceil(2.0 * sigma)), MAX_SPLAT_RADIUS)
-    inv2s2 = 0.5 / (sigma * sigma)
+    r = wp.min(int(wp.ceil(2.0 * MIN_SPLAT_SIGMA)), MAX_SPLAT_RADIUS)
     total = float(0.0)
     for dj in range(-r, r + 1):
         for di in range(-r, r + 1):
-            i = ci + di
-            j = cj + dj
-            if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
-                if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
-                    dx = float(i) + 0.5 - c[0]
-                    dy = float(j) + 0.5 - c[1]
-                    total += wp.exp(-(dx * dx + dy * dy) * inv2s2) / inv_footprint[j, i]
+            g_q = gaussian_on_surface(cam, depth, depth_slack, depth_tolerance, c, ci + di, cj + dj)
+            if g_q > 0.0:
+                total += g_q / inv_footprint[cj + dj, ci + di]
     if total <= 0.0:
         return
     for dj in range(-r, r + 1):
         for di in range(-r, r + 1):
-            i = ci + di
-            j = cj + dj
-            if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
-                if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
-                    dx = float(i) + 0.5 - c[0]
-                    dy = float(j) + 0.5 - c[1]
-                    add_flux(
-                        caustic,
-                        j,
-                        i,
-                        w * wp.exp(-(dx * dx + dy * dy) * inv2s2) / total,
-                        g,
-                        wavelengths_per_group,
-                        sun_irradiance,
-                        attenuation_per_m,
-                        ell,
-                    )
+            g_q = gaussian_on_surface(cam, depth, depth_slack, depth_tolerance, c, ci + di, cj + dj)
+            if g_q > 0.0:
+                add_flux(
+                    caustic,
+                    cj + dj,
+                    ci + di,
+                    w * g_q / total,
+                    g,
+                    wavelengths_per_group,
+                    sun_irradiance,
+                    attenuation_per_m,
+                    ell,
+                )
+
+
+@wp.func
+def gaussian_on_surface(
+    cam: PinholeCamera,
+    depth: wp.array2d[wp.float32],
+    depth_slack: wp.array2d[wp.float32],
+    depth_tolerance: float,
+    c: wp.vec3,
+    i: int,
+    j: int,
+) -> float:
+    """Weight of pixel (j, i) in a Gaussian splat (σ = MIN_SPLAT_SIGMA) centred at the projected
+    point c; 0 outside the image or where the pixel sees another surface."""
+    if i < 0 or j < 0 or i >= cam.width or j >= cam.height:
+        return 0.0
+    if not same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
+        return 0.0
+    dx = float(i) + 0.5 - c[0]
+    dy = float(j) + 0.5 - c[1]
+    return wp.exp(-(dx * dx + dy * dy) * (0.5 / (MIN_SPLAT_SIGMA * MIN_SPLAT_SIGMA)))
 
 
 SHAFT_LEVELS = 7
