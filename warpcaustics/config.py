@@ -221,6 +221,9 @@ class FloorConfig:
     albedo: tuple[float, ...] = field(default=(0.6, 0.55, 0.45), metadata=_range(0.0, 1.0))
     """Diffuse albedo of the floor: one value (grey) or three (linear sRGB, turned into a
     reflectance spectrum by Mallett & Yuksel 2019 through colour-science) [-]."""
+    albedo_file: str | None = None
+    """CSV of a measured reflectance spectrum (header line, then wavelength [nm], reflectance 0…1);
+    replaces ``albedo``. Relative paths start at the config file's folder."""
 
 
 @dataclass(frozen=True)
@@ -327,6 +330,8 @@ class ReceiverConfig:
     """Translation (x, y, z) [m]; applied last."""
     albedo: tuple[float, ...] = field(default=(0.7, 0.7, 0.7), metadata=_range(0.0, 1.0))
     """Diffuse albedo: one value (grey) or three (linear sRGB, as for the floor) [-]."""
+    albedo_file: str | None = None
+    """CSV of a reflectance spectrum (as ``floor.albedo_file``); replaces ``albedo``."""
 
 
 @dataclass(frozen=True)

@@ -182,7 +182,7 @@ class Renderer:
             if cfg.caustics.method is CausticsMethod.PHOTONS:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
-                                           water_top_z=_WALL_TOP_M)
+                                           water_top_z=_WALL_TOP_M, base_dir=scene.base_dir)
                 self.photons = photons.PhotonCaustics(cfg, self.receivers, n, self.sun_irradiance,
                                                       self.attenuation_per_m, len(self.group_ior),
                                                       scene.sun_direction, self.device,

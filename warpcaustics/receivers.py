@@ -27,6 +27,9 @@ FIRST_MESH_ID = 2
 PRIMITIVES = ("sphere", "cube", "cylinder", "cone")
 """Built-in meshes (pyvista's primitives): unit size, centred at the origin, axis along z."""
 
+WALL_ALBEDO = (0.8,)
+"""Grey albedo of a walled pool's walls [-]."""
+
 WALL_CELLS = 32
 """Wall quads per side along the wall (and 8 up it)."""
 
@@ -227,9 +230,21 @@ def _concat(meshes: list[TriangleMesh]) -> TriangleMesh:
     return TriangleMesh(np.concatenate(points), np.concatenate(triangles))
 
 
-def albedo_spectrum(albedo: tuple[float, ...], bins: SpectralBins) -> np.ndarray:
-    """(K,) reflectance per bin: a grey value, or linear sRGB turned into a reflectance spectrum by
-    Mallett & Yuksel (2019) (colour-science's ``RGB_to_sd_Mallett2019``)."""
+def albedo_spectrum(
+    albedo: tuple[float, ...],
+    bins: SpectralBins,
+    albedo_file: str | None = None,
+    base_dir: Path | None = None,
+    key: str = "floor",
+) -> np.ndarray:
+    """(K,) reflectance per bin: from ``albedo_file`` (a measured spectrum, bin averages), a grey
+    value, or linear sRGB turned into a reflectance spectrum by Mallett & Yuksel (2019)
+    (colour-science's ``RGB_to_sd_Mallett2019``)."""
+    if albedo_file is not None:
+        from warpcaustics.spectra import read_spectrum_csv
+
+        wl, refl = read_spectrum_csv(albedo_file, base_dir, f"{key}.albedo_file", "reflectance", 1.0)
+        return bins.average(wl, refl, what=f"{key}.albedo_file {albedo_file!r}")
     if len(albedo) == 1:
         return np.full(len(bins.centres_nm), float(albedo[0]))
     with warnings.catch_warnings():
@@ -238,6 +253,15 @@ def albedo_spectrum(albedo: tuple[float, ...], bins: SpectralBins) -> np.ndarray
 
         sd = colour.recovery.RGB_to_sd_Mallett2019(np.asarray(albedo, np.float64))
     return bins.average(sd.wavelengths, sd.values, what="Mallett 2019 sRGB basis")
+
+
+def receiver_albedos(cfg: Config, bins: SpectralBins, base_dir: Path | None) -> np.ndarray:
+    """(R, K) albedo per receiver id (floor, walls, then ``receivers[i]``) and band."""
+    albedos = [albedo_spectrum(cfg.floor.albedo, bins, cfg.floor.albedo_file, base_dir, "floor"),
+               albedo_spectrum(WALL_ALBEDO, bins)]
+    for i, r in enumerate(cfg.receivers):
+        albedos.append(albedo_spectrum(r.albedo, bins, r.albedo_file, base_dir, f"receivers[{i}]"))
+    return np.stack(albedos)
 
 
 def floor_texel_area(cfg: Config, relief: np.ndarray | None) -> np.ndarray:
@@ -266,6 +290,7 @@ class Receivers:
         relief: np.ndarray | None,
         meshes: tuple[TriangleMesh, ...],
         water_top_z: float,
+        base_dir: Path | None = None,
     ):
         floor = floor_mesh(cfg, relief, periodic)
         parts = [floor]
@@ -297,9 +322,7 @@ class Receivers:
         self.face_area_m2 = 0.5 * np.linalg.norm(
             np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=-1
         )
-        grey_walls = (0.8,)
-        albedos = [cfg.floor.albedo, grey_walls] + [r.albedo for r in cfg.receivers]
-        self.albedo = np.stack([albedo_spectrum(a, bins) for a in albedos])
+        self.albedo = receiver_albedos(cfg, bins, base_dir)
         """(R, K) diffuse albedo per receiver and band."""
         self._points_wp = wp.array(whole.points.astype(np.float32), dtype=wp.vec3, device=device)
         self._indices_wp = wp.array(whole.triangles.astype(np.int32).ravel(), dtype=wp.int32, device=device)

@@ -10,9 +10,16 @@ from typing import Any
 
 import numpy as np
 
-from warpcaustics.config import Config, FloorShape, WaterModel, config_from_dict, read_toml
+from warpcaustics.config import (
+    CausticsMethod,
+    Config,
+    FloorShape,
+    WaterModel,
+    config_from_dict,
+    read_toml,
+)
 from warpcaustics.heights import DEFAULT_RESOLUTION, load_heights
-from warpcaustics.receivers import load_floor_relief, load_receiver_mesh
+from warpcaustics.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
 
 
 @dataclass(frozen=True)
@@ -58,6 +65,10 @@ def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) ->
         path = Path(cfg.floor.file)
         relief = load_floor_relief(path if path.is_absolute() else base_dir / path)
     meshes = tuple(load_receiver_mesh(r, base_dir, f"receivers[{i}]") for i, r in enumerate(cfg.receivers))
+    if cfg.caustics.method is CausticsMethod.PHOTONS:
+        from warpcaustics import spectra
+
+        receiver_albedos(cfg, spectra.bins_for(cfg.optics), base_dir)  # bad albedo files fail at load
     return Scene(cfg, base_dir, heights, source, relief, meshes)
 
 

@@ -169,7 +169,7 @@ def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
         planck = _colour().colorimetry.planck_law(fine * 1e-9, sun.temperature_k)
         shape = bins.average(fine, planck, what="Planck")
     else:
-        shape = bins.average(*_read_spectrum_csv(sun.file, base_dir), what=f"sun.file {sun.file!r}")
+        shape = bins.average(*read_spectrum_csv(sun.file, base_dir), what=f"sun.file {sun.file!r}")
     total = sun.irradiance_w_m2 if sun.irradiance_w_m2 > 0 else float(np.sum(astm * bins.widths_nm))
     integral = float(np.sum(shape * bins.widths_nm))
     if not integral > 0:
@@ -177,7 +177,9 @@ def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
     return shape * (total / integral)
 
 
-def _read_spectrum_csv(name: str, base_dir: Path | None) -> tuple[np.ndarray, np.ndarray]:
+def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
+                      quantity: str = "irradiance", upper: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """A two-column CSV (header line, then wavelength [nm], value): one-line errors naming ``key``."""
     path = Path(name)
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
@@ -186,12 +188,13 @@ def _read_spectrum_csv(name: str, base_dir: Path | None) -> tuple[np.ndarray, np
             warnings.simplefilter("ignore")  # an empty file: numpy warns, then we say it in one line
             data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (OSError, ValueError) as exc:
-        raise ConfigError(f"sun.file = {str(path)!r} cannot be read as CSV (header line, then "
-                          f"wavelength_nm,irradiance): {exc}") from None
+        raise ConfigError(f"{key} = {str(path)!r} cannot be read as CSV (header line, then "
+                          f"wavelength_nm,{quantity}): {exc}") from None
     if data.shape[1] < 2 or len(data) < 2 or not np.all(np.diff(data[:, 0]) > 0) \
-            or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0):
-        raise ConfigError(f"sun.file = {str(path)!r} needs two columns, wavelengths strictly "
-                          f"increasing and finite, non-negative irradiances")
+            or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0) or np.any(data[:, 1] > upper):
+        bound = "" if upper == np.inf else f" and at most {upper:g}"
+        raise ConfigError(f"{key} = {str(path)!r} needs two columns, wavelengths strictly "
+                          f"increasing and finite, non-negative {quantity} values{bound}")
     return data[:, 0], data[:, 1]
 
 
