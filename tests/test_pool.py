@@ -206,3 +206,32 @@ def test_wave_pool_drop_keeps_the_troughs(device):
         assert before.min() < -1e-4 and after.min() < -1e-4
         # The wave step conserves Σ η with mirror walls; the drop adds its bump.
         assert after.sum() - before.sum() == pytest.approx(bump, rel=1e-3)
+
+
+def test_pool_over_a_floor_relief_keeps_still_water_still_and_its_volume(device):
+    """A pool over a 10° slope (the floor the photons light is the pool's depth map): still water
+    stays exactly still (gravity pushes on ∇η, not on ∇h), and after a drop the volume is kept."""
+    overrides = {"caustics.method": "photons", "water.resolution": 64, "caustics.map_resolution": 64,
+                 "floor.shape": "slope", "floor.slope_deg": 10.0, "floor.slope_azimuth_deg": 30.0}
+    still = wc.Renderer(wc.load_scene("configs/pool.toml", {**overrides, "water.drops": []}), device)
+    depth = still.water.floor_depth.numpy()
+    assert depth.max() - depth.min() > 0.5  # the depth map really varies
+    result = still.render(1.0)
+    assert still.water.substeps > 100
+    assert np.abs(result.surface_positions[..., 2]).max() < 1e-6
+    pool = ShallowWaterPool.from_config(
+        wc.load_scene("configs/pool.toml", {**overrides, "water.drops": [
+            {"time_s": 0.0, "x_m": 0.5, "y_m": 0.2, "radius_m": 0.2, "height_m": 0.1}]}).config, device)
+    before = pool.volume_m3()
+    for _ in range(500):
+        pool.step(0.004)
+    assert np.abs(pool.u.numpy()).max() > 1e-3
+    assert abs(pool.volume_m3() / before - 1.0) < 1e-6
+
+
+def test_pool_refuses_a_floor_that_reaches_the_water():
+    """A relief that breaks the surface is a one-line error naming floor.shape, not a crash."""
+    scene = wc.load_scene("configs/pool.toml", {"caustics.method": "photons", "floor.shape": "slope",
+                                                "floor.slope_deg": 50.0})
+    with pytest.raises(wc.WarpcausticsError, match="floor.shape = 'slope' reaches the water surface"):
+        wc.Renderer(scene, "cpu")

@@ -175,7 +175,7 @@ class Renderer:
         # One refraction per distinct index: K groups with dispersion, else one shared by all bins.
         self.group_ior = self.ior if cfg.optics.dispersion else self.ior[:1]
         with _memory_errors(self.device, self.bytes_needed):
-            self.water = make_water(cfg, self.device, scene.heights)
+            self.water = make_water(cfg, self.device, scene.heights, scene.floor_relief)
             n = scene.water_resolution
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.photons = None

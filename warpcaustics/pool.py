@@ -65,6 +65,26 @@ class WalledPool:
         return Surface(positions, normals, self.extent_m, periodic=False)
 
 
+def floor_depth_map(cfg: Config, floor_relief: np.ndarray | None) -> np.ndarray | float:
+    """Water depth at rest at the pool's cell centres [m]: ``floor.depth_m`` on a flat floor, else
+    minus the floor relief's height there. Raises a ConfigError where the floor reaches the water."""
+    from warpcaustics.config import FloorShape
+    from warpcaustics.errors import ConfigError
+    from warpcaustics.receivers import floor_relief_height
+
+    if cfg.floor.shape is FloorShape.FLAT:
+        return cfg.floor.depth_m
+    n, extent = cfg.water.resolution, cfg.water.extent_m
+    x = (np.arange(n) + 0.5) * extent / n - extent / 2
+    depth = -floor_relief_height(cfg.floor, floor_relief, extent, *np.meshgrid(x, x))
+    if depth.min() <= 0.0:
+        iy, ix = np.unravel_index(np.argmin(depth), depth.shape)
+        raise ConfigError(f"floor.shape = {cfg.floor.shape.value!r} reaches the water surface at "
+                          f"(x, y) = ({x[ix]:.2f}, {x[iy]:.2f}) m (depth {depth.min():.3f} m); the pool "
+                          "needs water everywhere: make floor.depth_m larger or the relief gentler")
+    return depth
+
+
 class ShallowWaterPool(WalledPool):
     """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
 
@@ -91,10 +111,12 @@ class ShallowWaterPool(WalledPool):
         self._drop_water(0.0)
 
     @classmethod
-    def from_config(cls, cfg: Config, device: str) -> ShallowWaterPool:
+    def from_config(cls, cfg: Config, device: str,
+                    floor_relief: np.ndarray | None = None) -> ShallowWaterPool:
+        """The pool of ``cfg``; its depth map follows ``floor.shape`` (the floor the photons light)."""
         w = cfg.water
-        return cls(w.resolution, w.extent_m, cfg.floor.depth_m, device, viscosity_m2_s=w.viscosity_m2_s,
-                   cfl=w.cfl, drops=w.drops, body=w.body)
+        return cls(w.resolution, w.extent_m, floor_depth_map(cfg, floor_relief), device,
+                   viscosity_m2_s=w.viscosity_m2_s, cfl=w.cfl, drops=w.drops, body=w.body)
 
     def body_state(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Centre [m] and velocity [m/s] of the body at ``time_s`` on its circular path."""

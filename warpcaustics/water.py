@@ -280,15 +280,16 @@ def water_bytes(cfg: Config, n: int) -> int:
     return surface + n * n * 4
 
 
-def make_water(cfg: Config, device: str, heights: np.ndarray | None):
-    """Build the surface model named by ``water.model``."""
+def make_water(cfg: Config, device: str, heights: np.ndarray | None, floor_relief: np.ndarray | None = None):
+    """Build the surface model named by ``water.model`` (``floor_relief``: ``floor.file``'s array,
+    for the shallow-water pool's depth map)."""
     w = cfg.water
     if w.model is WaterModel.FFT:
         return FFTOcean.from_config(cfg, device)
     if w.model is WaterModel.POOL:
         from warpcaustics.pool import ShallowWaterPool
 
-        return ShallowWaterPool.from_config(cfg, device)
+        return ShallowWaterPool.from_config(cfg, device, floor_relief)
     if w.model is WaterModel.WAVEPOOL:
         from warpcaustics.wavepool import WaveEquationPool
 
