@@ -220,8 +220,11 @@ def _photons() -> None:
     print(f"pool with a sphere (floor + walls + sphere) / transmitted - 1 = "
           f"{np.abs(total / r.transmitted_flux_w_nm - 1).max():.1e}")
 
-    print("\n## Shah's Newton–Raphson vs exact BVH hits (ocean 64², 2×2 photons per cell, 1024² buffer)")
-    for name, scene, receiver in (("15° slope", SLOPE, 0), ("sphere r = 1.5 m", SPHERE, 2)):
+    print("\n## Shah's Newton–Raphson vs exact BVH hits (64² surface, 2×2 photons per cell, 1024² buffer)")
+    oblique = {**SLOPE, "sun.elevation_deg": 80.0}
+    for name, scene, receiver in (("15° slope in the pool, sun at the zenith", SLOPE, 0),
+                                  ("15° slope in the pool, sun 80° high", oblique, 0),
+                                  ("sphere r = 1.5 m in the ocean", SPHERE, 2)):
         ks = [0, 1, 2, 3, 4, 5]
         errors, texel = newton_errors(scene, ks, receiver=receiver)
         print(f"{name} (light-view texel {texel * 1000:.1f} mm): k, mean, median, p95 [mm], "

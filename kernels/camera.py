@@ -251,7 +251,7 @@ def splat_photons(
         return
     if not same_surface(depth[cj, ci], depth_slack[cj, ci], c[2], depth_tolerance):
         return  # hidden behind something nearer the camera
-    ell = wp.length(x - origin[p])
+    ell = wp.length(hit[p] - origin[p])  # the copy's path is the photon's own
     g = p / photons_per_group
     w = weight[p]
     eu, ev, ok = photon_lattice(hit, face, p, quads, subdivisions, periodic, extent_m)

@@ -106,32 +106,29 @@ def test_photon_flux_is_conserved_in_a_walled_pool_with_an_object(device):
 def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
     """Statistics of |Newton hit − exact hit| [m] for each k in ``iterations`` over the photons whose
     exact hit is on receiver id ``receiver``: dicts of mean, median, p95 and ``within_texel`` (the
-    share closer than one light-view texel); and that texel's size [m]."""
+    share closer than one light-view texel); and that texel's size [m]. ``scene_overrides`` may
+    name a ``config`` (default the ocean) and the ``time_s`` rendered."""
+    overrides = dict(scene_overrides)
+    config = overrides.pop("config", "configs/ocean.toml")
+    time_s = overrides.pop("time_s", 0.0)
     base = {
         **PHOTONS,
         "water.resolution": 64,
         "caustics.map_resolution": 64,
         "optics.wavelengths": "rgb",
         "caustics.photon_subdivisions": 2,
-        **scene_overrides,
+        **overrides,
     }
-    exact = wc.Renderer(
-        wc.load_scene("configs/ocean.toml", {**base, "caustics.intersection": "exact"}), device
-    )
-    exact.render(0.0)
+    exact = wc.Renderer(wc.load_scene(config, {**base, "caustics.intersection": "exact"}), device)
+    exact.render(time_s)
     hit = exact.photons.hit.numpy().copy()
     face = exact.photons.face.numpy().copy()
     on_receiver = exact.receivers.face_receiver_np[np.maximum(face, 0)] == receiver
     out = []
     for k in iterations:
-        r = wc.Renderer(
-            wc.load_scene(
-                "configs/ocean.toml",
-                {**base, "caustics.intersection": "newton", "caustics.newton_iterations": k},
-            ),
-            device,
-        )
-        r.render(0.0)
+        newton = {**base, "caustics.intersection": "newton", "caustics.newton_iterations": k}
+        r = wc.Renderer(wc.load_scene(config, newton), device)
+        r.render(time_s)
         ok = (face >= 0) & on_receiver & (r.photons.face.numpy() >= 0)
         err = np.linalg.norm(r.photons.hit.numpy()[ok] - hit[ok], axis=1)
         out.append(
@@ -145,7 +142,17 @@ def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
     return out, r.photons.view.texel_m
 
 
-SLOPE = {"floor.shape": "slope", "floor.slope_deg": 15.0, "floor.slope_azimuth_deg": 30.0}
+SLOPE = {
+    "config": "configs/pool.toml",
+    "time_s": 0.6,
+    "floor.shape": "slope",
+    "floor.slope_deg": 15.0,
+    "floor.slope_azimuth_deg": 30.0,
+    "sun.elevation_deg": 90.0,
+}
+"""A 15° slope under the shallow-water pool, 0.6 s after its drops (a slope does not tile a sea),
+sun at the zenith, so that the sun sees all of the floor (an oblique sun hides the floor by the
+walls from the receiver-position buffer: those photons cannot converge, as on the sphere)."""
 SPHERE = {"receivers": [{"mesh": "sphere", "scale": 3.0, "translate_m": [0.0, 0.0, -2.5]}]}
 
 

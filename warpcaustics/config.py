@@ -552,6 +552,33 @@ def _check_vector(key: str, value: tuple[float, ...], lengths: tuple[int, ...]) 
         raise ConfigError(f"{key} = {list(value)} must have {' or '.join(map(str, lengths))} values")
 
 
+def _check_periodic_floor(cfg: Config) -> None:
+    """Under a periodic sea the floor must tile the patch too: the photons of the neighbouring
+    tiles are folded into the patch, which is only right if the floor repeats with it."""
+    if cfg.water.model in (WaterModel.POOL, WaterModel.WAVEPOOL):
+        return
+    floor = cfg.floor
+    if floor.shape is FloorShape.SLOPE:
+        raise ConfigError(f"floor.shape = 'slope' does not repeat, but water.model = "
+                          f"{cfg.water.model.value!r} is a periodic patch: use a walled pool "
+                          "(water.model = \"pool\" or \"wavepool\") or a floor that tiles (ripples, file)")
+    if floor.shape is FloorShape.RIPPLES:
+        a = math.radians(floor.ripple_direction_deg)
+        m = math.cos(a) * cfg.water.extent_m / floor.ripple_wavelength_m
+        n = math.sin(a) * cfg.water.extent_m / floor.ripple_wavelength_m
+        mi, ni = round(m), round(n)
+        if max(abs(m - mi), abs(n - ni)) > 1e-4:
+            if mi == 0 and ni == 0:
+                mi = 1
+            wavelength = cfg.water.extent_m / math.hypot(mi, ni)
+            direction = math.degrees(math.atan2(ni, mi))
+            raise ConfigError(
+                f"floor ripples (wavelength {floor.ripple_wavelength_m:g} m, direction "
+                f"{floor.ripple_direction_deg:g}°) do not tile the periodic {cfg.water.extent_m:g} m patch; "
+                f"the nearest that do: floor.ripple_wavelength_m = {wavelength:.6f}, "
+                f"floor.ripple_direction_deg = {direction:.4f}")
+
+
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon method."""
     photons = cfg.caustics.method is CausticsMethod.PHOTONS
@@ -571,6 +598,7 @@ def _check_photon_scene(cfg: Config) -> None:
     if cfg.floor.shape is not FloorShape.FILE and cfg.floor.file:
         raise ConfigError(f"floor.file = {cfg.floor.file!r} is only read by floor.shape = 'file'; remove "
                           "it or set floor.shape = \"file\"")
+    _check_periodic_floor(cfg)
     _check_vector("floor.albedo", cfg.floor.albedo, (1, 3))
     for i, r in enumerate(cfg.receivers):
         _check_vector(f"receivers[{i}].scale", r.scale, (1, 3))

@@ -50,6 +50,35 @@ class PhotonStats:
     """Photons that found a receiver."""
 
 
+def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, ior: np.ndarray) -> None:
+    """On a periodic sea a photon is moved by whole periods so that, followed to the floor plane at
+    rest, it lands in the patch; a mesh only gets the light of photons whose path through it would
+    land there. Refuse meshes so near the patch edge that some of their light would be missed."""
+    from warpcaustics.errors import ConfigError
+    from warpcaustics.reference import refract
+
+    if not meshes:
+        return
+    half = 0.5 * cfg.water.extent_m
+    plane_z = -cfg.floor.depth_m
+    for i, mesh in enumerate(meshes):
+        worst = 0.0
+        for n in (float(np.min(ior)), float(np.max(ior))):
+            d = refract(-np.asarray(sun_dir, np.float64), np.array([0.0, 0.0, 1.0]), 1.0 / n)
+            drop = mesh.points[:, 2] - plane_z
+            landing = mesh.points[:, :2] + (drop / -d[2])[:, None] * d[None, :2]
+            # Waves tilt the rays: allow for a tenth of the drop either way, and 2 % of the patch.
+            margin = 0.1 * np.abs(drop) + 0.02 * cfg.water.extent_m
+            spots = np.concatenate([landing, mesh.points[:, :2]])
+            reach = np.max(np.abs(spots) + np.tile(margin, 2)[:, None])
+            worst = max(worst, float(reach - half))
+        if worst > 0.0:
+            raise ConfigError(
+                f"receivers[{i}] is {worst:.2f} m too near the edge of the periodic {cfg.water.extent_m:g} m "
+                "patch: part of the light that reaches it would land outside the patch and be missed; "
+                "move it towards the centre (receivers[].translate_m) or enlarge water.extent_m")
+
+
 def light_view_frame(points: np.ndarray, sun_dir: np.ndarray, resolution: int):
     """(origin, u, v, texel) of an orthographic sun view covering all ``points``; u, v ⊥ sun."""
     s = np.asarray(sun_dir, np.float64)

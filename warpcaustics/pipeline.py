@@ -65,6 +65,8 @@ class RenderResult:
     """``photons``: (F,) area of each of those faces [m²]."""
     face_centres_m: np.ndarray | None = None
     """``photons``: (F, 3) centroid of each of those faces [m]."""
+    floor_texel_area_m2: np.ndarray | None = None
+    """``photons``: (M, M) true area of the floor over each texel [m²] (None: flat, (L/M)²)."""
     photon_stats: dict[str, int] | None = None
     """``photons``: photons emitted, carrying flux, and landed on a receiver."""
     camera_radiance: np.ndarray | None = None
@@ -90,7 +92,10 @@ class RenderResult:
 
     @property
     def floor_flux_w_nm(self) -> np.ndarray:
-        """(K,) total flux on the floor [W nm^-1], summed in float64."""
+        """(K,) total flux on the floor [W nm^-1], summed in float64 over each texel's true floor
+        area (a relief's area exceeds the texel's horizontal area)."""
+        if self.floor_texel_area_m2 is not None:
+            return np.einsum("kij,ij->k", self.floor_irradiance.astype(np.float64), self.floor_texel_area_m2)
         return self.floor_irradiance.sum(axis=(1, 2), dtype=np.float64) * self.texel_area_m2
 
     def save(self, out_dir: str | Path, *, frame: int = 0) -> dict[str, Path]:
@@ -136,6 +141,23 @@ def scene_bytes(scene: Scene) -> int:
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
         return water_bytes(cfg, n) + photons.photons_bytes(cfg, n, k, groups, periodic, faces) + cam
     return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
+
+
+def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
+    """The camera must be in the water: inside a walled pool's walls and above the floor."""
+    from warpcaustics.errors import ConfigError
+    from warpcaustics.receivers import floor_relief_height
+
+    x, y, z = cfg.camera.position_m
+    half = 0.5 * cfg.water.extent_m
+    if not periodic and max(abs(x), abs(y)) >= half:
+        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is outside the pool's walls "
+                          f"(|x|, |y| < {half:g} m); move the camera into the water")
+    floor_z = float(floor_relief_height(cfg.floor, floor_relief, cfg.water.extent_m, np.array(x),
+                                        np.array(y)))
+    if z <= floor_z:
+        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is below the floor (z = "
+                          f"{floor_z:.3f} m there); move the camera up into the water")
 
 
 def water_is_periodic(cfg) -> bool:
@@ -188,8 +210,12 @@ class Renderer:
                                                       scene.sun_direction, self.device,
                                                       periodic=self.water.periodic)
                 self.floor_top_z = self.receivers.floor_top_z
+                if self.water.periodic:
+                    photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, scene.sun_direction,
+                                                      self.group_ior)
                 self.camera = None
                 if cfg.camera.enabled:
+                    check_camera_position(cfg, scene.floor_relief, self.water.periodic)
                     self.camera = UnderwaterCamera(cfg.camera, self.receivers, optics.scattering_per_m,
                                                    PhaseFunction.from_optics(cfg.optics, self.device),
                                                    self.device)
@@ -226,6 +252,11 @@ class Renderer:
         if self.photons is not None:
             with watch.stage("photons"):
                 floor = self.photons.run(surface, visible, self.group_ior)
+            if self.receivers.mesh_top_z >= lowest:
+                raise WarpcausticsError(
+                    f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
+                    f"lowest point z = {lowest:.3f} m at t = {time_s:g} s; receivers must stay under the "
+                    "water: lower them (receivers[].translate_m) or make the floor deeper")
             if self.camera is not None:
                 if self.camera.position_z >= lowest:
                     raise WarpcausticsError(
@@ -247,6 +278,7 @@ class Renderer:
                              face_receiver=rec.face_receiver_np[rec.floor_face_count:],
                              face_area_m2=rec.face_area_m2[rec.floor_face_count:],
                              face_centres_m=rec.face_centres_m[rec.floor_face_count:],
+                             floor_texel_area_m2=rec.floor_texel_area_m2,
                              photon_stats=vars(self.photons.stats()))
         else:
             with watch.stage("refraction"):

@@ -314,19 +314,23 @@ class Receivers:
         inside = np.all(np.abs(floor.points[:, :2]) <= 0.5 * cfg.water.extent_m * (1 + 1e-9), axis=1)
         self.floor_top_z = float(floor.points[inside, 2].max())
         """Highest floor point inside the patch [m]."""
+        self.mesh_top_z = max((float(m.points[:, 2].max()) for m in meshes), default=-np.inf)
+        """Highest point of the ``[[receivers]]`` meshes [m] (−inf without meshes)."""
         self.points = whole.points
         self.triangles = whole.triangles
         self.face_receiver_np = np.concatenate(ids).astype(np.int32)
         tri = whole.points[whole.triangles]
         self.face_centres_m = tri.mean(axis=1)
-        self.face_area_m2 = 0.5 * np.linalg.norm(
-            np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=-1
-        )
+        cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        self.face_area_m2 = 0.5 * np.linalg.norm(cross, axis=-1)
+        unit_normals = cross / np.maximum(2.0 * self.face_area_m2, 1e-30)[:, None]
         self.albedo = receiver_albedos(cfg, bins, base_dir)
         """(R, K) diffuse albedo per receiver and band."""
         self._points_wp = wp.array(whole.points.astype(np.float32), dtype=wp.vec3, device=device)
         self._indices_wp = wp.array(whole.triangles.astype(np.int32).ravel(), dtype=wp.int32, device=device)
         self.mesh = wp.Mesh(self._points_wp, self._indices_wp)
+        self.face_normal = wp.array(unit_normals.astype(np.float32), dtype=wp.vec3, device=device)
+        """Unit normal of each face (winding order)."""
         self.face_receiver = wp.array(self.face_receiver_np, dtype=wp.int32, device=device)
         self.albedo_wp = wp.array(self.albedo.astype(np.float32), dtype=wp.float32, device=device)
         self.floor_texel_area_m2 = floor_texel_area(cfg, relief)
