@@ -18,8 +18,21 @@ INV_PI = 0.3183098861837907
 MAX_SPLAT_RADIUS = 8
 """Largest photon splat radius [pixels]."""
 
-MAX_TENT_RADIUS = 24
-"""Largest reach of a tent splat [pixels]."""
+MAX_TENT_RADIUS = 64
+"""Largest reach of a tent splat from its photon [pixels] (a sparse photon right at the lens)."""
+
+MAX_CELL_SPACINGS = 16.0
+"""A photon's lattice cell longer than this many surface photon spacings is not a neighbourhood
+(its neighbour landed far away, past a silhouette) and gets a Gaussian instead."""
+
+MIN_CELL_ALIGNMENT = 0.7
+"""A lattice cell must lie in its receiver's surface: |cos| between the cell's and the face's
+normals at least this (neighbours across the edge of a box do not)."""
+
+TENT_PLANE_TOLERANCE = 0.1
+"""A pixel's G-buffer point takes part in a photon's tent if it lies within this fraction of the
+cell's longer side (plus 1 mm) of the pixel's tangent plane through the photon: depth jumps and
+other surfaces of the same receiver are left out, however deep the tent reaches."""
 
 MIN_SPLAT_SIGMA = 1.0
 """Narrowest photon splat (Gaussian σ) [pixels]: photons closer than a pixel apart would alias
@@ -127,8 +140,9 @@ def unwrap(a: wp.vec3, b: wp.vec3, periodic: int, extent_m: float) -> wp.vec3:
 
 
 @wp.func
-def grid_neighbour(p: int, along_v: int, quads: int, s: int, periodic: int) -> int:
-    """Index of the next photon of the light-space grid along u (along_v = 0) or v; −1 at a wall."""
+def grid_neighbour(p: int, along_v: int, step: int, quads: int, s: int, periodic: int) -> int:
+    """Index of the photon one grid step (``step`` = ±1) along u (along_v = 0) or v from photon p;
+    −1 past a wall."""
     sub = p % (s * s)
     cell = p / (s * s)
     qx = cell % quads
@@ -137,42 +151,86 @@ def grid_neighbour(p: int, along_v: int, quads: int, s: int, periodic: int) -> i
     a = sub % s
     b = sub / s
     if along_v == 0:
-        a += 1
+        a += step
         if a == s:
             a = 0
             qx += 1
+        if a < 0:
+            a = s - 1
+            qx -= 1
     else:
-        b += 1
+        b += step
         if b == s:
             b = 0
             qy += 1
-    if qx == quads or qy == quads:
+        if b < 0:
+            b = s - 1
+            qy -= 1
+    if qx == quads or qy == quads or qx < 0 or qy < 0:
         if periodic == 0:
             return -1
-        qx = qx % quads
-        qy = qy % quads
+        qx = (qx + quads) % quads
+        qy = (qy + quads) % quads
     return (base + qy * quads + qx) * s * s + b * s + a
+
+
+@wp.func
+def lattice_step(
+    hit: wp.array[wp.vec3],
+    face: wp.array[wp.int32],
+    face_receiver: wp.array[wp.int32],
+    p: int,
+    along_v: int,
+    quads: int,
+    s: int,
+    periodic: int,
+    extent_m: float,
+):
+    """(e, ok): the step from photon p's hit to its next grid neighbour's along u or v, taken
+    forwards, or backwards (reversed) where the forward neighbour is missing, lost or on another
+    receiver; ok = 0 if neither qualifies."""
+    r = face_receiver[face[p]]
+    n = grid_neighbour(p, along_v, 1, quads, s, periodic)
+    if n >= 0:
+        if face[n] >= 0:
+            if face_receiver[face[n]] == r:
+                return unwrap(hit[p], hit[n], periodic, extent_m), int(1)
+    n = grid_neighbour(p, along_v, -1, quads, s, periodic)
+    if n >= 0:
+        if face[n] >= 0:
+            if face_receiver[face[n]] == r:
+                return unwrap(hit[n], hit[p], periodic, extent_m), int(1)
+    return wp.vec3(0.0), int(0)
 
 
 @wp.func
 def photon_lattice(
     hit: wp.array[wp.vec3],
     face: wp.array[wp.int32],
+    face_receiver: wp.array[wp.int32],
+    face_normal: wp.array[wp.vec3],
     p: int,
     quads: int,
     s: int,
     periodic: int,
     extent_m: float,
+    spacing_m: float,
 ):
-    """(e_u, e_v, ok): from photon p's hit to its two next grid neighbours' hits [m]; ok = 0 where
-    a neighbour is missing (a wall, a lost photon)."""
-    nu = grid_neighbour(p, 0, quads, s, periodic)
-    nv = grid_neighbour(p, 1, quads, s, periodic)
-    if nu < 0 or nv < 0:
-        return wp.vec3(0.0), wp.vec3(0.0), int(0)
-    if face[nu] < 0 or face[nv] < 0:
-        return wp.vec3(0.0), wp.vec3(0.0), int(0)
-    return unwrap(hit[p], hit[nu], periodic, extent_m), unwrap(hit[p], hit[nv], periodic, extent_m), int(1)
+    """(e_u, e_v, ok): photon p's lattice cell on its receiver [m]. ok = 0 (use a Gaussian) where
+    no neighbour on the same receiver exists along u or v, or where the cell does not lie in the
+    receiver's surface (neighbours across an edge of a box) or is implausibly large."""
+    eu, ok_u = lattice_step(hit, face, face_receiver, p, 0, quads, s, periodic, extent_m)
+    ev, ok_v = lattice_step(hit, face, face_receiver, p, 1, quads, s, periodic, extent_m)
+    if ok_u == 0 or ok_v == 0:
+        return eu, ev, int(0)
+    normal = wp.cross(eu, ev)
+    area = wp.length(normal)
+    longest = wp.max(wp.length(eu), wp.length(ev))
+    if area <= 1.0e-6 * longest * longest or longest > MAX_CELL_SPACINGS * spacing_m:
+        return eu, ev, int(0)
+    if wp.abs(wp.dot(normal, face_normal[face[p]])) < MIN_CELL_ALIGNMENT * area:
+        return eu, ev, int(0)
+    return eu, ev, int(1)
 
 
 @wp.func
@@ -210,7 +268,12 @@ def splat_photons(
     periodic: int,
     extent_m: float,
     floor_face_count: int,
+    photon_spacing_m: float,
+    face_receiver: wp.array[wp.int32],
+    face_normal: wp.array[wp.vec3],
     position: wp.array2d[wp.vec3],
+    normal: wp.array2d[wp.vec3],
+    receiver: wp.array2d[wp.int32],
     depth: wp.array2d[wp.float32],
     inv_footprint: wp.array2d[wp.float32],
     depth_slack: wp.array2d[wp.float32],
@@ -222,15 +285,17 @@ def splat_photons(
     spacing on the receiver seen at its distance (de la Fuente 2011 §4.5), from its grid neighbours'
     hits e_u, e_v, so splats shrink in focused light and widen where it spreads:
 
-    - a photon with both neighbours: the tent (bilinear hat) over ±e_u, ±e_v on the receiver,
-      evaluated at each pixel's G-buffer point, irradiance ``Φ hat / |e_u × e_v|``. The hats of a
-      lattice of photons sum to one at every point, so each pixel samples the piecewise-bilinear
-      irradiance exactly, however sparse, sheared (grazing light on a wall) or dense (sub-pixel
-      detail is then point-sampled, as any rasteriser without supersampling does) the photons are;
-      mixing kernels instead leaves seams where the kernel changes;
-    - a photon without neighbours (the edge of the lit region, lost neighbours): a Gaussian of σ =
-      MIN_SPLAT_SIGMA pixels normalised as a density on the receiver, ``Φ G_q / Σ_q' G_q' A_q'``
-      (A: pixel footprint), so its flux is kept.
+    - a photon with a neighbour on its receiver along u and along v (forwards, else backwards):
+      the tent (bilinear hat) over ±e_u, ±e_v on the receiver, evaluated at each pixel's G-buffer
+      point, irradiance ``Φ hat / |e_u × e_v|`` (:func:`splat_tent`). The hats of a regular
+      (affine) lattice of photons sum to one at every point, so each pixel samples the
+      piecewise-bilinear irradiance the photons imply, however sparse, sheared (grazing light on a
+      wall) or dense (sub-pixel detail is then point-sampled, as any rasteriser without
+      supersampling does) they are; where the lattice bends (focusing, the half-width quads at a
+      pool's walls) the hats sum to one only approximately;
+    - a photon without such neighbours (the edge of the lit region, a silhouette): a Gaussian of
+      σ = MIN_SPLAT_SIGMA pixels normalised as a density on the receiver,
+      ``Φ G_q / Σ_q' G_q' A_q'`` (A: pixel footprint), so its flux is kept.
 
     On a periodic sea a floor photon is also splatted at its eight copies one period away (the light
     of the neighbouring tiles), so the floor around the patch is lit and the patch edge does not
@@ -243,56 +308,37 @@ def splat_photons(
         return
     x = hit[p] + wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
     c = project(cam, x)
-    if c[2] < 0.0:
-        return
-    ci = int(wp.floor(c[0]))
-    cj = int(wp.floor(c[1]))
-    if ci < 0 or cj < 0 or ci >= cam.width or cj >= cam.height:
-        return
-    if not same_surface(depth[cj, ci], depth_slack[cj, ci], c[2], depth_tolerance):
-        return  # hidden behind something nearer the camera
     ell = wp.length(hit[p] - origin[p])  # the copy's path is the photon's own
     g = p / photons_per_group
     w = weight[p]
-    eu, ev, ok = photon_lattice(hit, face, p, quads, subdivisions, periodic, extent_m)
-    area = wp.length(wp.cross(eu, ev))
-    longest = wp.max(wp.length(eu), wp.length(ev))
-    # The lattice cell on screen [pixels]: its longer side and its narrower width.
-    su = project(cam, x + eu) - c
-    sv = project(cam, x + ev) - c
-    longest_px = wp.max(wp.length(wp.vec2(su[0], su[1])), wp.length(wp.vec2(sv[0], sv[1])))
-    if ok != 0 and area > 1.0e-6 * longest * longest:
-        # Tent over the photon's lattice cell: α, β solve (X − x) ≈ α e_u + β e_v (least squares).
-        a = wp.dot(eu, eu)
-        b = wp.dot(eu, ev)
-        d = wp.dot(ev, ev)
-        det = a * d - b * b
-        reach = wp.min(int(wp.ceil(2.0 * longest_px)) + 1, MAX_TENT_RADIUS)
-        for dj in range(-reach, reach + 1):
-            for di in range(-reach, reach + 1):
-                i = ci + di
-                j = cj + dj
-                if i >= 0 and j >= 0 and i < cam.width and j < cam.height:
-                    if same_surface(depth[j, i], depth_slack[j, i], c[2], depth_tolerance):
-                        q = position[j, i] - x
-                        pu = wp.dot(q, eu)
-                        pv = wp.dot(q, ev)
-                        alpha = (d * pu - b * pv) / det
-                        beta = (a * pv - b * pu) / det
-                        hat = wp.max(1.0 - wp.abs(alpha), 0.0) * wp.max(1.0 - wp.abs(beta), 0.0)
-                        if hat > 0.0:
-                            add_flux(
-                                caustic,
-                                j,
-                                i,
-                                w * hat / area,
-                                g,
-                                wavelengths_per_group,
-                                sun_irradiance,
-                                attenuation_per_m,
-                                ell,
-                            )
+    eu, ev, ok = photon_lattice(
+        hit, face, face_receiver, face_normal, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
+    )
+    if ok != 0:
+        splat_tent(
+            cam,
+            x,
+            eu,
+            ev,
+            face_receiver[f],
+            position,
+            normal,
+            receiver,
+            w,
+            g,
+            wavelengths_per_group,
+            sun_irradiance,
+            attenuation_per_m,
+            ell,
+            caustic,
+        )
         return
+    ci = int(wp.floor(c[0]))
+    cj = int(wp.floor(c[1]))
+    if c[2] < 0.0 or ci < 0 or cj < 0 or ci >= cam.width or cj >= cam.height:
+        return
+    if not same_surface(depth[cj, ci], depth_slack[cj, ci], c[2], depth_tolerance):
+        return  # hidden behind something nearer the camera
     r = wp.min(int(wp.ceil(2.0 * MIN_SPLAT_SIGMA)), MAX_SPLAT_RADIUS)
     total = float(0.0)
     for dj in range(-r, r + 1):
@@ -317,6 +363,87 @@ def splat_photons(
                     attenuation_per_m,
                     ell,
                 )
+
+
+@wp.func
+def splat_tent(
+    cam: PinholeCamera,
+    x: wp.vec3,
+    eu: wp.vec3,
+    ev: wp.vec3,
+    rid: int,
+    position: wp.array2d[wp.vec3],
+    normal: wp.array2d[wp.vec3],
+    receiver: wp.array2d[wp.int32],
+    w: float,
+    g: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    ell: float,
+    caustic: wp.array3d[wp.float32],
+):
+    """Add the tent of a photon at x with lattice cell (e_u, e_v) to every pixel whose G-buffer
+    point lies in its support: same receiver, on the pixel's tangent plane through x, and
+    (X − x) = α e_u + β e_v (least squares) with |α|, |β| < 1; irradiance ``w hat / |e_u × e_v|``.
+
+    The pixels searched are the screen box of the support's four corners x ± e_u ± e_v (clipped
+    to the frame and to MAX_TENT_RADIUS around the photon), so photons just outside the frame still
+    light its edge."""
+    lo = wp.vec2(1.0e30, 1.0e30)
+    hi = wp.vec2(-1.0e30, -1.0e30)
+    behind = int(0)
+    for k in range(4):
+        q = project(cam, x + float(2 * (k % 2) - 1) * eu + float(2 * (k / 2) - 1) * ev)
+        if q[2] < 0.0:
+            behind = 1
+        else:
+            lo = wp.vec2(wp.min(lo[0], q[0]), wp.min(lo[1], q[1]))
+            hi = wp.vec2(wp.max(hi[0], q[0]), wp.max(hi[1], q[1]))
+    c = project(cam, x)
+    if c[2] > 0.0:
+        radius = float(MAX_TENT_RADIUS)
+        if behind != 0:
+            lo = wp.vec2(c[0] - radius, c[1] - radius)
+            hi = wp.vec2(c[0] + radius, c[1] + radius)
+        lo = wp.vec2(wp.max(lo[0], c[0] - radius), wp.max(lo[1], c[1] - radius))
+        hi = wp.vec2(wp.min(hi[0], c[0] + radius), wp.min(hi[1], c[1] + radius))
+    elif behind != 0:
+        return  # the photon and part of its support lie behind the camera
+    i0 = wp.max(int(wp.floor(lo[0])), 0)
+    j0 = wp.max(int(wp.floor(lo[1])), 0)
+    i1 = wp.min(int(wp.floor(hi[0])), cam.width - 1)
+    j1 = wp.min(int(wp.floor(hi[1])), cam.height - 1)
+    i1 = wp.min(i1, i0 + 2 * MAX_TENT_RADIUS)
+    j1 = wp.min(j1, j0 + 2 * MAX_TENT_RADIUS)
+    a = wp.dot(eu, eu)
+    b = wp.dot(eu, ev)
+    d = wp.dot(ev, ev)
+    det = a * d - b * b
+    area = wp.length(wp.cross(eu, ev))
+    tolerance = TENT_PLANE_TOLERANCE * wp.sqrt(wp.max(a, d)) + 1.0e-3
+    for j in range(j0, j1 + 1):
+        for i in range(i0, i1 + 1):
+            if receiver[j, i] == rid:
+                q = position[j, i] - x
+                if wp.abs(wp.dot(q, normal[j, i])) <= tolerance:
+                    pu = wp.dot(q, eu)
+                    pv = wp.dot(q, ev)
+                    alpha = (d * pu - b * pv) / det
+                    beta = (a * pv - b * pu) / det
+                    hat = wp.max(1.0 - wp.abs(alpha), 0.0) * wp.max(1.0 - wp.abs(beta), 0.0)
+                    if hat > 0.0:
+                        add_flux(
+                            caustic,
+                            j,
+                            i,
+                            w * hat / area,
+                            g,
+                            wavelengths_per_group,
+                            sun_irradiance,
+                            attenuation_per_m,
+                            ell,
+                        )
 
 
 @wp.func
@@ -369,6 +496,9 @@ def shaft_lines(
     weight: wp.array[wp.float32],
     stride: int,
     tube_width_m: float,
+    periodic: int,
+    extent_m: float,
+    floor_face_count: int,
     photons_per_group: int,
     sun_irradiance: wp.array[wp.float32],
     attenuation_per_m: wp.array[wp.float32],
@@ -392,17 +522,31 @@ def shaft_lines(
     (near the camera), the step goes into the level of a pixel pyramid (``pyramid``: (K, packed
     levels)) whose pixels are at least as wide as the tube, Ω being that coarse pixel's solid angle;
     :func:`collapse_pyramid` adds the levels back up, so near lines neither streak nor spike.
+
+    On a periodic sea the lines of floor photons are also drawn at their eight copies one period
+    away, so the water beyond the patch holds light shafts too (``copy`` 4 is the line itself).
     """
-    t = wp.tid()
+    t, copy = wp.tid()
     p = t * stride
-    if face[p] < 0:
+    f = face[p]
+    if f < 0:
         return
-    o = origin[p]
-    x1 = hit[p]
+    if copy != 4 and (periodic == 0 or f >= floor_face_count):
+        return
+    shift = wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
+    o = origin[p] + shift
+    x1 = hit[p] + shift
     d = direction[p]
     length = wp.length(x1 - o)
     a = project(cam, o)
     b = project(cam, x1)
+    if a[2] > 0.0 and b[2] > 0.0:  # a line wholly off one side of the frame adds nothing
+        w_px = float(cam.width)
+        h_px = float(cam.height)
+        if (a[0] < 0.0 and b[0] < 0.0) or (a[0] > w_px and b[0] > w_px):
+            return
+        if (a[1] < 0.0 and b[1] < 0.0) or (a[1] > h_px and b[1] > h_px):
+            return
     pixels = float(MAX_SHAFT_STEPS)
     if a[2] > 0.0 and b[2] > 0.0:
         pixels = wp.length(wp.vec2(b[0] - a[0], b[1] - a[1]))

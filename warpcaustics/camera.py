@@ -132,7 +132,12 @@ class UnderwaterCamera:
                 int(photons.periodic),
                 float(photons.cfg.water.extent_m),
                 self.receivers.floor_face_count,
+                float(photon_spacing_m),
+                self.receivers.face_receiver,
+                self.receivers.face_normal,
                 self.position,
+                self.normal,
+                self.receiver,
                 self.depth,
                 self.inv_footprint,
                 self.depth_slack,
@@ -147,7 +152,7 @@ class UnderwaterCamera:
             ph = self.phase
             wp.launch(
                 camera_kernels.shaft_lines,
-                dim=count // stride,
+                dim=(count // stride, 9),
                 inputs=[
                     self.cam,
                     photons.hit,
@@ -157,6 +162,9 @@ class UnderwaterCamera:
                     photons.weight,
                     stride,
                     float(photon_spacing_m * photons.subdivisions),
+                    int(photons.periodic),
+                    float(photons.cfg.water.extent_m),
+                    self.receivers.floor_face_count,
                     photons.photons_per_group,
                     photons.sun_irradiance,
                     photons.attenuation_per_m,
