@@ -245,43 +245,15 @@ def _photons() -> None:
                   f"{np.abs(f - ref).sum() / np.abs(ref).sum():.2%}")
 
     print("\n## Light shafts vs single scattering, sun at the zenith over a still pool (clear_ocean)")
-    for n in (64, 128):
-        _shaft_ratio(n)
+    from test_photons import shaft_block
+
+    for n in (64, 128, 256):
+        for pitch, sees, view in ((0.0, 1, "level, to the far wall"), (35.0, -1, "35° up, to the surface"),
+                                  (-35.0, 0, "35° down, to the floor (+ the lit floor)")):
+            measured, expected = shaft_block(pitch, sees, n)
+            print(f"{n}² surface (one line per cell), {view}: block mean / analytic per band: "
+                  + ", ".join(f"{x:.3f}" for x in measured / expected))
     _camera_floor()
-
-
-def _shaft_ratio(n: int) -> None:
-    from test_photons import PHOTONS
-
-    import warpcaustics as wc
-    from warpcaustics import spectra
-    from warpcaustics.phase import PhaseFunction
-
-    from conftest import fresnel_t_angles
-
-    z_cam = -0.75
-    scene = wc.load_scene(None, {
-        **PHOTONS, "water.model": "pool", "water.resolution": n, "water.extent_m": 4.0, "floor.depth_m": 1.5,
-        "caustics.map_resolution": 64, "sun.elevation_deg": 90.0, "optics.water_type": "clear_ocean",
-        "optics.wavelengths": "rgb", "camera.enabled": True, "camera.position_m": [-1.9, 0.0, z_cam],
-        "camera.look_at_m": [0.0, 0.0, z_cam], "camera.width": 64, "camera.height": 48,
-        "camera.fov_deg": 30.0})
-    r = wc.render(scene, device="cpu")
-    g = r.camera_gbuffer
-    optics = spectra.water_optics(scene.config.optics, spectra.bins_for(scene.config.optics))
-    c, b = optics.attenuation_per_m[:, None, None], optics.scattering_per_m[:, None, None]
-    rows, cols = slice(18, 30), slice(12, 52)
-    ray = g["position"][rows, cols] - np.array([-1.9, 0.0, z_cam])
-    dist = np.linalg.norm(ray, axis=-1)
-    vz = ray[..., 2] / dist
-    ph = PhaseFunction.from_optics(scene.config.optics, "cpu").evaluate(vz.ravel(), "cpu").reshape(vz.shape)
-    t0 = fresnel_t_angles(np.array([0.0]), 1.0, 1.333)[0]
-    k = c * (1 - vz)
-    expected = b * ph * r.sun_irradiance[:, None, None] * t0 * np.exp(c * z_cam) * (1 - np.exp(-k * dist)) / k
-    ratio = r.camera_radiance[:, rows, cols].mean(axis=(1, 2)) / expected.mean(axis=(1, 2))
-    print(f"{n}² surface (one line per cell): block mean / analytic per band: "
-          + ", ".join(f"{x:.3f}" for x in ratio))
-
 
 
 def _camera_floor() -> None:
