@@ -18,9 +18,6 @@ INV_PI = 0.3183098861837907
 MAX_SPLAT_RADIUS = 8
 """Largest photon splat radius [pixels]."""
 
-MAX_TENT_RADIUS = 64
-"""Largest reach of a tent splat from its photon [pixels] (a sparse photon right at the lens)."""
-
 MAX_CELL_SPACINGS = 16.0
 """A photon's lattice cell longer than this many surface photon spacings is not a neighbourhood
 (its neighbour landed far away, past a silhouette) and gets a Gaussian instead."""
@@ -315,11 +312,15 @@ def splat_photons(
         hit, face, face_receiver, face_normal, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
     )
     if ok != 0:
+        n_lit = face_normal[f]  # the face's normal on the side the photon came from
+        if wp.dot(n_lit, origin[p] - hit[p]) < 0.0:
+            n_lit = -n_lit
         splat_tent(
             cam,
             x,
             eu,
             ev,
+            n_lit,
             face_receiver[f],
             position,
             normal,
@@ -366,11 +367,22 @@ def splat_photons(
 
 
 @wp.func
+def all_behind(cam: PinholeCamera, x: wp.vec3, eu: wp.vec3, ev: wp.vec3) -> bool:
+    """Whether all four corners x ± e_u ± e_v of a tent's support lie behind the camera."""
+    for k in range(4):
+        v = x + float(2 * (k % 2) - 1) * eu + float(2 * (k / 2) - 1) * ev - cam.position
+        if wp.dot(v, cam.forward) > 0.0:
+            return False
+    return True
+
+
+@wp.func
 def splat_tent(
     cam: PinholeCamera,
     x: wp.vec3,
     eu: wp.vec3,
     ev: wp.vec3,
+    n_lit: wp.vec3,
     rid: int,
     position: wp.array2d[wp.vec3],
     normal: wp.array2d[wp.vec3],
@@ -384,12 +396,15 @@ def splat_tent(
     caustic: wp.array3d[wp.float32],
 ):
     """Add the tent of a photon at x with lattice cell (e_u, e_v) to every pixel whose G-buffer
-    point lies in its support: same receiver, on the pixel's tangent plane through x, and
-    (X − x) = α e_u + β e_v (least squares) with |α|, |β| < 1; irradiance ``w hat / |e_u × e_v|``.
+    point lies in its support: same receiver, its lit side (``n_lit``, the face normal towards the
+    light, within 60° of the pixel's normal: the back of a one-sided plate or a slab's shaded
+    underside stays dark), on the pixel's tangent plane through x within TENT_PLANE_TOLERANCE plus
+    the curvature between the two normals, and (X − x) = α e_u + β e_v (least squares) with
+    |α|, |β| < 1; irradiance ``w hat / |e_u × e_v|``.
 
-    The pixels searched are the screen box of the support's four corners x ± e_u ± e_v (clipped
-    to the frame and to MAX_TENT_RADIUS around the photon), so photons just outside the frame still
-    light its edge."""
+    The pixels searched are the screen box of the support's four corners x ± e_u ± e_v, clipped to
+    the frame (the whole frame when part of the support is behind the camera), so photons just
+    outside the frame, or right at the lens, still light what they should."""
     lo = wp.vec2(1.0e30, 1.0e30)
     hi = wp.vec2(-1.0e30, -1.0e30)
     behind = int(0)
@@ -400,22 +415,16 @@ def splat_tent(
         else:
             lo = wp.vec2(wp.min(lo[0], q[0]), wp.min(lo[1], q[1]))
             hi = wp.vec2(wp.max(hi[0], q[0]), wp.max(hi[1], q[1]))
-    c = project(cam, x)
-    if c[2] > 0.0:
-        radius = float(MAX_TENT_RADIUS)
-        if behind != 0:
-            lo = wp.vec2(c[0] - radius, c[1] - radius)
-            hi = wp.vec2(c[0] + radius, c[1] + radius)
-        lo = wp.vec2(wp.max(lo[0], c[0] - radius), wp.max(lo[1], c[1] - radius))
-        hi = wp.vec2(wp.min(hi[0], c[0] + radius), wp.min(hi[1], c[1] + radius))
-    elif behind != 0:
-        return  # the photon and part of its support lie behind the camera
+    if behind != 0:
+        if all_behind(cam, x, eu, ev):
+            return
+        # Part of the support is behind the camera: its screen box is unbounded, search the frame.
+        lo = wp.vec2(0.0, 0.0)
+        hi = wp.vec2(float(cam.width), float(cam.height))
     i0 = wp.max(int(wp.floor(lo[0])), 0)
     j0 = wp.max(int(wp.floor(lo[1])), 0)
     i1 = wp.min(int(wp.floor(hi[0])), cam.width - 1)
     j1 = wp.min(int(wp.floor(hi[1])), cam.height - 1)
-    i1 = wp.min(i1, i0 + 2 * MAX_TENT_RADIUS)
-    j1 = wp.min(j1, j0 + 2 * MAX_TENT_RADIUS)
     a = wp.dot(eu, eu)
     b = wp.dot(eu, ev)
     d = wp.dot(ev, ev)
@@ -426,7 +435,11 @@ def splat_tent(
         for i in range(i0, i1 + 1):
             if receiver[j, i] == rid:
                 q = position[j, i] - x
-                if wp.abs(wp.dot(q, normal[j, i])) <= tolerance:
+                n_px = normal[j, i]
+                # The pixel must see the lit side, near the tangent plane through x (allowing for
+                # the surface's curvature: the normals' difference grows with it).
+                bend = 0.5 * wp.length(q) * wp.length(n_px - n_lit)
+                if wp.dot(n_px, n_lit) >= 0.5 and wp.abs(wp.dot(q, n_px)) <= tolerance + bend:
                     pu = wp.dot(q, eu)
                     pv = wp.dot(q, ev)
                     alpha = (d * pu - b * pv) / det
@@ -540,6 +553,8 @@ def shaft_lines(
     length = wp.length(x1 - o)
     a = project(cam, o)
     b = project(cam, x1)
+    if a[2] <= 0.0 and b[2] <= 0.0:
+        return  # wholly behind the camera
     if a[2] > 0.0 and b[2] > 0.0:  # a line wholly off one side of the frame adds nothing
         w_px = float(cam.width)
         h_px = float(cam.height)

@@ -575,8 +575,8 @@ def _check_periodic_floor(cfg: Config) -> None:
             raise ConfigError(
                 f"floor ripples (wavelength {floor.ripple_wavelength_m:g} m, direction "
                 f"{floor.ripple_direction_deg:g}°) do not tile the periodic {cfg.water.extent_m:g} m patch; "
-                f"the nearest that do: floor.ripple_wavelength_m = {wavelength:.6f}, "
-                f"floor.ripple_direction_deg = {direction:.4f}")
+                f"the nearest that do: floor.ripple_wavelength_m = {wavelength:.12g}, "
+                f"floor.ripple_direction_deg = {direction:.12g}")
 
 
 def _check_photon_scene(cfg: Config) -> None:
