@@ -31,6 +31,9 @@ TENT_PLANE_TOLERANCE = 0.1
 cell's longer side (plus 1 mm) of the pixel's tangent plane through the photon: depth jumps and
 other surfaces of the same receiver are left out, however deep the tent reaches."""
 
+NEAR_M = 1.0e-3
+"""Near plane of the camera for clipping tents [m]."""
+
 MIN_SPLAT_SIGMA = 1.0
 """Narrowest photon splat (Gaussian σ) [pixels]: photons closer than a pixel apart would alias
 into stripes with anything narrower."""
@@ -367,13 +370,15 @@ def splat_photons(
 
 
 @wp.func
-def all_behind(cam: PinholeCamera, x: wp.vec3, eu: wp.vec3, ev: wp.vec3) -> bool:
-    """Whether all four corners x ± e_u ± e_v of a tent's support lie behind the camera."""
-    for k in range(4):
-        v = x + float(2 * (k % 2) - 1) * eu + float(2 * (k / 2) - 1) * ev - cam.position
-        if wp.dot(v, cam.forward) > 0.0:
-            return False
-    return True
+def tent_corner(x: wp.vec3, eu: wp.vec3, ev: wp.vec3, k: int) -> wp.vec3:
+    """Corner k (0…3, in order round the parallelogram) of a tent's support x ± e_u ± e_v."""
+    su = float(1)
+    sv = float(1)
+    if k == 0 or k == 3:
+        su = -1.0
+    if k < 2:
+        sv = -1.0
+    return x + su * eu + sv * ev
 
 
 @wp.func
@@ -402,25 +407,32 @@ def splat_tent(
     the curvature between the two normals, and (X − x) = α e_u + β e_v (least squares) with
     |α|, |β| < 1; irradiance ``w hat / |e_u × e_v|``.
 
-    The pixels searched are the screen box of the support's four corners x ± e_u ± e_v, clipped to
-    the frame (the whole frame when part of the support is behind the camera), so photons just
-    outside the frame, or right at the lens, still light what they should."""
+    The pixels searched are the screen box of the support x ± e_u ± e_v clipped by the camera's
+    near plane, then by the frame, so photons just outside the frame, or right at the lens, still
+    light what they should."""
+    # Screen box of the support clipped by the near plane: the corners in front of it and the
+    # points where the support's edges cross it (points just in front project far off-screen, so
+    # the box opens only towards the side that reaches behind the camera).
     lo = wp.vec2(1.0e30, 1.0e30)
     hi = wp.vec2(-1.0e30, -1.0e30)
-    behind = int(0)
+    seen = int(0)
     for k in range(4):
-        q = project(cam, x + float(2 * (k % 2) - 1) * eu + float(2 * (k / 2) - 1) * ev)
-        if q[2] < 0.0:
-            behind = 1
-        else:
+        c0 = tent_corner(x, eu, ev, k)
+        c1 = tent_corner(x, eu, ev, (k + 1) % 4)
+        d0 = wp.dot(c0 - cam.position, cam.forward) - NEAR_M
+        d1 = wp.dot(c1 - cam.position, cam.forward) - NEAR_M
+        if d0 > 0.0:
+            q = project(cam, c0)
             lo = wp.vec2(wp.min(lo[0], q[0]), wp.min(lo[1], q[1]))
             hi = wp.vec2(wp.max(hi[0], q[0]), wp.max(hi[1], q[1]))
-    if behind != 0:
-        if all_behind(cam, x, eu, ev):
-            return
-        # Part of the support is behind the camera: its screen box is unbounded, search the frame.
-        lo = wp.vec2(0.0, 0.0)
-        hi = wp.vec2(float(cam.width), float(cam.height))
+            seen = 1
+        if d0 * d1 < 0.0:
+            q = project(cam, c0 + (d0 / (d0 - d1)) * (c1 - c0))
+            lo = wp.vec2(wp.min(lo[0], q[0]), wp.min(lo[1], q[1]))
+            hi = wp.vec2(wp.max(hi[0], q[0]), wp.max(hi[1], q[1]))
+            seen = 1
+    if seen == 0:
+        return  # wholly behind the camera
     i0 = wp.max(int(wp.floor(lo[0])), 0)
     j0 = wp.max(int(wp.floor(lo[1])), 0)
     i1 = wp.min(int(wp.floor(hi[0])), cam.width - 1)
