@@ -267,8 +267,3 @@ class PhotonCaustics:
             carrying=int(np.count_nonzero(w > 0)),
             landed=int(np.count_nonzero(self.face.numpy() >= 0)),
         )
-
-
-def photons_per_texel(cfg: Config, n: int) -> float:
-    """Photons per floor map texel on average (one index group)."""
-    return n * n * cfg.caustics.photon_subdivisions**2 / cfg.caustics.map_resolution**2

@@ -341,13 +341,3 @@ class Receivers:
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return self.points.min(axis=0), self.points.max(axis=0)
-
-
-def receivers_bytes(cfg: Config, periodic: bool) -> int:
-    """Device memory of the receivers' BVH and face tables (an estimate) [bytes]."""
-    planar = cfg.floor.shape in (FloorShape.FLAT, FloorShape.SLOPE)
-    cells = 4 if planar else cfg.caustics.map_resolution
-    floor_faces = 2 * int((cells * (1.3 if periodic else 1.0)) ** 2)
-    mesh_faces = 9000 * len(cfg.receivers)  # primitives; files are counted when loaded
-    faces = floor_faces + mesh_faces + (0 if periodic else 8 * WALL_CELLS * 8)
-    return faces * (12 + 4 + 4 + 64)  # indices, receiver id, flux share, BVH nodes
