@@ -250,19 +250,19 @@ class Renderer:
             visible = sun_visibility(surface, sun_dir, highest, dev, out=self.visible)
         extra = {}
         if self.photons is not None:
-            with watch.stage("photons"):
-                floor = self.photons.run(surface, visible, self.group_ior)
             if self.receivers.mesh_top_z >= lowest:
                 raise WarpcausticsError(
                     f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
                     f"lowest point z = {lowest:.3f} m at t = {time_s:g} s; receivers must stay under the "
                     "water: lower them (receivers[].translate_m) or make the floor deeper")
+            if self.camera is not None and self.camera.position_z >= lowest:
+                raise WarpcausticsError(
+                    f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
+                    f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
+                    "above the water is not implemented yet: lower the camera")
+            with watch.stage("photons"):
+                floor = self.photons.run(surface, visible, self.group_ior)
             if self.camera is not None:
-                if self.camera.position_z >= lowest:
-                    raise WarpcausticsError(
-                        f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
-                        f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
-                        "above the water is not implemented yet: lower the camera")
                 with watch.stage("camera"):
                     n = self.scene.water_resolution
                     spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
