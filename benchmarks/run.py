@@ -166,6 +166,11 @@ def main(argv: list[str] | None = None) -> int:
     # Photon splatting vs its numpy twin, both in one child process (benchmarks/photons.py).
     photons = _in_child("run", args.quick, args.device, module="photons")
 
+    # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
+    from benchmarks import sweep as sweep_bench
+
+    sweeps = sweep_bench.run(args.quick, args.device)
+
     record = {
         "benchmark": "ocean_frame_floor_caustics",
         "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
@@ -180,6 +185,7 @@ def main(argv: list[str] | None = None) -> int:
         "steps": steps,
         "bins": bins_rows,
         "photons": photons,
+        "sweep": sweeps,
     }
     out = args.out or ROOT / "benchmarks" / "results" / (
         f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")

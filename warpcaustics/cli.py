@@ -1,4 +1,5 @@
-"""Command line: ``warpcaustics render | info``. User errors print one line and exit with 2."""
+"""Command line: ``warpcaustics render | study | sweep | report | info``. User errors print one line
+and exit with 2."""
 
 from __future__ import annotations
 
@@ -41,6 +42,22 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("study", metavar="STUDY", help="study TOML, e.g. configs/study.toml")
     st.add_argument("--out", required=True, metavar="DIR", help="output folder")
     st.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+
+    sw = sub.add_parser("sweep", help="run a parameter sweep (resumable) with a local process pool",
+                        description="Render every scene variant × frame of a sweep TOML into "
+                                    "DIR/<task id>/, skipping tasks a previous run finished; write "
+                                    "DIR/manifest.jsonl and DIR/summary.csv.")
+    sw.add_argument("sweep", metavar="SWEEP", help="sweep TOML, e.g. configs/sweeps/water_types.toml")
+    sw.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
+    sw.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
+    sw.add_argument("--executor", default="local", metavar="local",
+                    help="local (a process pool; the only executor so far)")
+    sw.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    sw.add_argument("--quiet", action="store_true", help="no progress lines")
+
+    rp = sub.add_parser("report", help="print a sweep's summary table and plot it",
+                        description="Print DIR/summary.csv and write DIR/summary.png.")
+    rp.add_argument("out", metavar="DIR", help="the folder of a sweep")
 
     sub.add_parser("info", help="versions and the devices Warp sees",
                    description="Print package versions and the compute devices Warp can use.")
@@ -131,6 +148,17 @@ def main(argv: list[str] | None = None) -> int:
             return _render(args)
         if args.command == "study":
             return _study(args)
+        if args.command == "sweep":
+            from warpcaustics.sweep import sweep_main
+
+            if args.executor != "local":
+                raise WarpcausticsError(f"--executor {args.executor!r} is not available yet; use --executor "
+                                        "local (Ray support is planned)")
+            return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet)
+        if args.command == "report":
+            from warpcaustics.sweep import report_main
+
+            return report_main(args.out)
         return _info()
     except WarpcausticsError as exc:
         print(f"warpcaustics: error: {exc}", file=sys.stderr)

@@ -1,0 +1,149 @@
+"""Sweeps: tasks and ids, a local process pool, failures, resume after SIGKILL, the study table."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from warpcaustics.errors import ConfigError
+from warpcaustics.sweep import load_sweep, read_manifest, run_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TINY = """
+base = "{base}"
+[set]
+"water.resolution" = 16
+"caustics.map_resolution" = 16
+"optics.wavelengths" = "rgb"
+[grid]
+"floor.depth_m" = [2.0, 4.0]
+"optics.water_type" = [{types}]
+[zip]
+"sun.elevation_deg" = [40.0, 80.0]
+"sun.azimuth_deg" = [0.0, 45.0]
+[frames]
+count = {frames}
+fps = 4.0
+"""
+
+
+def _sweep(tmp_path, types='"pure", "clear_ocean"', frames=1, name="sweep.toml"):
+    path = tmp_path / name
+    path.write_text(
+        TINY.format(base=(ROOT / "configs" / "ocean.toml").as_posix(), types=types, frames=frames)
+    )
+    return path
+
+
+def _csv_rows(out):
+    with open(out / "summary.csv", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_sweep_expands_grid_and_zip_into_stable_ids(tmp_path):
+    """2 depths × 2 water types × 2 zipped suns = 8 variants; ids are stable and distinct, and a
+    frame range multiplies stateless variants into one task per frame."""
+    sweep = load_sweep(_sweep(tmp_path))
+    assert len(sweep.tasks) == 8 and len({t.id for t in sweep.tasks}) == 8
+    assert [t.id for t in load_sweep(_sweep(tmp_path)).tasks] == [t.id for t in sweep.tasks]
+    zipped = {(t.overrides["sun.elevation_deg"], t.overrides["sun.azimuth_deg"]) for t in sweep.tasks}
+    assert zipped == {(40.0, 0.0), (80.0, 45.0)}  # zipped, not crossed
+    assert len(load_sweep(_sweep(tmp_path, frames=3, name="anim.toml")).tasks) == 24
+    bad = tmp_path / "bad.toml"
+    bad.write_text('base = "x.toml"\n[zip]\n"a" = [1]\n"b" = [1, 2]\n')
+    with pytest.raises(ConfigError, match="equal lengths"):
+        load_sweep(bad)
+
+
+def test_local_sweep_runs_every_task_and_resumes(tmp_path):
+    """8 tiny tasks on 2 workers: 8 folders with run.json, a CSV of 8 rows; a rerun skips them all."""
+    out = tmp_path / "out"
+    sweep = load_sweep(_sweep(tmp_path))
+    report = run_sweep(sweep, out, workers=2, device="cpu", quiet=True)
+    assert (report.done, report.skipped, report.failed) == (8, 0, [])
+    rows = _csv_rows(out)
+    assert len(rows) == 8 and {r["id"] for r in rows} == {t.id for t in sweep.tasks}
+    assert all(
+        (out / t.id / "run.json").exists() and (out / t.id / "frame_0000.exr").exists() for t in sweep.tasks
+    )
+    # Deeper water of the same type and sun gives a darker floor (a sanity check of the rows).
+    by_key = {
+        (r["optics.water_type"], r["floor.depth_m"], r["sun.elevation_deg"]): float(r["floor_w_m2"])
+        for r in rows
+    }
+    assert by_key[("clear_ocean", "4.0", "80.0")] < by_key[("clear_ocean", "2.0", "80.0")]
+    again = run_sweep(sweep, out, workers=2, device="cpu", quiet=True)
+    assert (again.done, again.skipped) == (0, 8)
+
+
+def test_a_failing_task_is_reported_and_the_rest_finish(tmp_path):
+    """A variant whose override is invalid fails with its one-line error; the other tasks finish."""
+    sweep = load_sweep(_sweep(tmp_path, types='"pure", "no_such_water"'))
+    report = run_sweep(sweep, tmp_path / "out", workers=1, device="cpu", quiet=True)
+    assert report.done == 4 and len(report.failed) == 4
+    assert all("optics.water_type = 'no_such_water' is not allowed" in msg for _, msg in report.failed)
+    assert len(_csv_rows(tmp_path / "out")) == 4
+
+
+def test_sigkill_midway_then_rerun_finishes_each_task_once(tmp_path):
+    """SIGKILL the sweep's driver after its first task: its workers die with it (nothing is left
+    writing), a rerun completes the rest, every task is recorded done exactly once, and no
+    temporary folder is left."""
+    sweep_file = _sweep(tmp_path, frames=3)  # 24 tasks
+    out = tmp_path / "out"
+    cmd = [
+        sys.executable,
+        "-m",
+        "warpcaustics",
+        "sweep",
+        str(sweep_file),
+        "--out",
+        str(out),
+        "--workers",
+        "2",
+        "--device",
+        "cpu",
+        "--quiet",
+    ]
+    proc = subprocess.Popen(
+        cmd, cwd=ROOT, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not any(
+        r.get("state") == "done" for r in read_manifest(out).values() if out.exists()
+    ):
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)  # the driver only
+    proc.wait()
+    deadline = time.time() + 10
+    while time.time() < deadline:
+        try:
+            os.killpg(proc.pid, 0)  # any process of the sweep's group still alive?
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("the workers outlived their driver")
+    first = read_manifest(out)
+    assert 0 < len(first) < 24, "the kill must land midway"
+    subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    lines = [json.loads(x) for x in (out / "manifest.jsonl").read_text().splitlines() if x.strip()]
+    done = [rec["id"] for rec in lines if rec["state"] == "done"]
+    assert sorted(done) == sorted({t.id for t in load_sweep(sweep_file).tasks})  # each once
+    assert not list(out.glob(".*.tmp-*"))
+    assert len(_csv_rows(out)) == 24
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "configs" / "sweeps").glob("*.toml")), ids=lambda p: p.name)
+def test_shipped_sweeps_expand(path):
+    """Each sweep in configs/sweeps/ loads, and every one of its variants is a valid scene."""
+    sweep = load_sweep(path)
+    assert sweep.tasks and all(t.error is None for t in sweep.tasks)
