@@ -443,11 +443,13 @@ def report_main(out: str) -> int:
     from warpcaustics.output import atomic_path
 
     fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(rows)), 4))
-    labels = [f"{r['id'][:6]}/{r['frame']}" for r in rows]
+    varied = [c for c in shown if c not in headline]
+    labels = ["/".join(_short(r[c]) for c in varied) or r["id"][:6] for r in rows]
     ax.bar(range(len(rows)), [float(r["floor_w_m2"]) for r in rows])
     ax.set_xticks(range(len(rows)), labels, rotation=90, fontsize=7)
+    ax.set_yscale("log")
     ax.set_ylabel("mean floor irradiance [W m$^{-2}$]")
-    ax.set_title(f"{len(rows)} frames of {out}")
+    ax.set_title(f"{len(rows)} frames of {Path(out).name}" + (f" ({' / '.join(varied)})" if varied else ""))
     fig.tight_layout()
     plot = Path(out) / "summary.png"
     with atomic_path(plot) as tmp:
