@@ -547,3 +547,67 @@ def test_scenes_photons_cannot_render_are_refused():
             ),
             "cpu",
         )
+
+
+def test_vtk_files_read_back_with_pyvista(tmp_path):
+    """output.vtk: the surface (points and normals), the floor map (per-band cells) and the
+    receivers (per-face irradiance) read back with pyvista equal to the render's arrays."""
+    import pyvista as pv
+
+    scene = wc.load_scene(
+        "configs/pool.toml",
+        {
+            **PHOTONS,
+            "water.resolution": 32,
+            "caustics.map_resolution": 32,
+            "optics.wavelengths": "rgb",
+            "output.vtk": True,
+            "receivers": [{"mesh": "sphere", "scale": 0.6, "translate_m": [0.3, 0.0, -1.0]}],
+        },
+    )
+    result = wc.Renderer(scene, "cpu").render(0.5)
+    paths = result.save(tmp_path)
+    surface = pv.read(paths["surface_vtk"])
+    np.testing.assert_allclose(surface.points, result.surface_positions.reshape(-1, 3), rtol=1e-6)
+    np.testing.assert_allclose(surface.point_data["normal"], result.surface_normals.reshape(-1, 3), rtol=1e-6)
+    floor = pv.read(paths["floor_vtk"])
+    name = f"irradiance_{result.wavelengths_nm[1]:g}nm"
+    np.testing.assert_array_equal(floor.cell_data[name], result.floor_irradiance[1].ravel())
+    # Cell (ix, iy) of the image sits at the texel centre (i + 0.5) L/M - L/2.
+    centre = floor.cell_centers().points[5 * 32 + 7]
+    np.testing.assert_allclose(centre[:2], (np.array([7, 5]) + 0.5) * 4.0 / 32 - 2.0, atol=1e-6)
+    receivers = pv.read(paths["receivers_vtk"])
+    assert receivers.n_cells == len(result.face_flux_w_nm)
+    np.testing.assert_allclose(
+        receivers.cell_data[name],
+        result.receiver_irradiance(1)[:, 1].tolist() + result.receiver_irradiance(2)[:, 1].tolist(),
+        rtol=1e-6,
+    )
+    assert set(np.unique(receivers.cell_data["receiver"])) == {1, 2}
+    assert not list(tmp_path.glob(".*tmp*"))
+
+
+def test_preview_draws_a_png(tmp_path):
+    """`warpcaustics preview` renders a frame and draws it off screen into a PNG of the asked size
+    (skipped, and saying so, where VTK has no off-screen context)."""
+    from warpcaustics.preview import preview_png
+
+    scene = wc.load_scene(
+        "configs/pool.toml",
+        {
+            **PHOTONS,
+            "water.resolution": 32,
+            "caustics.map_resolution": 32,
+            "optics.wavelengths": "rgb",
+            "receivers": [{"mesh": "cube", "scale": 0.5, "translate_m": [0.0, 0.0, -1.2]}],
+        },
+    )
+    result = wc.render(scene, 0.5, device="cpu")
+    try:
+        path = preview_png(result, tmp_path / "p.png", width=200, height=120)
+    except WarpcausticsError as exc:
+        pytest.skip(str(exc))
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    assert int.from_bytes(data[16:20], "big") == 200 and int.from_bytes(data[20:24], "big") == 120
+    assert not list(tmp_path.glob(".*tmp*"))

@@ -55,6 +55,16 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
     sw.add_argument("--quiet", action="store_true", help="no progress lines")
 
+    pv = sub.add_parser("preview", help="an off-screen 3-D view (PNG) of a scene's frame",
+                        description="Render one frame of CONFIG and draw it in 3-D with pyvista: the "
+                                    "floor and receivers coloured by irradiance, the water surface above.")
+    pv.add_argument("config", metavar="CONFIG", help="TOML scene file")
+    pv.add_argument("--out", required=True, metavar="FILE.png", help="the PNG to write")
+    pv.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help="simulation time [s]")
+    pv.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    pv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
+                    help="override a config key (repeatable)")
+
     rp = sub.add_parser("report", help="print a sweep's summary table and plot it",
                         description="Print DIR/summary.csv and write DIR/summary.png.")
     rp.add_argument("out", metavar="DIR", help="the folder of a sweep")
@@ -120,6 +130,23 @@ def _study(args: argparse.Namespace) -> int:
     return 0
 
 
+def _preview(args: argparse.Namespace) -> int:
+    from warpcaustics.config import parse_override
+    from warpcaustics.pipeline import render
+    from warpcaustics.preview import preview_png
+    from warpcaustics.scene import load_scene
+
+    out = Path(args.out)
+    if out.suffix.lower() != ".png":
+        raise WarpcausticsError(f"--out {str(out)!r} must name a .png file")
+    scene = load_scene(args.config, dict(parse_override(text) for text in args.overrides))
+    if not out.parent.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
+    preview_png(render(scene, args.time, args.device), out)
+    print(f"wrote {out}")
+    return 0
+
+
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
     from warpcaustics.output import versions
@@ -155,6 +182,8 @@ def main(argv: list[str] | None = None) -> int:
                 raise WarpcausticsError(f"--executor {args.executor!r} is not available yet; use --executor "
                                         "local (Ray support is planned)")
             return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet)
+        if args.command == "preview":
+            return _preview(args)
         if args.command == "report":
             from warpcaustics.sweep import report_main
 

@@ -373,6 +373,10 @@ class OutputConfig:
     rendered neutral (von Kries / CAT02)."""
     exposure_ev: float = field(default=0.0, metadata=_range(-20.0, 20.0))
     """PNG exposure relative to the automatic one (mean luminance → 0.25) [stops]."""
+    vtk: bool = False
+    """Also write VTK files for ParaView / pyvista: ``surface_NNNN.vts`` (water surface, normals),
+    ``floor_NNNN.vti`` (floor irradiance per band) and, with photons, ``receivers_NNNN.vtp``
+    (receiver meshes with their irradiance per band)."""
 
 
 @dataclass(frozen=True)

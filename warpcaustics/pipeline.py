@@ -67,6 +67,9 @@ class RenderResult:
     """``photons``: (F, 3) centroid of each of those faces [m]."""
     floor_texel_area_m2: np.ndarray | None = None
     """``photons``: (M, M) true area of the floor over each texel [m²] (None: flat, (L/M)²)."""
+    receiver_mesh: tuple[np.ndarray, np.ndarray] | None = None
+    """``photons``: (points (V, 3) [m], triangles (F, 3)) of the receivers other than the floor, the
+    faces in the order of :attr:`face_flux_w_nm`."""
     photon_stats: dict[str, int] | None = None
     """``photons``: photons emitted, carrying flux, and landed on a receiver."""
     camera_radiance: np.ndarray | None = None
@@ -279,6 +282,7 @@ class Renderer:
                              face_area_m2=rec.face_area_m2[rec.floor_face_count:],
                              face_centres_m=rec.face_centres_m[rec.floor_face_count:],
                              floor_texel_area_m2=rec.floor_texel_area_m2,
+                             receiver_mesh=rec.non_floor_mesh(),
                              photon_stats=vars(self.photons.stats()))
         else:
             with watch.stage("refraction"):

@@ -311,6 +311,7 @@ class Receivers:
         self.names = names
         self.floor_face_count = len(floor.triangles)
         self.floor_vertex_count = len(floor.points)
+        self._non_floor = None
         inside = np.all(np.abs(floor.points[:, :2]) <= 0.5 * cfg.water.extent_m * (1 + 1e-9), axis=1)
         self.floor_top_z = float(floor.points[inside, 2].max())
         """Highest floor point inside the patch [m]."""
@@ -334,6 +335,15 @@ class Receivers:
         self.face_receiver = wp.array(self.face_receiver_np, dtype=wp.int32, device=device)
         self.albedo_wp = wp.array(self.albedo.astype(np.float32), dtype=wp.float32, device=device)
         self.floor_texel_area_m2 = floor_texel_area(cfg, relief)
+
+    def non_floor_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """(points, triangles) of the walls and meshes, the faces in their order here (after the
+        floor's), the points renumbered to those they use."""
+        if self._non_floor is None:
+            tris = self.triangles[self.floor_face_count:]
+            used, inverse = np.unique(tris, return_inverse=True)
+            self._non_floor = (self.points[used], inverse.reshape(tris.shape))
+        return self._non_floor
 
     @property
     def face_count(self) -> int:
