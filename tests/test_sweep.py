@@ -147,3 +147,69 @@ def test_shipped_sweeps_expand(path):
     """Each sweep in configs/sweeps/ loads, and every one of its variants is a valid scene."""
     sweep = load_sweep(path)
     assert sweep.tasks and all(t.error is None for t in sweep.tasks)
+
+
+POOL = """
+base = "{base}"
+[set]
+"water.resolution" = 24
+"caustics.map_resolution" = 24
+"optics.wavelengths" = "rgb"
+[grid]
+"floor.depth_m" = [1.5]
+[frames]
+count = 4
+fps = 4.0
+"""
+
+
+def test_interrupted_pool_animation_resumes_from_its_checkpoint(tmp_path, monkeypatch):
+    """A pool animation is one task. Interrupted after 2 of its 4 frames, a rerun continues from the
+    checkpoint (only frames 3 and 4 are rendered again) and its frames equal an uninterrupted run's."""
+    import numpy as np
+
+    from warpcaustics import pipeline
+    from warpcaustics.sweep import run_task
+
+    path = tmp_path / "pool.toml"
+    path.write_text(POOL.format(base=(ROOT / "configs" / "pool.toml").as_posix()))
+    sweep = load_sweep(path)
+    assert len(sweep.tasks) == 1 and sweep.tasks[0].stateful and len(sweep.tasks[0].times_s) == 4
+    task = sweep.tasks[0]
+    clean = run_task(str(sweep.base), task, str(tmp_path / "clean"), "cpu")
+
+    real_render = pipeline.Renderer.render
+    calls = []
+
+    def interrupted(self, time_s):
+        calls.append(time_s)
+        if len(calls) == 3:
+            raise KeyboardInterrupt  # the sweep is stopped during frame 3
+        return real_render(self, time_s)
+
+    monkeypatch.setattr(pipeline.Renderer, "render", interrupted)
+    out = tmp_path / "resumed"
+    out.mkdir()
+    with pytest.raises(KeyboardInterrupt):
+        run_task(str(sweep.base), task, str(out), "cpu")
+    assert (out / f".{task.id}.partial" / "checkpoint.npz").exists() and not (out / task.id).exists()
+    calls.clear()
+    monkeypatch.setattr(
+        pipeline.Renderer, "render", lambda self, t: (calls.append(t), real_render(self, t))[1]
+    )
+    resumed = run_task(str(sweep.base), task, str(out), "cpu")
+    assert calls == list(task.times_s[2:])  # frames 1-2 were not simulated again
+    assert [r["floor_w_m2"] for r in resumed["rows"]] == [r["floor_w_m2"] for r in clean["rows"]]
+    import OpenEXR
+
+    for k in range(4):
+        a = (
+            OpenEXR.File(str(tmp_path / "clean" / task.id / f"frame_{k:04d}.exr"))
+            .channels()["S0.550,000000nm"]
+            .pixels
+        )
+        b = OpenEXR.File(str(out / task.id / f"frame_{k:04d}.exr")).channels()["S0.550,000000nm"].pixels
+        np.testing.assert_array_equal(a, b)
+    run = json.loads((out / task.id / "run.json").read_text())
+    assert [f["frame"] for f in run["frames"]] == [0, 1, 2, 3]
+    assert not (out / f".{task.id}.partial").exists()

@@ -199,10 +199,29 @@ def _write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, heade
     write_png(png, colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
 
 
-def write_run_json(out_dir: Path, results: list) -> Path:
+def frame_entry(frame: int, r) -> dict:
+    """run.json's record of one frame (JSON-ready: arrays become lists)."""
+    entry = {
+        "frame": frame,
+        "time_s": r.time_s,
+        "files": [f"frame_{frame:04d}.exr", f"frame_{frame:04d}.png"] + (
+            [f"camera_{frame:04d}.exr", f"camera_{frame:04d}.png"] if r.camera_radiance is not None else []),
+        "timings_s": r.timings_s,
+        "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
+        "floor_flux_w_nm": r.floor_flux_w_nm,
+        "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
+        "fold_fraction": r.fold_fraction,
+        **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
+    }
+    return json.loads(json.dumps(entry, default=_jsonable))
+
+
+def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = None) -> Path:
     """Write ``run.json`` (resolved config, versions, device, per-frame timings and totals).
 
-    Written last, after every frame file: its presence marks a complete run.
+    ``frames``: the per-frame records (:func:`frame_entry`) when they are not all in ``results``
+    (a resumed pool animation); by default one per result, numbered from 0. Written last, after
+    every frame file: its presence marks a complete run.
     """
     first = results[0]
     path = out_dir / "run.json"
@@ -216,17 +235,6 @@ def write_run_json(out_dir: Path, results: list) -> Path:
         "attenuation_per_m": first.attenuation_per_m,
         "ior": first.ior,
         "sun_irradiance_w_m2_nm": first.sun_irradiance,
-        "frames": [{
-            "frame": i,
-            "time_s": r.time_s,
-            "files": [f"frame_{i:04d}.exr", f"frame_{i:04d}.png"] + (
-                [f"camera_{i:04d}.exr", f"camera_{i:04d}.png"] if r.camera_radiance is not None else []),
-            "timings_s": r.timings_s,
-            "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
-            "floor_flux_w_nm": r.floor_flux_w_nm,
-            "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
-            "fold_fraction": r.fold_fraction,
-            **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
-        } for i, r in enumerate(results)],
+        "frames": frames if frames is not None else [frame_entry(i, r) for i, r in enumerate(results)],
     })
     return path

@@ -36,6 +36,29 @@ class WalledPool:
         self.time_s = 0.0
         self._drops = sorted(drops, key=lambda d: d.time_s)
 
+    STATE_FIELDS: tuple[str, ...] = ()
+    """Names of the device arrays that hold the pool's state (with its time, drops and substeps)."""
+
+    def state(self) -> dict:
+        """The pool's state as numpy arrays and numbers: enough to continue exactly (a checkpoint)."""
+        out = {name: getattr(self, name).numpy().copy() for name in self.STATE_FIELDS}
+        out.update(time_s=self.time_s, drops_left=len(self._drops), substeps=getattr(self, "substeps", 0))
+        return out
+
+    def load_state(self, state: dict) -> None:
+        """Continue from a :meth:`state` of a pool built from the same config."""
+        for name in self.STATE_FIELDS:
+            array = getattr(self, name)
+            if tuple(state[name].shape) != tuple(array.shape):
+                raise WarpcausticsError(f"pool checkpoint has {name} of shape {state[name].shape}, the pool "
+                                        f"{tuple(array.shape)}: it belongs to another scene")
+            array.assign(np.ascontiguousarray(state[name], dtype=np.float32))
+        self.time_s = float(state["time_s"])
+        left = int(state["drops_left"])
+        self._drops = self._drops[len(self._drops) - left:] if left else []
+        if hasattr(self, "substeps"):
+            self.substeps = int(state["substeps"])
+
     def _check_forward(self, time_s: float) -> None:
         if time_s < self.time_s - 1e-9:
             raise WarpcausticsError(
@@ -87,6 +110,8 @@ def floor_depth_map(cfg: Config, floor_relief: np.ndarray | None) -> np.ndarray 
 
 class ShallowWaterPool(WalledPool):
     """Shallow water in a square pool with walls, over a flat floor or a floor depth map."""
+
+    STATE_FIELDS = ("h", "u", "v")
 
     def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
                  viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = (),

@@ -62,6 +62,8 @@ class Task:
     """Index of the first frame (for file names)."""
     error: str | None = None
     """Why the variant cannot run (its overrides do not make a valid scene); recorded as failed."""
+    stateful: bool = False
+    """A pool animation: its frames step on from each other, with a checkpoint after each."""
 
 
 @dataclass
@@ -138,7 +140,9 @@ def load_sweep(path: str | Path) -> Sweep:
         stateful = scene.config.water.model in (WaterModel.POOL, WaterModel.WAVEPOOL)
         groups = [times] if stateful else [(t,) for t in times]
         for i, group in enumerate(groups):
-            tasks.append(Task(task_id(resolved, group), overrides, group, 0 if stateful else i))
+            tasks.append(
+                Task(task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful)
+            )
     return Sweep(base, tasks, path, list(grid) + list(zipped))
 
 
@@ -179,6 +183,8 @@ def _die_with_parent(parent_pid: int) -> None:
 
 def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
     """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
+    if task.stateful:
+        return run_pool_task(base, task, out_dir, device)
     from warpcaustics.output import save_frame, write_run_json
     from warpcaustics.pipeline import Renderer
     from warpcaustics.scene import load_scene
@@ -205,6 +211,58 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
         "seconds": time.perf_counter() - t0,
         "device": results[0].device,
     }
+
+
+CHECKPOINT = "checkpoint.npz"
+CHECKPOINT_META = "checkpoint.json"
+
+
+def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
+    """Render a pool animation into ``out_dir/.<id>.partial/``, checkpointing the pool's state after
+    every frame, and rename the folder to ``out_dir/<id>`` when all frames are done. A task that
+    was interrupted continues from its last checkpoint (same frames, bit for bit on one device)
+    instead of simulating from t = 0 again."""
+    import numpy as np
+
+    from warpcaustics.output import atomic_path, frame_entry, save_frame, write_json, write_run_json
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.scene import load_scene
+
+    t0 = time.perf_counter()
+    out = Path(out_dir)
+    final = out / task.id
+    partial = out / f".{task.id}.partial"
+    partial.mkdir(parents=True, exist_ok=True)
+    renderer = Renderer(load_scene(base, task.overrides), device)
+    entries: list[dict] = []
+    rows: list[dict] = []
+    meta_path = partial / CHECKPOINT_META
+    if meta_path.exists() and (partial / CHECKPOINT).exists():
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        with np.load(partial / CHECKPOINT) as data:
+            state = {name: data[name] for name in data.files}
+        if int(state.pop("frames_done")) == meta["frames_done"]:  # the pair was written together
+            state["time_s"] = float(state["time_s"])
+            renderer.water.load_state(state)
+            entries, rows = meta["entries"], meta["rows"]
+    result = None
+    for k in range(len(entries), len(task.times_s)):
+        result = renderer.render(task.times_s[k])
+        save_frame(result, partial, frame=task.frame_start + k)
+        entries.append(frame_entry(task.frame_start + k, result))
+        rows.append(summary_row(task, result, k))
+        with atomic_path(partial / CHECKPOINT) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, frames_done=len(entries), **renderer.water.state())
+        write_json(meta_path, {"frames_done": len(entries), "entries": entries, "rows": rows})
+    if result is None:  # every frame was done before the interruption
+        result = renderer.render(task.times_s[-1])
+    write_run_json(partial, [result], frames=entries)
+    for name in (CHECKPOINT, CHECKPOINT_META):
+        (partial / name).unlink()
+    if final.exists():
+        shutil.rmtree(final)
+    os.replace(partial, final)
+    return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
 
 
 def summary_row(task: Task, result, k: int) -> dict:

@@ -21,6 +21,8 @@ from warpcaustics.water import GRAVITY_M_S2, Surface
 class WaveEquationPool(WalledPool):
     """η_tt = c² ∇²η − γ η_t in a square pool with walls; c = √(g·depth) unless given."""
 
+    STATE_FIELDS = ("eta", "eta_prev")
+
     def __init__(self, n: int, extent_m: float, depth_m: float, device: str, *,
                  wave_speed_m_s: float = 0.0, damping_per_s: float = 0.5, cfl: float = 0.4,
                  drops: tuple[DropConfig, ...] = ()):
