@@ -67,15 +67,41 @@ def run(quick: bool, device: str = "cpu") -> dict:
             report = run_sweep(sweep, tmp / f"w{workers}", workers=workers, device=device, quiet=True)
             times[workers] = time.perf_counter() - t0
             assert report.done == count, report
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            ray_s = None
+        else:  # a local Ray instance of 2 CPUs, started and stopped inside the timed region
+            t0 = time.perf_counter()
+            report = run_sweep(sweep, tmp / "ray", workers=2, device=device, quiet=True, executor="ray")
+            ray_s = time.perf_counter() - t0
+            assert report.done == count, report
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    row = {"tasks": count, "water_n": n, "map_m": m, "bands": k, "loop_s": loop_s,
-           "workers_1_s": times[1], "workers_2_s": times[2], "cpus": os.cpu_count()}
+    row = {
+        "tasks": count,
+        "water_n": n,
+        "map_m": m,
+        "bands": k,
+        "loop_s": loop_s,
+        "workers_1_s": times[1],
+        "workers_2_s": times[2],
+        "ray_2_cpus_s": ray_s,
+        "cpus": os.cpu_count(),
+    }
     rate = {name: 60.0 * count / sec for name, sec in (("loop", loop_s), ("1", times[1]), ("2", times[2]))}
-    print(f"sweep        {count} tasks ({n}² ocean, {m}² map, {k} bands) | tasks/min: "
-          f"loop {rate['loop']:.1f}, 1 worker {rate['1']:.1f}, 2 workers {rate['2']:.1f} | "
-          f"2 workers / loop {loop_s / times[2]:.2f}x | "
-          f"1 worker - loop per task {(times[1] - loop_s) / count * 1000:+.0f} ms")
+    print(
+        f"sweep        {count} tasks ({n}² ocean, {m}² map, {k} bands) | tasks/min: "
+        f"loop {rate['loop']:.1f}, 1 worker {rate['1']:.1f}, 2 workers {rate['2']:.1f} | "
+        f"2 workers / loop {loop_s / times[2]:.2f}x | "
+        f"1 worker - loop per task {(times[1] - loop_s) / count * 1000:+.0f} ms"
+    )
+    if ray_s is not None:
+        print(
+            f"sweep        Ray (local, 2 CPUs, start and stop included): "
+            f"{60.0 * count / ray_s:.1f} tasks/min | "
+            f"Ray - 2 local workers per task {(ray_s - times[2]) / count * 1000:+.0f} ms"
+        )
     return row
 
 

@@ -50,8 +50,11 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("sweep", metavar="SWEEP", help="sweep TOML, e.g. configs/sweeps/water_types.toml")
     sw.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
     sw.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
-    sw.add_argument("--executor", default="local", metavar="local",
-                    help="local (a process pool; the only executor so far)")
+    sw.add_argument("--executor", default="local", choices=["local", "ray"],
+                    help="local (a process pool, default) or ray (pip install 'warpcaustics[ray]')")
+    sw.add_argument("--address", metavar="ADDR",
+                    help="with --executor ray: an existing cluster (e.g. auto or ray://host:10001); "
+                         "default: a local Ray instance of --workers CPUs")
     sw.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
     sw.add_argument("--quiet", action="store_true", help="no progress lines")
 
@@ -178,10 +181,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "sweep":
             from warpcaustics.sweep import sweep_main
 
-            if args.executor != "local":
-                raise WarpcausticsError(f"--executor {args.executor!r} is not available yet; use --executor "
-                                        "local (Ray support is planned)")
-            return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet)
+            return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet, args.executor,
+                              args.address)
         if args.command == "preview":
             return _preview(args)
         if args.command == "report":

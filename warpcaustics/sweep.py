@@ -336,11 +336,21 @@ class _Progress:
 
 
 def run_sweep(
-    sweep: Sweep, out_dir: str | Path, *, workers: int = 1, device: str | None = None, quiet: bool = False
+    sweep: Sweep,
+    out_dir: str | Path,
+    *,
+    workers: int = 1,
+    device: str | None = None,
+    quiet: bool = False,
+    executor: str = "local",
+    address: str | None = None,
 ) -> SweepReport:
-    """Run every unfinished task of ``sweep`` into ``out_dir`` with a local process pool."""
-    import multiprocessing
-
+    """Run every unfinished task of ``sweep`` into ``out_dir``: with a local process pool
+    (``executor = "local"``, ``workers`` processes) or on Ray (``"ray"``: the cluster at ``address``,
+    or a local instance of ``workers`` CPUs started and stopped here). Workers write the task
+    folders; the driver alone keeps the manifest."""
+    if executor not in ("local", "ray"):
+        raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
     if workers < 1:
         raise WarpcausticsError(f"--workers = {workers} must be at least 1")
     out = Path(out_dir)
@@ -373,6 +383,54 @@ def run_sweep(
             todo.append(task)
     t0 = time.perf_counter()
     progress = _Progress(len(todo), quiet)
+
+    def finish(task: Task, outcome: dict | None, error: BaseException | None) -> None:
+        record = {
+            "id": task.id,
+            "version": __version__,
+            "overrides": task.overrides,
+            "times_s": list(task.times_s),
+        }
+        if error is not None:  # a failing task is recorded and the sweep goes on
+            message = _error_line(error)
+            _append(out, {**record, "state": "failed", "error": message})
+            report.failed.append((task.id, message))
+            progress.step(f"FAILED {task.id}: {message}")
+            return
+        _append(
+            out,
+            {
+                **record,
+                "state": "done",
+                "seconds": outcome["seconds"],
+                "device": outcome["device"],
+                "rows": outcome["rows"],
+            },
+        )
+        report.done += 1
+        progress.step(f"done {task.id} in {outcome['seconds']:.1f} s")
+
+    if executor == "ray":
+        _run_on_ray(sweep, todo, out, workers, device, address, finish)
+    else:
+        _run_locally(sweep, todo, out, workers, device, finish)
+    report.seconds = time.perf_counter() - t0
+    write_summary(out, sweep)
+    return report
+
+
+def _error_line(error: BaseException) -> str:
+    """One line for a failed task; Ray's wrapped errors are unwrapped to their cause."""
+    cause = getattr(error, "cause", None)
+    if isinstance(cause, BaseException):
+        error = cause
+    text = str(error).strip()
+    return f"{type(error).__name__}: {text.splitlines()[0] if text else ''}"
+
+
+def _run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
+    import multiprocessing
+
     context = multiprocessing.get_context("spawn")  # no forked Warp/CUDA state in the workers
     with ProcessPoolExecutor(
         max_workers=workers, mp_context=context, initializer=_die_with_parent, initargs=(os.getpid(),)
@@ -382,35 +440,49 @@ def run_sweep(
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in finished:
                 task = pending.pop(future)
-                record = {
-                    "id": task.id,
-                    "version": __version__,
-                    "overrides": task.overrides,
-                    "times_s": list(task.times_s),
-                }
                 try:
-                    result = future.result()
-                except Exception as exc:  # a failing task is recorded and the sweep goes on
-                    message = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
-                    _append(out, {**record, "state": "failed", "error": message})
-                    report.failed.append((task.id, message))
-                    progress.step(f"FAILED {task.id}: {message}")
-                    continue
-                _append(
-                    out,
-                    {
-                        **record,
-                        "state": "done",
-                        "seconds": result["seconds"],
-                        "device": result["device"],
-                        "rows": result["rows"],
-                    },
-                )
-                report.done += 1
-                progress.step(f"done {task.id} in {result['seconds']:.1f} s")
-    report.seconds = time.perf_counter() - t0
-    write_summary(out, sweep)
-    return report
+                    outcome = future.result()
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+
+
+def _run_on_ray(
+    sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, address: str | None, finish
+) -> None:
+    """One Ray task per sweep task (``num_gpus=1`` when rendering on CUDA); the workers write to
+    ``out``, which must be storage they share with the driver."""
+    try:
+        import ray
+    except ImportError:
+        raise WarpcausticsError("--executor ray needs Ray: pip install 'warpcaustics[ray]'") from None
+    started = not ray.is_initialized()
+    if started:
+        ray.init(
+            address=address,
+            num_cpus=None if address else workers,
+            include_dashboard=False,
+            log_to_driver=False,
+            configure_logging=False,
+        )
+    try:
+        gpus = 1 if device is not None and device.startswith("cuda") else 0
+        remote = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(run_task)
+        pending = {remote.remote(str(sweep.base), task, str(out.resolve()), device): task for task in todo}
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            for ref in ready:
+                task = pending.pop(ref)
+                try:
+                    outcome = ray.get(ref)
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+    finally:
+        if started:
+            ray.shutdown()
 
 
 def write_summary(out_dir: Path, sweep: Sweep) -> Path:
@@ -452,9 +524,19 @@ def format_report(report: SweepReport) -> str:
     return "\n".join(lines)
 
 
-def sweep_main(path: str, out: str, workers: int, device: str | None, quiet: bool) -> int:
+def sweep_main(
+    path: str,
+    out: str,
+    workers: int,
+    device: str | None,
+    quiet: bool,
+    executor: str = "local",
+    address: str | None = None,
+) -> int:
     sweep = load_sweep(path)
-    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet)
+    report = run_sweep(
+        sweep, out, workers=workers, device=device, quiet=quiet, executor=executor, address=address
+    )
     print(format_report(report), file=sys.stdout)
     print(f"summary: {Path(out) / SUMMARY}")
     return 1 if report.failed else 0
