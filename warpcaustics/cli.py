@@ -35,6 +35,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--frames", type=int, default=1, metavar="N", help="number of frames (default 1)")
     r.add_argument("--fps", type=float, default=30.0, metavar="F",
                    help="frames per second of an animation (default 30)")
+    r.add_argument("--quiet", action="store_true", help="no progress output")
 
     st = sub.add_parser("study", help="water-type study: irradiance, contrast and colour vs depth",
                         description="Render a base scene for each water type × depth × sun elevation "
@@ -102,19 +103,26 @@ def _render(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
     results = []
-    for frame in range(args.frames):
-        t0 = time.perf_counter()
-        result = renderer.render(args.time + frame / args.fps)
-        try:
-            save_frame(result, out, frame=frame)
-        except OSError as exc:
-            raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
-                                    f"{exc.strerror or exc}") from None
-        results.append(result)
-        print(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
-              f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
+    from warpcaustics.sweep import Progress
+
+    progress = Progress(args.frames, args.quiet, unit="frame")
+    try:
+        for frame in range(args.frames):
+            t0 = time.perf_counter()
+            result = renderer.render(args.time + frame / args.fps)
+            try:
+                save_frame(result, out, frame=frame)
+            except OSError as exc:
+                raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
+                                        f"{exc.strerror or exc}") from None
+            results.append(result)
+            progress.step(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
+                          f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
+    finally:
+        progress.close()
     write_run_json(out, results)
-    print(f"wrote {args.frames} frame(s) and run.json to {out}")
+    if not args.quiet:
+        print(f"wrote {args.frames} frame(s) and run.json to {out}")
     return 0
 
 

@@ -319,20 +319,34 @@ class SweepReport:
     seconds: float = 0.0
 
 
-class _Progress:
-    """One line per finished task with throughput and ETA (quiet: nothing)."""
+class Progress:
+    """Progress of many tasks or frames: a tqdm bar with throughput and ETA on a terminal, one plain
+    line per step otherwise (logs, CI), nothing when quiet."""
 
-    def __init__(self, total: int, quiet: bool):
+    def __init__(self, total: int, quiet: bool, unit: str = "task"):
         self.total, self.quiet, self.count, self.t0 = total, quiet, 0, time.perf_counter()
+        self.bar = None
+        if not quiet and sys.stdout.isatty():
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, unit=unit, dynamic_ncols=True)
 
     def step(self, text: str) -> None:
         self.count += 1
         if self.quiet:
             return
+        if self.bar is not None:
+            self.bar.set_postfix_str(text[:60], refresh=False)
+            self.bar.update(1)
+            return
         elapsed = time.perf_counter() - self.t0
         rate = self.count / elapsed if elapsed > 0 else 0.0
         eta = (self.total - self.count) / rate if rate > 0 else 0.0
-        print(f"[{self.count}/{self.total}] {text}  ({rate * 60:.1f} tasks/min, ETA {eta:.0f} s)", flush=True)
+        print(f"[{self.count}/{self.total}] {text}  ({rate * 60:.1f}/min, ETA {eta:.0f} s)", flush=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def run_sweep(
@@ -382,7 +396,7 @@ def run_sweep(
         else:
             todo.append(task)
     t0 = time.perf_counter()
-    progress = _Progress(len(todo), quiet)
+    progress = Progress(len(todo), quiet)
 
     def finish(task: Task, outcome: dict | None, error: BaseException | None) -> None:
         record = {
@@ -410,10 +424,13 @@ def run_sweep(
         report.done += 1
         progress.step(f"done {task.id} in {outcome['seconds']:.1f} s")
 
-    if executor == "ray":
-        _run_on_ray(sweep, todo, out, workers, device, address, finish)
-    else:
-        _run_locally(sweep, todo, out, workers, device, finish)
+    try:
+        if executor == "ray":
+            _run_on_ray(sweep, todo, out, workers, device, address, finish)
+        else:
+            _run_locally(sweep, todo, out, workers, device, finish)
+    finally:
+        progress.close()
     report.seconds = time.perf_counter() - t0
     write_summary(out, sweep)
     return report
