@@ -64,6 +64,8 @@ class Task:
     """Why the variant cannot run (its overrides do not make a valid scene); recorded as failed."""
     stateful: bool = False
     """A pool animation: its frames step on from each other, with a checkpoint after each."""
+    config: dict | None = None
+    """The resolved configuration the id hashes (recorded in the manifest)."""
 
 
 @dataclass
@@ -141,7 +143,9 @@ def load_sweep(path: str | Path) -> Sweep:
         groups = [times] if stateful else [(t,) for t in times]
         for i, group in enumerate(groups):
             tasks.append(
-                Task(task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful)
+                Task(
+                    task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
+                )
             )
     return Sweep(base, tasks, path, list(grid) + list(zipped))
 
@@ -402,6 +406,7 @@ def run_sweep(
         record = {
             "id": task.id,
             "version": __version__,
+            "config": task.config,
             "overrides": task.overrides,
             "times_s": list(task.times_s),
         }
