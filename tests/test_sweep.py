@@ -81,6 +81,12 @@ def test_local_sweep_runs_every_task_and_resumes(tmp_path):
     assert by_key[("clear_ocean", "4.0", "80.0")] < by_key[("clear_ocean", "2.0", "80.0")]
     again = run_sweep(sweep, out, workers=2, device="cpu", quiet=True)
     assert (again.done, again.skipped) == (0, 8)
+    from warpcaustics import __version__
+    from warpcaustics.sweep import task_id
+
+    for rec in read_manifest(out).values():  # the manifest holds what the id hashes
+        assert rec["version"] == __version__ and rec["config"]["water"]["resolution"] == 16
+        assert task_id(rec["config"], tuple(rec["times_s"])) == rec["id"]
 
 
 def test_a_failing_task_is_reported_and_the_rest_finish(tmp_path):
