@@ -14,7 +14,6 @@ single-threaded, and so is Warp's ``cpu`` device. ``python -m benchmarks.photons
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import time
@@ -263,7 +262,7 @@ class PhotonCase:
         """The Warp photon stage once, device synchronised; the (K, M, M) map on the host."""
         import warp as wp
 
-        irr = self.renderer.photons.run(self.surface, self.visible, self.renderer.group_ior)
+        irr = self.renderer.photons.run(self.surface, self.visible)
         wp.synchronize_device(self.device)
         return irr.numpy().copy()
 
@@ -385,7 +384,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--device", default="cpu", help="Warp device for the Warp side (default cpu)")
     p.add_argument("--out", type=Path, default=None, help="JSON file (default benchmarks/results/...)")
     args = p.parse_args(argv)
-    from benchmarks.run import _cpu_name
+    from benchmarks.run import _cpu_name, save_record
 
     record = run(args.quick, args.device)
     record.update(command="python -m benchmarks.photons" + (" --quick" if args.quick else "")
@@ -393,11 +392,7 @@ def main(argv: list[str] | None = None) -> int:
                   machine={"platform": platform.platform(), "processor": _cpu_name(),
                            "python": platform.python_version()},
                   versions={d: metadata.version(d) for d in ("warp-lang", "numpy")})
-    out = args.out or ROOT / "benchmarks" / "results" / (
-        f"photons{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(record, indent=2) + "\n")
-    print(f"wrote {out}")
+    save_record(record, args.out, "photons", args.quick, args.device)
     return 0
 
 

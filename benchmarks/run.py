@@ -187,12 +187,18 @@ def main(argv: list[str] | None = None) -> int:
         "photons": photons,
         "sweep": sweeps,
     }
-    out = args.out or ROOT / "benchmarks" / "results" / (
-        f"ocean_frame{'_quick' if args.quick else ''}_{args.device.replace(':', '')}.json")
+    save_record(record, args.out, "ocean_frame", args.quick, args.device)
+    return 0
+
+
+def save_record(record: dict, out: Path | None, name: str, quick: bool, device: str) -> Path:
+    """Write a benchmark's JSON record to ``out`` or benchmarks/results/<name>[_quick]_<device>.json."""
+    tag = f"{name}{'_quick' if quick else ''}_{device.replace(':', '')}"
+    out = out or ROOT / "benchmarks" / "results" / f"{tag}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(record, indent=2) + "\n")
     print(f"wrote {out}")
-    return 0
+    return out
 
 
 if __name__ == "__main__":

@@ -68,6 +68,26 @@ def fresnel_transmittance(cos_i: float, eta: float) -> float:
     return 1.0 - 0.5 * (rs * rs + rp * rp)
 
 
+MIN_DOWNWARD_COS = 1.0e-3
+"""A refracted ray must descend at least this steeply (|d_z|) to be followed to a receiver."""
+
+
+@wp.func
+def sun_into_water(normal: wp.vec3, sun_dir: wp.vec3, eta: float):
+    """The sun refracted into the water at a surface point with unit ``normal``: (unit direction,
+    Fresnel transmittance). Light from behind the surface (n·s <= 0), total internal reflection or
+    a ray that would not descend give (straight down, 0), so it carries nothing but stays finite."""
+    cos_i = wp.dot(normal, sun_dir)
+    t = wp.vec3(0.0, 0.0, -1.0)
+    transmitted = float(0.0)
+    if cos_i > 0.0:
+        d = refract(-sun_dir, normal, eta)
+        if d[2] < -MIN_DOWNWARD_COS:
+            t = wp.normalize(d)
+            transmitted = fresnel_transmittance(cos_i, eta)
+    return t, transmitted
+
+
 @wp.func
 def clip_half_plane(px: vec8, py: vec8, count: int, axis: int, bound: float, keep_above: bool):
     """Sutherland–Hodgman step: keep the part of polygon ``(px, py)`` on one side of a line.

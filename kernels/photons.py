@@ -14,12 +14,9 @@ k is ``weight · E_sun(k) · exp(−c(k) ℓ)``, ℓ its path in water.
 import warp as wp
 
 from warpcaustics.kernels.floor import grid_corner, lift, texel_of
-from warpcaustics.kernels.geometry import fresnel_transmittance, refract
+from warpcaustics.kernels.geometry import bilerp, sun_into_water
 
 wp.set_module_options({"enable_backward": False})
-
-MIN_DOWNWARD_COS = 1.0e-3
-"""A refracted photon must descend at least this steeply (|d_z|) to be followed."""
 
 RAY_LENGTH_M = 1.0e5
 """Longest ray queried on the BVH [m]."""
@@ -180,18 +177,9 @@ def emit_photons(
     normal = wp.normalize(
         bilinear_vec3(normals[y00, x00], normals[y10, x10], normals[y01, x01], normals[y11, x11], tu, tv)
     )
-    seen = (1.0 - tv) * ((1.0 - tu) * visible[y00, x00] + tu * visible[y10, x10]) + tv * (
-        (1.0 - tu) * visible[y01, x01] + tu * visible[y11, x11]
-    )
-    eta = 1.0 / ior[g]
-    cos_i = wp.dot(normal, sun_dir)
-    d = wp.vec3(0.0, 0.0, -1.0)
-    w = float(0.0)
-    if cos_i > 0.0:
-        t = refract(-sun_dir, normal, eta)
-        if t[2] < -MIN_DOWNWARD_COS:
-            d = wp.normalize(t)
-            w = a_perp * fresnel_transmittance(cos_i, eta) * seen
+    seen = bilerp(visible[y00, x00], visible[y10, x10], visible[y01, x01], visible[y11, x11], tu, tv)
+    d, transmitted = sun_into_water(normal, sun_dir, 1.0 / ior[g])
+    w = a_perp * transmitted * seen
     i = ((g * quads + qy) * quads + qx) * s * s + sub
     origin[i] = p
     direction[i] = d

@@ -2,12 +2,9 @@
 
 import warp as wp
 
-from warpcaustics.kernels.geometry import bilerp, bilinear_cell, fresnel_transmittance, refract
+from warpcaustics.kernels.geometry import bilerp, bilinear_cell, sun_into_water
 
 wp.set_module_options({"enable_backward": False})
-
-MIN_DOWNWARD_COS = 1.0e-3
-"""A refracted ray must descend at least this steeply (|d_z|) to reach the floor plane."""
 
 
 @wp.kernel
@@ -32,15 +29,8 @@ def refract_to_floor(
     g, iy, ix = wp.tid()
     v = positions[iy, ix]
     n = normals[iy, ix]
-    eta = 1.0 / ior[g]
-    cos_i = wp.dot(n, sun_dir)
-    t = wp.vec3(0.0, 0.0, -1.0)
-    T = float(0.0)
-    if cos_i > 0.0:
-        d = refract(-sun_dir, n, eta)
-        if d[2] < -MIN_DOWNWARD_COS:
-            t = wp.normalize(d)
-            T = fresnel_transmittance(cos_i, eta) * visible[iy, ix]
+    t, T = sun_into_water(n, sun_dir, 1.0 / ior[g])
+    T = T * visible[iy, ix]
     ell = (floor_z - v[2]) / t[2]
     hit_xy[g, iy, ix] = wp.vec2(v[0] + ell * t[0], v[1] + ell * t[1])
     path_m[g, iy, ix] = ell

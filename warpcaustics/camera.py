@@ -87,6 +87,7 @@ class UnderwaterCamera:
         self.shafts_raw = wp.empty((k, h, w), dtype=wp.float32, device=device)
         self.pyramid = wp.empty((k, pyramid_pixels(w, h)), dtype=wp.float32, device=device)
         self.radiance = wp.empty((k, h, w), dtype=wp.float32, device=device)
+        self._gbuffer: dict[str, np.ndarray] | None = None
         wp.launch(
             camera_kernels.gbuffer,
             dim=(h, w),
@@ -208,11 +209,15 @@ class UnderwaterCamera:
         return self.radiance
 
     def gbuffer(self) -> dict[str, np.ndarray]:
-        depth = self.depth.numpy().copy()
-        depth[depth >= 1.0e29] = np.inf
-        return {
-            "position": self.position.numpy().copy(),
-            "normal": self.normal.numpy().copy(),
-            "depth": depth,
-            "receiver": self.receiver.numpy().copy(),
-        }
+        """The G-buffer on the host. Receivers are static, so it is read back once and shared by
+        every frame's result."""
+        if self._gbuffer is None:
+            depth = self.depth.numpy().copy()
+            depth[depth >= 1.0e29] = np.inf
+            self._gbuffer = {
+                "position": self.position.numpy().copy(),
+                "normal": self.normal.numpy().copy(),
+                "depth": depth,
+                "receiver": self.receiver.numpy().copy(),
+            }
+        return self._gbuffer

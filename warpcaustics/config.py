@@ -197,6 +197,11 @@ class WaterConfig:
     seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
     """Seed of the ocean's random phases and amplitudes."""
 
+    @property
+    def walled(self) -> bool:
+        """The stateful pools have walls; the other models are periodic patches."""
+        return self.model in (WaterModel.POOL, WaterModel.WAVEPOOL)
+
 
 @dataclass(frozen=True)
 class FloorConfig:
@@ -559,7 +564,7 @@ def _check_vector(key: str, value: tuple[float, ...], lengths: tuple[int, ...]) 
 def _check_periodic_floor(cfg: Config) -> None:
     """Under a periodic sea the floor must tile the patch too: the photons of the neighbouring
     tiles are folded into the patch, which is only right if the floor repeats with it."""
-    if cfg.water.model in (WaterModel.POOL, WaterModel.WAVEPOOL):
+    if cfg.water.walled:
         return
     floor = cfg.floor
     if floor.shape is FloorShape.SLOPE:

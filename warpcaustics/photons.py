@@ -103,7 +103,7 @@ class PhotonCaustics:
         n: int,
         sun_irradiance: np.ndarray,
         attenuation_per_m: np.ndarray,
-        groups: int,
+        group_ior: np.ndarray,
         sun_dir: np.ndarray,
         device: str,
         *,
@@ -115,7 +115,10 @@ class PhotonCaustics:
         self.periodic = periodic
         self.subdivisions = cfg.caustics.photon_subdivisions
         self.quads = n if periodic else n + 1
+        groups = len(group_ior)
         self.groups = groups
+        self.ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
+        """Refractive index of each index group (one, or one per band with dispersion)."""
         count = photon_count(cfg, n, groups, periodic)
         self.photons_per_group = count // groups
         k = len(sun_irradiance)
@@ -181,11 +184,11 @@ class PhotonCaustics:
             )
         return view
 
-    def run(self, surface: Surface, visible: wp.array2d, group_ior: np.ndarray) -> wp.array3d:
+    def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:
         """Emit, trace and deposit every photon; fills :attr:`irradiance` and :attr:`face_flux`."""
         dev = self.device
         s = self.subdivisions
-        ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=dev)
+        ior = self.ior
         extent = float(surface.extent_m)
         wp.launch(
             photon_kernels.emit_photons,

@@ -139,7 +139,7 @@ def scene_bytes(scene: Scene) -> int:
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
     if cfg.caustics.method is CausticsMethod.PHOTONS:
-        periodic = water_is_periodic(cfg)
+        periodic = not cfg.water.walled
         faces = receiver_face_estimate(scene, periodic)
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
         return water_bytes(cfg, n) + photons.photons_bytes(cfg, n, k, groups, periodic, faces) + cam
@@ -163,18 +163,12 @@ def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) 
                           f"{floor_z:.3f} m there); move the camera up into the water")
 
 
-def water_is_periodic(cfg) -> bool:
-    from warpcaustics.config import WaterModel
-
-    return cfg.water.model not in (WaterModel.POOL, WaterModel.WAVEPOOL)
-
-
 def receiver_face_estimate(scene: Scene, periodic: bool) -> int:
     """Faces of the receivers' BVH (the floor grid with its margin, walls, meshes)."""
-    from warpcaustics.config import FloorShape
+    from warpcaustics.receivers import floor_mesh_cells
 
     cfg = scene.config
-    cells = 4 if cfg.floor.shape in (FloorShape.FLAT, FloorShape.SLOPE) else cfg.caustics.map_resolution
+    cells = floor_mesh_cells(cfg)
     floor = 2 * int(cells * (1.5 if periodic else 1.0)) ** 2
     return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + (0 if periodic else 4 * 2 * 32 * 8)
 
@@ -209,7 +203,7 @@ class Renderer:
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
                                            water_top_z=_WALL_TOP_M, base_dir=scene.base_dir)
                 self.photons = photons.PhotonCaustics(cfg, self.receivers, n, self.sun_irradiance,
-                                                      self.attenuation_per_m, len(self.group_ior),
+                                                      self.attenuation_per_m, self.group_ior,
                                                       scene.sun_direction, self.device,
                                                       periodic=self.water.periodic)
                 self.floor_top_z = self.receivers.floor_top_z
@@ -264,7 +258,7 @@ class Renderer:
                     f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
                     "above the water is not implemented yet: lower the camera")
             with watch.stage("photons"):
-                floor = self.photons.run(surface, visible, self.group_ior)
+                floor = self.photons.run(surface, visible)
             if self.camera is not None:
                 with watch.stage("camera"):
                     n = self.scene.water_resolution

@@ -167,13 +167,19 @@ def _grid_mesh(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> TriangleMesh:
     return TriangleMesh(points, triangles)
 
 
+def floor_mesh_cells(cfg: Config) -> int:
+    """Cells per patch side of the floor mesh: few for a plane (flat, slope), one per map texel for a
+    curved relief."""
+    return 4 if cfg.floor.shape in (FloorShape.FLAT, FloorShape.SLOPE) else cfg.caustics.map_resolution
+
+
 def floor_mesh(cfg: Config, relief: np.ndarray | None, periodic: bool) -> TriangleMesh:
     """The floor as a grid mesh over the patch; on a periodic sea it reaches a margin beyond the
     patch so that photons moved by whole periods still land on it. Planar floors use few cells."""
     floor = cfg.floor
     extent = cfg.water.extent_m
     planar = floor.shape in (FloorShape.FLAT, FloorShape.SLOPE)
-    cells = 4 if planar else cfg.caustics.map_resolution
+    cells = floor_mesh_cells(cfg)
     cell = extent / cells
     margin_cells = 0
     if periodic:

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from warpcaustics import __version__
-from warpcaustics.config import WaterModel, config_to_dict, read_toml
+from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 MANIFEST = "manifest.jsonl"
@@ -139,7 +139,7 @@ def load_sweep(path: str | Path) -> Sweep:
             tasks.append(Task(task_id({"overrides": overrides}, times), overrides, times, 0, str(exc)))
             continue
         resolved = config_to_dict(scene.config)
-        stateful = scene.config.water.model in (WaterModel.POOL, WaterModel.WAVEPOOL)
+        stateful = scene.config.water.walled  # the pools: frame k steps on from frame k-1
         groups = [times] if stateful else [(t,) for t in times]
         for i, group in enumerate(groups):
             tasks.append(
