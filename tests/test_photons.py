@@ -611,3 +611,20 @@ def test_preview_draws_a_png(tmp_path):
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
     assert int.from_bytes(data[16:20], "big") == 200 and int.from_bytes(data[20:24], "big") == 120
     assert not list(tmp_path.glob(".*tmp*"))
+
+
+def test_albedo_and_relief_areas_follow_their_definitions():
+    """A grey sRGB albedo becomes a flat reflectance spectrum (Mallett & Yuksel's basis sums to one
+    at every wavelength), and a slope's texels have the area (L/M)² / cos(slope)."""
+    from warpcaustics.receivers import albedo_spectrum, floor_texel_area
+
+    bins = spectra.bins_for(wc.load_scene(None, {}).config.optics)
+    np.testing.assert_allclose(albedo_spectrum((0.5, 0.5, 0.5), bins), 0.5, rtol=1e-6)
+    red = albedo_spectrum((0.8, 0.1, 0.1), bins)
+    assert red[-1] > 2 * red[0]  # a red surface reflects long wavelengths more than short ones
+    scene = wc.load_scene(
+        "configs/pool.toml",
+        {**PHOTONS, "floor.shape": "slope", "floor.slope_deg": 12.0, "caustics.map_resolution": 16},
+    )
+    area = floor_texel_area(scene.config, None)
+    np.testing.assert_allclose(area, (4.0 / 16) ** 2 / np.cos(np.radians(12.0)), rtol=1e-9)
