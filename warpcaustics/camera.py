@@ -208,6 +208,87 @@ class UnderwaterCamera:
         )
         return self.radiance
 
+    def render_beams(self, beams, shafts: bool) -> wp.array3d:
+        """Light the receivers the camera sees by ``beams``' last frame (point-in-beam on the
+        G-buffer), add the scan-plane volume caustics, shade: (K, H, W) radiance."""
+        from warpcaustics.beams import SCREEN_TILE_PIXELS, TileBins
+        from warpcaustics.kernels import beams as beam_kernels
+
+        dev = self.device
+        h, w = self.cfg.height, self.cfg.width
+        k = beams.k
+        pixels = h * w
+        beams.points(
+            self.position.reshape((pixels,)),
+            self.normal.reshape((pixels,)),
+            self.receiver.reshape((pixels,)),
+            self.caustic.reshape((k, pixels)),
+        )
+        self.shafts.zero_()
+        if shafts:
+            copies = 3 if beams.periodic else 1  # the patch and its eight neighbours, as for photons
+            items = beams.weight.shape[0] * copies * copies
+            bins = getattr(self, "_screen_bins", None)
+            if bins is None or bins.spans.shape[0] != items:
+                grid = beam_kernels.TileGrid()
+                grid.origin = wp.vec2(0.0, 0.0)
+                grid.size = wp.vec2(float(SCREEN_TILE_PIXELS), float(SCREEN_TILE_PIXELS))
+                grid.nx = -(-w // SCREEN_TILE_PIXELS)
+                grid.ny = -(-h // SCREEN_TILE_PIXELS)
+                grid.wrap = 0
+                bins = self._screen_bins = TileBins(grid, items, dev).with_boxes()
+                self._box_pixels = wp.empty(items, dtype=wp.float32, device=dev)
+                self._pairs = wp.zeros(3, dtype=wp.int32, device=dev)
+            wp.launch(
+                beam_kernels.screen_spans,
+                dim=items,
+                inputs=[bins.grid, self.cam, beams.base, beams.direction, beams.end_m, beams.weight, copies,
+                        beams.extent_m],
+                outputs=[bins.spans, bins.box_axis, bins.box_lo, bins.box_hi, self._box_pixels],
+                device=dev,
+            )
+            bins.bin()
+            self._pairs.zero_()
+            ph = self.phase
+            wp.launch(
+                beam_kernels.scan_plane_radiance,
+                dim=(h, w),
+                inputs=[*bins.inputs(), SCREEN_TILE_PIXELS, self.cam, self.depth, beams.base, beams.direction,
+                        beams.transmit, beams.end_m, beams.weight, beams.area_coef, copies, beams.extent_m,
+                        bins.box_axis, bins.box_lo, bins.box_hi, beams.beams_per_group, k // beams.groups,
+                        beams.sun_irradiance, beams.attenuation_per_m, self.scattering_per_m, ph.kind, ph.g,
+                        ph.angles_rad, ph.log_phase, ph.cone_phase],
+                outputs=[self.shafts, self._pairs],
+                device=dev,
+            )
+        wp.launch(
+            camera_kernels.shade,
+            dim=(k, h, w),
+            inputs=[
+                self.receiver,
+                self.depth,
+                self.caustic,
+                self.shafts,
+                self.receivers.albedo_wp,
+                beams.attenuation_per_m,
+            ],
+            outputs=[self.radiance],
+            device=dev,
+        )
+        return self.radiance
+
+    def beam_fill(self) -> dict[str, float]:
+        """Rasteriser fill of the last :meth:`render_beams` with shafts, as (pixel, beam copy) pairs:
+        in the axis-aligned screen boxes of the beams' hulls, in the tile lists, inside the oriented
+        boxes (where the scan plane is computed), and with a real chord through the beam."""
+        pairs = self._pairs.numpy()
+        return {
+            "box_pixels": float(self._box_pixels.numpy().astype(np.float64).sum()),
+            "tile_pairs": int(pairs[0]),
+            "oriented_box_pairs": int(pairs[1]),
+            "inside_pairs": int(pairs[2]),
+        }
+
     def gbuffer(self) -> dict[str, np.ndarray]:
         """The G-buffer on the host. Receivers are static, so it is read back once and shared by
         every frame's result."""

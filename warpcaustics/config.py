@@ -94,6 +94,12 @@ class JerlovSource(str, enum.Enum):
 class CausticsMethod(str, enum.Enum):
     FLUXRATIO = "fluxratio"
     PHOTONS = "photons"
+    BEAMS = "beams"
+
+    @property
+    def uses_receivers(self) -> bool:
+        """Photons and beams light every receiver (relief, walls, meshes) and feed the camera."""
+        return self in (CausticsMethod.PHOTONS, CausticsMethod.BEAMS)
 
 
 class Intersection(str, enum.Enum):
@@ -116,7 +122,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("beams", "both", "sunmap", "eikonal", "wave3d"),
+    "caustics.method": ("both", "sunmap", "eikonal", "wave3d"),
     "water.model": ("procedural",),
 }
 
@@ -209,7 +215,7 @@ class FloorConfig:
     """Depth of the floor below the water at rest at the origin (floor at z = -depth_m + relief) [m]."""
     shape: FloorShape = FloorShape.FLAT
     """Relief of the floor: ``flat``, ``slope`` (a plane), ``ripples`` (sand ripples, a sine) or
-    ``file`` (``floor.file``); anything but ``flat`` needs ``caustics.method = "photons"``."""
+    ``file`` (``floor.file``); anything but ``flat`` needs ``caustics.method = "photons"`` or ``"beams"``."""
     slope_deg: float = field(default=5.0, metadata=_range(0.0, 60.0))
     """Inclination of the ``slope`` [deg]."""
     slope_azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
@@ -305,8 +311,10 @@ class OpticsConfig:
 @dataclass(frozen=True)
 class CausticsConfig:
     method: CausticsMethod = CausticsMethod.FLUXRATIO
-    """Caustics method: ``fluxratio`` (refracted triangle footprints on a flat floor) or
-    ``photons`` (photon splatting onto every receiver, Shah et al. 2007)."""
+    """Caustics method: ``fluxratio`` (refracted triangle footprints on a flat floor),
+    ``photons`` (photon splatting onto every receiver, Shah et al. 2007) or ``beams`` (warped beam
+    volumes through a tile-binned rasteriser onto every receiver, with volume caustics in the
+    camera; Ernst et al. 2005, Liktor & Dachsbacher 2011)."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
     intersection: Intersection = Intersection.EXACT
@@ -319,7 +327,8 @@ class CausticsConfig:
     newton_buffer_resolution: int = field(default=1024, metadata=_range(16, 16384))
     """Texels per side of the ``newton`` receiver-position buffer seen from the sun [-]."""
     shafts: bool = True
-    """Add photon light shafts (single scattering along each photon's path) to the camera image."""
+    """Add light shafts (single scattering in the water: along each photon's path, or through each
+    beam by scan planes) to the camera image."""
 
 
 @dataclass(frozen=True)
@@ -342,7 +351,8 @@ class ReceiverConfig:
 @dataclass(frozen=True)
 class CameraConfig:
     enabled: bool = False
-    """Render a camera image (needs ``caustics.method = "photons"``); the camera is under water."""
+    """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``); the camera is
+    under water."""
     position_m: tuple[float, ...] = (0.0, -6.0, -1.0)
     """Pinhole position (x, y, z) [m]; must be below the water surface."""
     look_at_m: tuple[float, ...] = (0.0, 0.0, -3.0)
@@ -589,8 +599,8 @@ def _check_periodic_floor(cfg: Config) -> None:
 
 
 def _check_photon_scene(cfg: Config) -> None:
-    """Receivers other than a flat floor, and the camera, need the photon method."""
-    photons = cfg.caustics.method is CausticsMethod.PHOTONS
+    """Receivers other than a flat floor, and the camera, need the photon or beam method."""
+    photons = cfg.caustics.method.uses_receivers
     needs = []
     if cfg.floor.shape is not FloorShape.FLAT:
         needs.append(f"floor.shape = {cfg.floor.shape.value!r}")
@@ -599,7 +609,8 @@ def _check_photon_scene(cfg: Config) -> None:
     if cfg.camera.enabled:
         needs.append("camera.enabled = true")
     if needs and not photons:
-        raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" (the method is "
+        raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" or \"beams\" "
+                          f"(the method is "
                           f"{cfg.caustics.method.value!r})")
     if cfg.floor.shape is FloorShape.FILE and not cfg.floor.file:
         raise ConfigError("floor.file is missing; floor.shape = 'file' needs a .npy file of floor relief "

@@ -212,6 +212,7 @@ def frame_entry(frame: int, r) -> dict:
         "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
         "fold_fraction": r.fold_fraction,
         **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
+        **({"beams": r.beam_stats} if r.beam_stats is not None else {}),
     }
     return json.loads(json.dumps(entry, default=_jsonable))
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import warp as wp
 
-from warpcaustics import caustics, photons, spectra
+from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.config import CausticsMethod
@@ -45,7 +45,7 @@ class RenderResult:
     """(K,) solar spectral irradiance on a plane perpendicular to the beam [W m^-2 nm^-1]."""
     transmitted_flux_w_nm: np.ndarray
     """(K,) flux that enters the water [W nm^-1]: ``fluxratio`` counts it after attenuation on the
-    way to the floor, ``photons`` at the surface (before attenuation)."""
+    way to the floor, ``photons`` and ``beams`` at the surface (before attenuation)."""
     surface_positions: np.ndarray
     """(N, N, 3) water surface vertices [m]."""
     surface_normals: np.ndarray
@@ -57,21 +57,24 @@ class RenderResult:
     timings_s: dict[str, float] = field(default_factory=dict)
     """Wall time of each stage [s] (device synchronised)."""
     face_flux_w_nm: np.ndarray | None = None
-    """``photons``: (F, K) flux on each receiver face that is not floor [W nm^-1], faces ordered
-    walls, then ``receivers[i]`` (see :attr:`face_receiver`)."""
+    """``photons``, ``beams``: (F, K) flux on each receiver face that is not floor [W nm^-1], faces
+    ordered walls, then ``receivers[i]`` (see :attr:`face_receiver`)."""
     face_receiver: np.ndarray | None = None
-    """``photons``: (F,) receiver id of each of those faces (1 = walls, 2 + i = ``receivers[i]``)."""
+    """``photons``, ``beams``: (F,) receiver id of each of those faces (1 = walls, 2 + i =
+    ``receivers[i]``)."""
     face_area_m2: np.ndarray | None = None
-    """``photons``: (F,) area of each of those faces [m²]."""
+    """``photons``, ``beams``: (F,) area of each of those faces [m²]."""
     face_centres_m: np.ndarray | None = None
-    """``photons``: (F, 3) centroid of each of those faces [m]."""
+    """``photons``, ``beams``: (F, 3) centroid of each of those faces [m]."""
     floor_texel_area_m2: np.ndarray | None = None
-    """``photons``: (M, M) true area of the floor over each texel [m²] (None: flat, (L/M)²)."""
+    """``photons``, ``beams``: (M, M) true area of the floor over each texel [m²] (None: flat, (L/M)²)."""
     receiver_mesh: tuple[np.ndarray, np.ndarray] | None = None
-    """``photons``: (points (V, 3) [m], triangles (F, 3)) of the receivers other than the floor, the
-    faces in the order of :attr:`face_flux_w_nm`."""
+    """``photons``, ``beams``: (points (V, 3) [m], triangles (F, 3)) of the receivers other than the
+    floor, the faces in the order of :attr:`face_flux_w_nm`."""
     photon_stats: dict[str, int] | None = None
     """``photons``: photons emitted, carrying flux, and landed on a receiver."""
+    beam_stats: dict[str, int] | None = None
+    """``beams``: beams built, carrying flux, dropped, and tile-list entries."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -81,7 +84,7 @@ class RenderResult:
     def receiver_irradiance(self, receiver: int) -> np.ndarray:
         """(F_r, K) irradiance on the faces of receiver id ``receiver`` [W m^-2 nm^-1]."""
         if self.face_flux_w_nm is None:
-            raise ValueError("receiver irradiance needs caustics.method = 'photons'")
+            raise ValueError("receiver irradiance needs caustics.method = 'photons' or 'beams'")
         sel = self.face_receiver == receiver
         return self.face_flux_w_nm[sel] / self.face_area_m2[sel, None]
 
@@ -138,11 +141,15 @@ def scene_bytes(scene: Scene) -> int:
     n = scene.water_resolution
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
-    if cfg.caustics.method is CausticsMethod.PHOTONS:
+    if cfg.caustics.method.uses_receivers:
         periodic = not cfg.water.walled
         faces = receiver_face_estimate(scene, periodic)
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
-        return water_bytes(cfg, n) + photons.photons_bytes(cfg, n, k, groups, periodic, faces) + cam
+        if cfg.caustics.method is CausticsMethod.BEAMS:
+            stage = beams.beams_bytes(cfg, n, k, groups, periodic, faces)
+        else:
+            stage = photons.photons_bytes(cfg, n, k, groups, periodic, faces)
+        return water_bytes(cfg, n) + stage + cam
     return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
 
 
@@ -198,14 +205,21 @@ class Renderer:
             n = scene.water_resolution
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.photons = None
-            if cfg.caustics.method is CausticsMethod.PHOTONS:
+            self.beams = None
+            if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
                                            water_top_z=_WALL_TOP_M, base_dir=scene.base_dir)
-                self.photons = photons.PhotonCaustics(cfg, self.receivers, n, self.sun_irradiance,
-                                                      self.attenuation_per_m, self.group_ior,
-                                                      scene.sun_direction, self.device,
-                                                      periodic=self.water.periodic)
+                stage = (beams.BeamCaustics if cfg.caustics.method is CausticsMethod.BEAMS
+                         else photons.PhotonCaustics)
+                extra = {"relief": scene.floor_relief} if stage is beams.BeamCaustics else {}
+                built = stage(cfg, self.receivers, n, self.sun_irradiance, self.attenuation_per_m,
+                              self.group_ior, scene.sun_direction, self.device,
+                              periodic=self.water.periodic, **extra)
+                if stage is beams.BeamCaustics:
+                    self.beams = built
+                else:
+                    self.photons = built
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
                     photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, scene.sun_direction,
@@ -246,7 +260,8 @@ class Renderer:
         with watch.stage("shading"):
             visible = sun_visibility(surface, sun_dir, highest, dev, out=self.visible)
         extra = {}
-        if self.photons is not None:
+        stage = self.photons if self.photons is not None else self.beams
+        if stage is not None:
             if self.receivers.mesh_top_z >= lowest:
                 raise WarpcausticsError(
                     f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
@@ -257,27 +272,35 @@ class Renderer:
                     f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
                     f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
                     "above the water is not implemented yet: lower the camera")
-            with watch.stage("photons"):
-                floor = self.photons.run(surface, visible)
+            with watch.stage("photons" if self.photons is not None else "beams"):
+                floor = stage.run(surface, visible)
             if self.camera is not None:
                 with watch.stage("camera"):
-                    n = self.scene.water_resolution
-                    spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
-                    self.camera.render(self.photons, spacing, cfg.caustics.shafts)
+                    if self.photons is not None:
+                        n = self.scene.water_resolution
+                        spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
+                        self.camera.render(self.photons, spacing, cfg.caustics.shafts)
+                    else:
+                        self.camera.render_beams(self.beams, cfg.caustics.shafts)
                     extra["camera_radiance"] = self.camera.radiance.numpy().copy()
                     extra["camera_gbuffer"] = self.camera.gbuffer()
             with watch.stage("readback"):
                 floor_np = floor.numpy().copy()
-                transmitted = self.photons.transmitted_flux()
+                transmitted = stage.transmitted_flux()
                 rec = self.receivers
                 other = rec.face_count - rec.floor_face_count
-                extra.update(face_flux_w_nm=self.photons.face_flux.numpy()[:other].copy(),
+                if self.photons is not None:
+                    face_flux = self.photons.face_flux.numpy()[:other].copy()
+                    extra["photon_stats"] = vars(self.photons.stats())
+                else:
+                    face_flux = self.beams.face_flux_w_nm()
+                    extra["beam_stats"] = vars(self.beams.stats())
+                extra.update(face_flux_w_nm=face_flux,
                              face_receiver=rec.face_receiver_np[rec.floor_face_count:],
                              face_area_m2=rec.face_area_m2[rec.floor_face_count:],
                              face_centres_m=rec.face_centres_m[rec.floor_face_count:],
                              floor_texel_area_m2=rec.floor_texel_area_m2,
-                             receiver_mesh=rec.non_floor_mesh(),
-                             photon_stats=vars(self.photons.stats()))
+                             receiver_mesh=rec.non_floor_mesh())
         else:
             with watch.stage("refraction"):
                 refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,

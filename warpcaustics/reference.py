@@ -100,7 +100,7 @@ def triangles(n: int, extent_m: float):
     return np.concatenate(idx), np.concatenate(shift).astype(np.float64)
 
 
-def _subtriangle_centroids(s: int) -> tuple[np.ndarray, float]:
+def subtriangle_centroids(s: int) -> tuple[np.ndarray, float]:
     """Barycentric (u, v) of the centroids of the s² congruent sub-triangles, and their weight."""
     a, b = np.meshgrid(np.arange(s), np.arange(s), indexing="ij")
     up = (a + b) <= s - 1
@@ -187,7 +187,7 @@ def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradian
     tri_parts, texel_parts, weight_parts = [], [], []
     # Huge footprints: equal shares at the centroids of S² congruent sub-triangles.
     tc = lit[coarse]
-    bary, w = _subtriangle_centroids(SAMPLE_SUBDIVISIONS)
+    bary, w = subtriangle_centroids(SAMPLE_SUBDIVISIONS)
     pts = q[tc, None, 0] + bary[None, :, :1] * e1[tc, None] + bary[None, :, 1:] * e2[tc, None]
     cells = np.mod(np.floor(pts), m).astype(np.int64)
     tri_parts.append(np.repeat(tc, len(bary)))

@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from warpcaustics.config import (
-    CausticsMethod,
     Config,
     FloorShape,
     WaterModel,
@@ -65,7 +64,7 @@ def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) ->
         path = Path(cfg.floor.file)
         relief = load_floor_relief(path if path.is_absolute() else base_dir / path)
     meshes = tuple(load_receiver_mesh(r, base_dir, f"receivers[{i}]") for i, r in enumerate(cfg.receivers))
-    if cfg.caustics.method is CausticsMethod.PHOTONS:
+    if cfg.caustics.method.uses_receivers:
         from warpcaustics import spectra
 
         receiver_albedos(cfg, spectra.bins_for(cfg.optics), base_dir)  # bad albedo files fail at load

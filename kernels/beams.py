@@ -1,0 +1,1056 @@
+"""Warped beam volumes (Sandberg & Falemo 2005; Ernst et al. 2005; Liktor & Dachsbacher 2011).
+
+One beam per surface triangle and index group: its base vertices v_i on the displaced surface,
+the unit refracted directions d_i of its three edges, the transmittance T_i at each vertex, the
+length e_i along each edge to the first receiver (a ray query on the receivers' BVH), and its
+flux weight ``w = A⊥`` [m²] (the triangle's area projected perpendicular to the sun). Beams are
+stored flat, index ``((g Q + qy) Q + qx) 2 + half``; a beam that carries nothing (facing away from
+the sun, total internal reflection at all three vertices, a degenerate triangle) has ``w = 0``.
+
+The horizontal section of a beam at height z has vertices ``p_i(z) = v_i + (z − v_iz)/d_iz · d_i``
+and signed area ``A(z) = a0 + a1 z + a2 z²`` (DESIGN.md). A point P is in the beam iff it lies in
+the section at P_z; its barycentrics λ there interpolate the transmittance, the path length
+ℓ = Σ λ_i (v_iz − P_z)/|d_iz| and the direction. The flux density on a horizontal plane is
+``E_sun(k) · w · Σλ_i T_i · exp(−c(k) ℓ) / |A(P_z)|``; on a receiver with unit normal n it is
+multiplied by ``|d·n| / |d_z|`` (``constant`` interpolation: flux spread uniformly in barycentric
+terms, so a section receives exactly ``E_sun · w · mean(T)`` without absorption).
+
+A beam ends at the plane through its three edge ends: a point more than one beam width beyond
+that plane is in the shadow of whatever stopped the beam (``shadow_slack``).
+
+Binning (Laine & Karras 2011; Kerbl et al. 2023): every beam (or periodic copy of a beam) gets a
+span of tiles, tiles count their beams (atomics), an exclusive scan gives each tile's start, and
+a scatter fills the per-tile lists; each query (texel, receiver point, pixel) then loops only over
+its tile's list and adds up additively, so the order of beams never matters except for rounding.
+On the GPU the order inside a tile follows the atomics, so sums may differ in the last bits from
+run to run; on the CPU launches are serial and the result is deterministic.
+"""
+
+import warp as wp
+
+from warpcaustics.kernels.camera import PinholeCamera, pixel_ray
+from warpcaustics.kernels.floor import lift, quad_corner
+from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, sun_into_water, vec8
+from warpcaustics.kernels.phase import henyey_greenstein, tabulated_phase
+
+wp.set_module_options({"enable_backward": False})
+
+RAY_LENGTH_M = 1.0e5
+"""Longest edge traced to a receiver [m]."""
+
+MIN_AREA_FRACTION = 1.0e-6
+"""|A(z)| is floored at this fraction of the beam's base-section area (a focus is a finite peak)."""
+
+PARALLEL_COS = 1.0e-4
+"""``|v × d̄|`` below which a view ray counts as running along a beam (DESIGN.md)."""
+
+MAX_CHORD_PIECES = 16
+"""Most midpoint pieces a scan-plane chord is split into for the in-scattering integral."""
+
+
+@wp.func
+def corner_ray(
+    positions: wp.array2d[wp.vec3],
+    normals: wp.array2d[wp.vec3],
+    visible: wp.array2d[wp.float32],
+    qx: int,
+    qy: int,
+    half: int,
+    corner: int,
+    extent_m: float,
+    periodic: int,
+    sun_dir: wp.vec3,
+    eta: float,
+):
+    """Surface vertex of a triangle corner (periodic wrap / wall offset applied), its refracted
+    unit direction and its transmittance (Fresnel × sun visibility)."""
+    n = positions.shape[0]
+    x, y, s = quad_corner(qx, qy, half, corner, n, extent_m, periodic)
+    d, t = sun_into_water(normals[y, x], sun_dir, eta)
+    return lift(positions[y, x], s), d, t * visible[y, x]
+
+
+@wp.func
+def edge_end(mesh: wp.uint64, origin: wp.vec3, d: wp.vec3, plane_z: float) -> float:
+    """Length along an edge to the first receiver; a miss ends on the plane z = plane_z."""
+    q = wp.mesh_query_ray(mesh, origin, d, RAY_LENGTH_M)
+    if q.result:
+        return q.t
+    return wp.max((origin[2] - plane_z) / wp.max(-d[2], 1.0e-6), 0.0)
+
+
+@wp.func
+def cross2(a: wp.vec2, b: wp.vec2) -> float:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+@wp.func
+def xy(v: wp.vec3) -> wp.vec2:
+    return wp.vec2(v[0], v[1])
+
+
+@wp.func
+def section_vertex(v: wp.vec3, d: wp.vec3, z: float) -> wp.vec2:
+    """p_i(z): where the edge line v + t d crosses height z (d_z < 0 for every kept beam)."""
+    return xy(v) + ((z - v[2]) / d[2]) * xy(d)
+
+
+@wp.kernel
+def build_beams(
+    positions: wp.array2d[wp.vec3],
+    normals: wp.array2d[wp.vec3],
+    visible: wp.array2d[wp.float32],
+    ior: wp.array[wp.float32],
+    sun_dir: wp.vec3,
+    extent_m: float,
+    periodic: int,
+    plane_z: float,
+    mesh: wp.uint64,
+    quads: int,
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    dropped: wp.array[wp.int32],
+):
+    """Build beam ((g Q + qy) Q + qx) 2 + half. On a periodic sea the beam is moved by whole
+    periods so that its mean ray lands inside the patch on the plane ``plane_z`` (as photons are)."""
+    g, qy, qx, half = wp.tid()
+    b = ((g * quads + qy) * quads + qx) * 2 + half
+    eta = 1.0 / ior[g]
+    p0, d0, t0 = corner_ray(positions, normals, visible, qx, qy, half, 0, extent_m, periodic, sun_dir, eta)
+    p1, d1, t1 = corner_ray(positions, normals, visible, qx, qy, half, 1, extent_m, periodic, sun_dir, eta)
+    p2, d2, t2 = corner_ray(positions, normals, visible, qx, qy, half, 2, extent_m, periodic, sun_dir, eta)
+    a_perp = 0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir)
+    w = float(0.0)
+    if a_perp > 0.0 and t0 + t1 + t2 > 0.0:
+        w = a_perp
+    if periodic != 0:
+        c = (p0 + p1 + p2) / 3.0
+        dm = wp.normalize(d0 + d1 + d2)
+        land = c + ((plane_z - c[2]) / wp.min(dm[2], -1.0e-6)) * dm
+        shift = wp.vec3(
+            -extent_m * wp.floor(land[0] / extent_m + 0.5),
+            -extent_m * wp.floor(land[1] / extent_m + 0.5),
+            0.0,
+        )
+        p0 = p0 + shift
+        p1 = p1 + shift
+        p2 = p2 + shift
+    base[b, 0] = p0
+    base[b, 1] = p1
+    base[b, 2] = p2
+    direction[b, 0] = d0
+    direction[b, 1] = d1
+    direction[b, 2] = d2
+    transmit[b, 0] = t0
+    transmit[b, 1] = t1
+    transmit[b, 2] = t2
+    # A(z) = 0.5 cross(p1(z) − p0(z), p2(z) − p0(z)) with p_i(z) = u_i + z r_i, r_i = d_xy / d_z.
+    r0 = xy(d0) / d0[2]
+    r1 = xy(d1) / d1[2]
+    r2 = xy(d2) / d2[2]
+    u1 = xy(p1) - p1[2] * r1 - (xy(p0) - p0[2] * r0)
+    u2 = xy(p2) - p2[2] * r2 - (xy(p0) - p0[2] * r0)
+    q1 = r1 - r0
+    q2 = r2 - r0
+    area_coef[b] = 0.5 * wp.vec3(cross2(u1, u2), cross2(u1, q2) + cross2(q1, u2), cross2(q1, q2))
+    if w > 0.0:
+        end_m[b, 0] = edge_end(mesh, p0, d0, plane_z)
+        end_m[b, 1] = edge_end(mesh, p1, d1, plane_z)
+        end_m[b, 2] = edge_end(mesh, p2, d2, plane_z)
+    else:
+        wp.atomic_add(dropped, 0, 1)
+        end_m[b, 0] = 0.0
+        end_m[b, 1] = 0.0
+        end_m[b, 2] = 0.0
+    weight[b] = w
+
+
+@wp.func
+def section_area(coef: wp.vec3, z: float) -> float:
+    """Signed area A(z) of the horizontal section [m²]."""
+    return coef[0] + z * (coef[1] + z * coef[2])
+
+
+@wp.func
+def safe_area(coef: wp.vec3, z: float, base_z: float) -> float:
+    """|A(z)| floored at MIN_AREA_FRACTION of |A| at the base (a focus stays finite)."""
+    return wp.max(
+        wp.abs(section_area(coef, z)), MIN_AREA_FRACTION * wp.abs(section_area(coef, base_z)) + 1.0e-20
+    )
+
+
+@wp.func
+def barycentrics(a: wp.vec2, b: wp.vec2, c: wp.vec2, p: wp.vec2) -> wp.vec3:
+    """Barycentric coordinates of p in triangle (a, b, c), either orientation; (−1, …) if degenerate."""
+    det = cross2(b - a, c - a)
+    if det == 0.0:
+        return wp.vec3(-1.0, 0.0, 0.0)
+    l1 = cross2(p - a, c - a) / det
+    l2 = cross2(b - a, p - a) / det
+    return wp.vec3(1.0 - l1 - l2, l1, l2)
+
+
+@wp.func
+def period_shift(target: wp.vec2, p: wp.vec2, extent_m: float, periodic: int) -> wp.vec2:
+    """The whole-period shift that moves p nearest to target (zero on a walled pool)."""
+    if periodic == 0:
+        return wp.vec2(0.0)
+    return wp.vec2(
+        extent_m * wp.floor((target[0] - p[0]) / extent_m + 0.5),
+        extent_m * wp.floor((target[1] - p[1]) / extent_m + 0.5),
+    )
+
+
+@wp.struct
+class BeamSample:
+    """A beam seen at one point: inside?, barycentrics, path from the surface ℓ [m], interpolated
+    unit direction, Σλ_i T_i, |A(z)| [m²], and how far the point is beyond the beam's end [m]."""
+
+    inside: int
+    lam: wp.vec3
+    path_m: float
+    d: wp.vec3
+    transmit: float
+    area: float
+    beyond_end_m: float
+
+
+@wp.func
+def sample_beam(
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    b: int,
+    p: wp.vec3,
+) -> BeamSample:
+    """The beam b at point p (already moved into the beam's periodic image)."""
+    out = BeamSample()
+    out.inside = 0
+    v0 = base[b, 0]
+    v1 = base[b, 1]
+    v2 = base[b, 2]
+    d0 = direction[b, 0]
+    d1 = direction[b, 1]
+    d2 = direction[b, 2]
+    z = p[2]
+    lam = barycentrics(section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p))
+    if lam[0] < 0.0 or lam[1] < 0.0 or lam[2] < 0.0:
+        return out
+    l0 = (v0[2] - z) / -d0[2]
+    l1 = (v1[2] - z) / -d1[2]
+    l2 = (v2[2] - z) / -d2[2]
+    path = lam[0] * l0 + lam[1] * l1 + lam[2] * l2
+    if path < 0.0:
+        return out  # above the water surface (a wall's top): the beam starts below
+    out.inside = 1
+    out.lam = lam
+    out.path_m = path
+    out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
+    out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
+    out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
+    out.beyond_end_m = beyond_end(base, direction, end_m, b, p)
+    return out
+
+
+@wp.func
+def end_plane(
+    base: wp.array2d[wp.vec3], direction: wp.array2d[wp.vec3], end_m: wp.array2d[wp.float32], b: int
+):
+    """A point of the plane through the three edge ends and its unit normal along the beam."""
+    e0 = base[b, 0] + end_m[b, 0] * direction[b, 0]
+    e1 = base[b, 1] + end_m[b, 1] * direction[b, 1]
+    e2 = base[b, 2] + end_m[b, 2] * direction[b, 2]
+    along = direction[b, 0] + direction[b, 1] + direction[b, 2]
+    nrm = wp.cross(e1 - e0, e2 - e0)
+    if wp.length(nrm) <= 1.0e-12 * wp.max(wp.length_sq(e1 - e0) + wp.length_sq(e2 - e0), 1.0e-30):
+        nrm = wp.vec3(0.0, 0.0, -1.0)  # collinear ends: a horizontal end plane at their mean
+        e0 = (e0 + e1 + e2) / 3.0
+    nrm = wp.normalize(nrm)
+    if wp.dot(nrm, along) < 0.0:
+        nrm = -nrm
+    return e0, nrm
+
+
+@wp.func
+def beyond_end(
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    b: int,
+    p: wp.vec3,
+) -> float:
+    e0, nrm = end_plane(base, direction, end_m, b)
+    return wp.dot(p - e0, nrm)
+
+
+@wp.func
+def lit(mesh: wp.uint64, occluders: int, s: BeamSample, p: wp.vec3) -> bool:
+    """Whether the beam's light reaches receiver point p. With occluders (walls, meshes, a relief)
+    a ray from p back along the beam towards the surface must reach it unblocked (exact shadows at
+    the resolution of the BVH); with a flat floor alone the beam's end plane decides."""
+    if occluders == 0:
+        return s.beyond_end_m <= shadow_slack(s.area)
+    eps = 1.0e-4 * (1.0 + s.path_m)
+    length = s.path_m - 2.0 * eps
+    if length <= 0.0:
+        return True
+    q = wp.mesh_query_ray(mesh, p - eps * s.d, -s.d, length)
+    return not q.result
+
+
+@wp.func
+def shadow_slack(area: float) -> float:
+    """A point counts as lit up to one beam width (√|A|) beyond the beam's end plane: receivers are
+    curved between edge ends, occluders lie well beyond."""
+    return wp.sqrt(area) + 1.0e-4
+
+
+# --- binning ------------------------------------------------------------------------------------
+
+
+@wp.struct
+class TileGrid:
+    """Tiles over a plane: tile (i, j) covers ``origin + [i, i+1) size`` × ``[j, j+1) size``."""
+
+    origin: wp.vec2
+    size: wp.vec2
+    nx: int
+    ny: int
+    wrap: int
+    """1: indices wrap (a periodic sea); 0: clamped to the grid."""
+
+
+@wp.func
+def tile_index(grid: TileGrid, i: int, j: int) -> int:
+    if grid.wrap != 0:
+        i = ((i % grid.nx) + grid.nx) % grid.nx
+        j = ((j % grid.ny) + grid.ny) % grid.ny
+    return j * grid.nx + i
+
+
+@wp.func
+def tile_of(grid: TileGrid, p: wp.vec2) -> int:
+    i = int(wp.floor((p[0] - grid.origin[0]) / grid.size[0]))
+    j = int(wp.floor((p[1] - grid.origin[1]) / grid.size[1]))
+    if grid.wrap == 0:  # a walled pool: points on the walls belong to the edge tiles
+        i = wp.clamp(i, 0, grid.nx - 1)
+        j = wp.clamp(j, 0, grid.ny - 1)
+    return tile_index(grid, i, j)
+
+
+@wp.func
+def set_span(grid: TileGrid, lo: wp.vec2, hi: wp.vec2, spans: wp.array2d[wp.int32], b: int):
+    """Store the tile range covering the box [lo, hi]: (i0, j0, i1, j1), or an empty range."""
+    i0 = int(wp.floor((lo[0] - grid.origin[0]) / grid.size[0]))
+    j0 = int(wp.floor((lo[1] - grid.origin[1]) / grid.size[1]))
+    i1 = int(wp.floor((hi[0] - grid.origin[0]) / grid.size[0]))
+    j1 = int(wp.floor((hi[1] - grid.origin[1]) / grid.size[1]))
+    if grid.wrap != 0:
+        if i1 - i0 >= grid.nx:
+            i0 = 0
+            i1 = grid.nx - 1
+        if j1 - j0 >= grid.ny:
+            j0 = 0
+            j1 = grid.ny - 1
+    else:
+        i0 = wp.max(i0, 0)
+        j0 = wp.max(j0, 0)
+        i1 = wp.min(i1, grid.nx - 1)
+        j1 = wp.min(j1, grid.ny - 1)
+    spans[b, 0] = i0
+    spans[b, 1] = j0
+    spans[b, 2] = i1
+    spans[b, 3] = j1
+
+
+@wp.func
+def empty_span(spans: wp.array2d[wp.int32], b: int):
+    spans[b, 0] = 0
+    spans[b, 1] = 0
+    spans[b, 2] = -1
+    spans[b, 3] = -1
+
+
+@wp.kernel
+def horizontal_spans(
+    grid: TileGrid,
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    query_lo_z: float,
+    query_hi_z: float,
+    spans: wp.array2d[wp.int32],
+):
+    """Tiles of the horizontal grid that the beam's sections between the query heights touch (the
+    sections are linear in z, so the box of the two end sections bounds them all)."""
+    b = wp.tid()
+    if weight[b] <= 0.0:
+        empty_span(spans, b)
+        return
+    top = wp.max(base[b, 0][2], wp.max(base[b, 1][2], base[b, 2][2]))
+    bottom = top
+    for i in range(3):
+        bottom = wp.min(bottom, base[b, i][2] + end_m[b, i] * direction[b, i][2])
+    # Points up to shadow_slack beyond the end are lit: reach below the lowest end by twice that.
+    v_mean = (base[b, 0][2] + base[b, 1][2] + base[b, 2][2]) / 3.0
+    bottom = bottom - 2.0 * shadow_slack(safe_area(area_coef[b], bottom, v_mean))
+    hi_z = wp.min(top, query_hi_z)
+    lo_z = wp.max(bottom, query_lo_z)
+    if lo_z > hi_z:
+        empty_span(spans, b)
+        return
+    lo = wp.vec2(1.0e30)
+    hi = wp.vec2(-1.0e30)
+    for i in range(3):
+        for k in range(2):
+            z = lo_z
+            if k == 1:
+                z = hi_z
+            q = section_vertex(base[b, i], direction[b, i], z)
+            lo = wp.min(lo, q)
+            hi = wp.max(hi, q)
+    set_span(grid, lo, hi, spans, b)
+
+
+@wp.func
+def listed(
+    grid: TileGrid,
+    i: int,
+    j: int,
+    use_boxes: int,
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    b: int,
+) -> bool:
+    if use_boxes == 0:
+        return True
+    return tile_in_box(grid, i, j, box_axis[b], box_lo[b], box_hi[b])
+
+
+@wp.kernel
+def count_tiles(
+    grid: TileGrid,
+    spans: wp.array2d[wp.int32],
+    use_boxes: int,
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    tile_count: wp.array[wp.int32],
+):
+    """Tiles of each item's span (that its oriented box touches, with ``use_boxes``) count it."""
+    b = wp.tid()
+    for j in range(spans[b, 1], spans[b, 3] + 1):
+        for i in range(spans[b, 0], spans[b, 2] + 1):
+            if listed(grid, i, j, use_boxes, box_axis, box_lo, box_hi, b):
+                wp.atomic_add(tile_count, tile_index(grid, i, j), 1)
+
+
+@wp.kernel
+def scatter_tiles(
+    grid: TileGrid,
+    spans: wp.array2d[wp.int32],
+    use_boxes: int,
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    tile_start: wp.array[wp.int32],
+    tile_fill: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+):
+    b = wp.tid()
+    for j in range(spans[b, 1], spans[b, 3] + 1):
+        for i in range(spans[b, 0], spans[b, 2] + 1):
+            if listed(grid, i, j, use_boxes, box_axis, box_lo, box_hi, b):
+                t = tile_index(grid, i, j)
+                slot = tile_start[t] + wp.atomic_add(tile_fill, t, 1)
+                tile_items[slot] = b
+
+
+# --- queries ------------------------------------------------------------------------------------
+
+
+@wp.func
+def add_beam_irradiance(
+    out: wp.array2d[wp.float32],
+    point: int,
+    scale: float,
+    b: int,
+    s: BeamSample,
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    weight: wp.array[wp.float32],
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+):
+    """out[k, point] += scale · E_sun(k) w Σλ T exp(−c(k) ℓ) / |A| for the bands of b's group."""
+    g = b / beams_per_group
+    f = scale * weight[b] * s.transmit / s.area
+    for j in range(wavelengths_per_group):
+        k = g * wavelengths_per_group + j
+        out[k, point] = out[k, point] + f * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * s.path_m)
+
+
+@wp.kernel
+def point_irradiance(
+    grid: TileGrid,
+    tile_start: wp.array[wp.int32],
+    tile_count: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    extent_m: float,
+    periodic: int,
+    mesh: wp.uint64,
+    occluders: int,
+    points: wp.array[wp.vec3],
+    normals: wp.array[wp.vec3],
+    point_ids: wp.array[wp.int32],
+    out: wp.array2d[wp.float32],
+):
+    """Irradiance on the receiver at each point (K, P) [W m^-2 nm^-1] (points with id < 0 skipped):
+    the sum over the beams of the point's horizontal tile of ``E_h · |d·n| / |d_z|``."""
+    p_index = wp.tid()
+    for k in range(out.shape[0]):
+        out[k, p_index] = 0.0
+    if point_ids[p_index] < 0:
+        return
+    p = points[p_index]
+    n = normals[p_index]
+    t = tile_of(grid, xy(p))
+    if t < 0:
+        return
+    start = tile_start[t]
+    for item in range(tile_count[t]):
+        b = tile_items[start + item]
+        anchor = section_vertex(base[b, 0], direction[b, 0], p[2])
+        shift = period_shift(anchor, xy(p), extent_m, periodic)
+        q = p + wp.vec3(shift[0], shift[1], 0.0)
+        s = sample_beam(base, direction, transmit, end_m, area_coef, b, q)
+        if s.inside == 0:
+            continue
+        if not lit(mesh, occluders, s, q):
+            continue
+        cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
+        add_beam_irradiance(
+            out,
+            p_index,
+            cos_factor,
+            b,
+            s,
+            beams_per_group,
+            wavelengths_per_group,
+            weight,
+            sun_irradiance,
+            attenuation_per_m,
+        )
+
+
+@wp.func
+def clamped_sample(
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    b: int,
+    p: wp.vec3,
+) -> BeamSample:
+    """:func:`sample_beam` with barycentrics clamped to the triangle (for points on its edge)."""
+    v0 = base[b, 0]
+    v1 = base[b, 1]
+    v2 = base[b, 2]
+    d0 = direction[b, 0]
+    d1 = direction[b, 1]
+    d2 = direction[b, 2]
+    z = p[2]
+    lam = barycentrics(section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p))
+    lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
+    total = lam[0] + lam[1] + lam[2]
+    if total <= 0.0:
+        lam = wp.vec3(1.0 / 3.0)
+    else:
+        lam = lam / total
+    q = (
+        lam[0] * section_vertex(v0, d0, z)
+        + lam[1] * section_vertex(v1, d1, z)
+        + lam[2] * section_vertex(v2, d2, z)
+    )
+    out = sample_beam(base, direction, transmit, end_m, area_coef, b, wp.vec3(q[0], q[1], z))
+    if out.inside == 0:
+        out.inside = 1
+        out.lam = lam
+        out.path_m = (
+            lam[0] * (v0[2] - z) / -d0[2] + lam[1] * (v1[2] - z) / -d1[2] + lam[2] * (v2[2] - z) / -d2[2]
+        )
+        out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
+        out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
+        out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
+        out.beyond_end_m = beyond_end(base, direction, end_m, b, p)
+    return out
+
+
+@wp.kernel
+def flat_floor_texels(
+    grid: TileGrid,
+    tile_start: wp.array[wp.int32],
+    tile_count: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+    texels_per_tile: int,
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    extent_m: float,
+    periodic: int,
+    mesh: wp.uint64,
+    occluders: int,
+    floor_z: float,
+    out: wp.array2d[wp.float32],
+):
+    """Irradiance of each texel of a flat floor at z = floor_z (K, M·M) [W m^-2 nm^-1]: every beam
+    section is clipped exactly against the texel square and contributes its flux density at the
+    clipped piece's centroid times the piece's area share (exact for the barycentric-linear
+    transmittance, so flux is conserved to rounding)."""
+    ty, tx = wp.tid()
+    m = texels_per_tile * grid.nx
+    texel_m = extent_m / float(m)
+    point = ty * m + tx
+    for k in range(out.shape[0]):
+        out[k, point] = 0.0
+    t = tile_index(grid, tx / texels_per_tile, ty / texels_per_tile)
+    corner = wp.vec2(float(tx) * texel_m - 0.5 * extent_m, float(ty) * texel_m - 0.5 * extent_m)
+    centre = corner + wp.vec2(0.5 * texel_m)
+    start = tile_start[t]
+    for item in range(tile_count[t]):
+        b = tile_items[start + item]
+        q0 = section_vertex(base[b, 0], direction[b, 0], floor_z)
+        q1 = section_vertex(base[b, 1], direction[b, 1], floor_z)
+        q2 = section_vertex(base[b, 2], direction[b, 2], floor_z)
+        shift = period_shift(q0, centre, extent_m, periodic)
+        origin = corner + shift
+        px = vec8()
+        py = vec8()
+        px[0] = (q0[0] - origin[0]) / texel_m
+        py[0] = (q0[1] - origin[1]) / texel_m
+        px[1] = (q1[0] - origin[0]) / texel_m
+        py[1] = (q1[1] - origin[1]) / texel_m
+        px[2] = (q2[0] - origin[0]) / texel_m
+        py[2] = (q2[1] - origin[1]) / texel_m
+        cx, cy, cn = clip_to_slab(px, py, 3, 0, 0.0, 1.0)
+        if cn < 3:
+            continue
+        rx, ry, rn = clip_to_slab(cx, cy, cn, 1, 0.0, 1.0)
+        if rn < 3:
+            continue
+        share = polygon_area(rx, ry, rn)  # of the texel
+        if share <= 0.0:
+            continue
+        mx = float(0.0)
+        my = float(0.0)
+        for v in range(rn):
+            mx += rx[v]
+            my += ry[v]
+        # The vertex mean lies inside the convex piece; for a linear integrand the exact centroid
+        # matters, so use the area centroid.
+        ax = float(0.0)
+        ay = float(0.0)
+        a2 = float(0.0)
+        for v in range(rn):
+            vn = (v + 1) % rn
+            cr = rx[v] * ry[vn] - rx[vn] * ry[v]
+            a2 += cr
+            ax += (rx[v] + rx[vn]) * cr
+            ay += (ry[v] + ry[vn]) * cr
+        if wp.abs(a2) > 1.0e-12:
+            mx = ax / (3.0 * a2)
+            my = ay / (3.0 * a2)
+        else:
+            mx = mx / float(rn)
+            my = my / float(rn)
+        p = wp.vec3(origin[0] + mx * texel_m, origin[1] + my * texel_m, floor_z)
+        s = sample_beam(base, direction, transmit, end_m, area_coef, b, p)
+        lam_ok = s.inside
+        if lam_ok == 0:
+            # The centroid sits on the section's boundary to rounding: take the clamped barycentrics.
+            s = clamped_sample(base, direction, transmit, end_m, area_coef, b, p)
+        if not lit(mesh, occluders, s, p):
+            continue
+        add_beam_irradiance(
+            out,
+            point,
+            share,
+            b,
+            s,
+            beams_per_group,
+            wavelengths_per_group,
+            weight,
+            sun_irradiance,
+            attenuation_per_m,
+        )
+
+
+# --- volume caustics: scan planes -----------------------------------------------------------------
+
+NEAR_M = 1.0e-3
+"""Camera-space depth of the near plane that bounding volumes are clipped against [m]."""
+
+
+@wp.func
+def copy_offset(c: int, copies: int, extent_m: float) -> wp.vec3:
+    """Shift of periodic copy c of copies×copies (centred on the patch)."""
+    r = copies / 2
+    return wp.vec3(float(c % copies - r) * extent_m, float(c / copies - r) * extent_m, 0.0)
+
+
+@wp.func
+def screen_xy(cam: PinholeCamera, x: wp.vec3, depth: float) -> wp.vec2:
+    """Continuous pixel coordinates of x at camera-space depth ``depth`` (> 0), kept finite."""
+    v = x - cam.position
+    px = (wp.dot(v, cam.right) / (depth * cam.tan_half_fov * cam.aspect) + 1.0) * 0.5 * float(cam.width)
+    py = (1.0 - wp.dot(v, cam.up) / (depth * cam.tan_half_fov)) * 0.5 * float(cam.height)
+    return wp.vec2(wp.clamp(px, -1.0e6, 1.0e6), wp.clamp(py, -1.0e6, 1.0e6))
+
+
+@wp.func
+def perp(axis: wp.vec2) -> wp.vec2:
+    return wp.vec2(-axis[1], axis[0])
+
+
+@wp.func
+def in_frame(q: wp.vec2, axis: wp.vec2) -> wp.vec2:
+    """q in the frame (axis, perp(axis))."""
+    return wp.vec2(wp.dot(q, axis), wp.dot(q, perp(axis)))
+
+
+@wp.func
+def hull_edge(cam: PinholeCamera, a: wp.vec3, b: wp.vec3, axis: wp.vec2, lo: wp.vec2, hi: wp.vec2):
+    """Grow the box [lo, hi], in the screen frame (axis, perp(axis)), by the projection of the part
+    of segment ab in front of the near plane."""
+    za = wp.dot(a - cam.position, cam.forward)
+    zb = wp.dot(b - cam.position, cam.forward)
+    if za > NEAR_M:
+        q = in_frame(screen_xy(cam, a, za), axis)
+        lo = wp.min(lo, q)
+        hi = wp.max(hi, q)
+    if (za > NEAR_M) != (zb > NEAR_M):
+        x = a + ((NEAR_M - za) / (zb - za)) * (b - a)
+        q = in_frame(screen_xy(cam, x, NEAR_M), axis)
+        lo = wp.min(lo, q)
+        hi = wp.max(hi, q)
+    return lo, hi
+
+
+@wp.func
+def hull_box(
+    cam: PinholeCamera,
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    b: int,
+    shift: wp.vec3,
+    axis: wp.vec2,
+):
+    """The box, in the screen frame (axis, perp(axis)), of the beam's hull: the convex hull of its
+    base and end vertices (which holds its bilinear side patches), clipped to the near plane."""
+    lo = wp.vec2(1.0e30)
+    hi = wp.vec2(-1.0e30)
+    for i in range(3):
+        i1 = (i + 1) % 3
+        a = base[b, i] + shift
+        e = a + end_m[b, i] * direction[b, i]
+        a1 = base[b, i1] + shift
+        e1 = a1 + end_m[b, i1] * direction[b, i1]
+        lo, hi = hull_edge(cam, a, e, axis, lo, hi)
+        lo, hi = hull_edge(cam, a, a1, axis, lo, hi)
+        lo, hi = hull_edge(cam, e, e1, axis, lo, hi)
+    return lo, hi
+
+
+@wp.func
+def tile_in_box(grid: TileGrid, i: int, j: int, axis: wp.vec2, lo: wp.vec2, hi: wp.vec2) -> bool:
+    """Whether tile (i, j) overlaps the oriented box [lo, hi] in the frame (axis, perp(axis))
+    (separating axes of the box; the tile's own axes are covered by the span)."""
+    x0 = grid.origin[0] + float(i) * grid.size[0]
+    y0 = grid.origin[1] + float(j) * grid.size[1]
+    c0 = in_frame(wp.vec2(x0, y0), axis)
+    c1 = in_frame(wp.vec2(x0 + grid.size[0], y0), axis)
+    c2 = in_frame(wp.vec2(x0, y0 + grid.size[1]), axis)
+    c3 = in_frame(wp.vec2(x0 + grid.size[0], y0 + grid.size[1]), axis)
+    mn = wp.min(wp.min(c0, c1), wp.min(c2, c3))
+    mx = wp.max(wp.max(c0, c1), wp.max(c2, c3))
+    return not (mx[0] < lo[0] or mn[0] > hi[0] or mx[1] < lo[1] or mn[1] > hi[1])
+
+
+@wp.kernel
+def screen_spans(
+    grid: TileGrid,
+    cam: PinholeCamera,
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    copies: int,
+    extent_m: float,
+    spans: wp.array2d[wp.int32],
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    box_pixels: wp.array[wp.float32],
+):
+    """Screen bounds of each beam copy ``b · copies² + c``: the tile span of its hull's screen box
+    and an oriented box along the beam's projected axis (base centroid → end centroid) that the
+    tiles and pixels are then tested against. ``box_pixels``: pixels of the axis-aligned box."""
+    item = wp.tid()
+    per_beam = copies * copies
+    b = item / per_beam
+    box_axis[item] = wp.vec2(1.0, 0.0)
+    box_lo[item] = wp.vec2(1.0)
+    box_hi[item] = wp.vec2(-1.0)
+    box_pixels[item] = 0.0
+    if weight[b] <= 0.0:
+        empty_span(spans, item)
+        return
+    shift = copy_offset(item % per_beam, copies, extent_m)
+    lo, hi = hull_box(cam, base, direction, end_m, b, shift, wp.vec2(1.0, 0.0))
+    w = float(cam.width)
+    h = float(cam.height)
+    if lo[0] > hi[0] or hi[0] < 0.0 or hi[1] < 0.0 or lo[0] >= w or lo[1] >= h:
+        empty_span(spans, item)
+        return
+    lo = wp.max(lo, wp.vec2(0.0))
+    hi = wp.min(hi, wp.vec2(w - 1.0e-3, h - 1.0e-3))
+    box_pixels[item] = (wp.floor(hi[0]) - wp.floor(lo[0]) + 1.0) * (wp.floor(hi[1]) - wp.floor(lo[1]) + 1.0)
+    set_span(grid, lo, hi, spans, item)
+    # The beam's axis on the screen, when both centroids are in front of the camera.
+    axis = wp.vec2(1.0, 0.0)
+    cb = (base[b, 0] + base[b, 1] + base[b, 2]) / 3.0 + shift
+    ce = cb
+    for i in range(3):
+        ce += end_m[b, i] * direction[b, i] / 3.0
+    zb = wp.dot(cb - cam.position, cam.forward)
+    ze = wp.dot(ce - cam.position, cam.forward)
+    if zb > NEAR_M and ze > NEAR_M:
+        delta = screen_xy(cam, ce, ze) - screen_xy(cam, cb, zb)
+        if wp.length(delta) > 1.0:
+            axis = wp.normalize(delta)
+    olo, ohi = hull_box(cam, base, direction, end_m, b, shift, axis)
+    box_axis[item] = axis
+    box_lo[item] = olo
+    box_hi[item] = ohi
+
+
+@wp.func
+def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
+    """Clip [s_a, s_b] to the points where a + s k >= 0."""
+    if wp.abs(k) < 1.0e-20:
+        if a < 0.0:
+            return 1.0, 0.0
+        return s_a, s_b
+    root = -a / k
+    if k > 0.0:
+        return wp.max(s_a, root), s_b
+    return s_a, wp.min(s_b, root)
+
+
+@wp.func
+def scan_chord(
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    b: int,
+    shift: wp.vec3,
+    o: wp.vec3,
+    v: wp.vec3,
+):
+    """[s_a, s_b] of the ray o + s v inside beam b moved by ``shift``, by the scan plane (Ernst
+    2005, Liktor & Dachsbacher 2011): the plane through the ray most nearly perpendicular to the
+    beam cuts the three edge lines in a triangle; the ray's chord through it is clipped to the
+    beam's base and end planes. Returns s_a > s_b for a miss. Exact for a straight prism."""
+    v0 = base[b, 0] + shift
+    v1 = base[b, 1] + shift
+    v2 = base[b, 2] + shift
+    d0 = direction[b, 0]
+    d1 = direction[b, 1]
+    d2 = direction[b, 2]
+    dbar = wp.normalize(d0 + d1 + d2)
+    w = wp.cross(v, dbar)
+    s_a = float(-1.0e30)
+    s_b = float(1.0e30)
+    if wp.length(w) < PARALLEL_COS:
+        # Along the beam: inside iff the ray's point on the base plane is in the base triangle.
+        nb = wp.cross(v1 - v0, v2 - v0)
+        den = wp.dot(v, nb)
+        if wp.abs(den) < 1.0e-20:
+            return 1.0, 0.0
+        x = o + (wp.dot(v0 - o, nb) / den) * v
+        lam = barycentrics(xy(v0), xy(v1), xy(v2), xy(x))
+        if lam[0] < 0.0 or lam[1] < 0.0 or lam[2] < 0.0:
+            return 1.0, 0.0
+    else:
+        n_p = wp.normalize(wp.cross(v, w))
+        e2 = wp.cross(n_p, v)
+        den0 = wp.dot(d0, n_p)
+        den1 = wp.dot(d1, n_p)
+        den2 = wp.dot(d2, n_p)
+        if wp.abs(den0) < 1.0e-12 or wp.abs(den1) < 1.0e-12 or wp.abs(den2) < 1.0e-12:
+            return 1.0, 0.0
+        q0 = v0 + (wp.dot(o - v0, n_p) / den0) * d0 - o
+        q1 = v1 + (wp.dot(o - v1, n_p) / den1) * d1 - o
+        q2 = v2 + (wp.dot(o - v2, n_p) / den2) * d2 - o
+        a = wp.vec3(wp.dot(q0, v), wp.dot(q1, v), wp.dot(q2, v))
+        c = wp.vec3(wp.dot(q0, e2), wp.dot(q1, e2), wp.dot(q2, e2))
+        lo = float(1.0e30)
+        hi = float(-1.0e30)
+        for i in range(3):
+            j = (i + 1) % 3
+            if (c[i] >= 0.0) != (c[j] >= 0.0):
+                s = a[i] + (a[j] - a[i]) * c[i] / (c[i] - c[j])
+                lo = wp.min(lo, s)
+                hi = wp.max(hi, s)
+        if lo > hi:
+            return 1.0, 0.0
+        s_a = lo
+        s_b = hi
+    # Base plane: keep the side the beam goes to.
+    nb = wp.normalize(wp.cross(v1 - v0, v2 - v0))
+    if wp.dot(nb, dbar) < 0.0:
+        nb = -nb
+    s_a, s_b = clip_halfspace(s_a, s_b, wp.dot(o - v0, nb), wp.dot(v, nb))
+    e0, ne = end_plane(base, direction, end_m, b)
+    e0 = e0 + shift
+    s_a, s_b = clip_halfspace(s_a, s_b, -wp.dot(o - e0, ne), -wp.dot(v, ne))
+    return s_a, s_b
+
+
+@wp.kernel
+def scan_plane_radiance(
+    grid: TileGrid,
+    tile_start: wp.array[wp.int32],
+    tile_count: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+    tile_pixels: int,
+    cam: PinholeCamera,
+    depth: wp.array2d[wp.float32],
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    end_m: wp.array2d[wp.float32],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    copies: int,
+    extent_m: float,
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    scattering_per_m: wp.array[wp.float32],
+    phase_kind: int,
+    hg_g: float,
+    angles_rad: wp.array[wp.float32],
+    log_phase: wp.array[wp.float32],
+    cone_phase: float,
+    radiance: wp.array3d[wp.float32],
+    pairs: wp.array[wp.int32],
+):
+    """Single-scattered radiance of the beams along each pixel's ray (K, H, W) [W m^-2 sr^-1
+    nm^-1]: ``Σ Δs σ_s p(cos θ) E⊥(x_m) exp(−c (ℓ(x_m) + s_m))`` over the chords of the pixel tile's
+    beam copies, each chord cut at the receiver the pixel sees and split into up to
+    MAX_CHORD_PIECES midpoint pieces. ``pairs`` counts (pixel, beam copy) pairs: [0] in the tile
+    lists, [1] inside the oriented box (scan plane computed), [2] with a chord."""
+    j, i = wp.tid()
+    for k in range(radiance.shape[0]):
+        radiance[k, j, i] = 0.0
+    v = pixel_ray(cam, i, j)
+    o = cam.position
+    s_max = depth[j, i]
+    t = tile_index(grid, i / tile_pixels, j / tile_pixels)
+    start = tile_start[t]
+    per_beam = copies * copies
+    centre = wp.vec2(float(i) + 0.5, float(j) + 0.5)
+    count = tile_count[t]
+    wp.atomic_add(pairs, 0, count)
+    for item in range(count):
+        bc = tile_items[start + item]
+        q = in_frame(centre, box_axis[bc])
+        lo = box_lo[bc]
+        hi = box_hi[bc]
+        if q[0] < lo[0] - 1.0e-3 or q[0] > hi[0] + 1.0e-3 or q[1] < lo[1] - 1.0e-3 or q[1] > hi[1] + 1.0e-3:
+            continue  # the ray passes outside the beam's hull
+        wp.atomic_add(pairs, 1, 1)
+        b = bc / per_beam
+        shift = copy_offset(bc % per_beam, copies, extent_m)
+        s_a, s_b = scan_chord(base, direction, end_m, b, shift, o, v)
+        s_a = wp.max(s_a, 0.0)
+        s_b = wp.min(s_b, s_max)
+        if s_b <= s_a:
+            continue
+        wp.atomic_add(pairs, 2, 1)
+        ds = s_b - s_a
+        mid = o + (0.5 * (s_a + s_b)) * v - shift
+        width = wp.sqrt(safe_area(area_coef[b], mid[2], base[b, 0][2]))
+        pieces = wp.clamp(int(ds / wp.max(width, 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
+        piece = ds / float(pieces)
+        g = b / beams_per_group
+        for n in range(pieces):
+            s_m = s_a + (float(n) + 0.5) * piece
+            x = o + s_m * v - shift
+            smp = clamped_sample(base, direction, transmit, end_m, area_coef, b, x)
+            if smp.beyond_end_m > shadow_slack(smp.area):
+                continue
+            cos_theta = -wp.dot(smp.d, v)
+            phase = float(0.0)
+            if phase_kind == 0:
+                phase = henyey_greenstein(cos_theta, hg_g)
+            else:
+                phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+            e_perp = weight[b] * smp.transmit / (smp.area * wp.abs(smp.d[2]))
+            f = piece * phase * e_perp
+            for jj in range(wavelengths_per_group):
+                k = g * wavelengths_per_group + jj
+                c = attenuation_per_m[k]
+                radiance[k, j, i] = radiance[k, j, i] + f * scattering_per_m[k] * sun_irradiance[k] * wp.exp(
+                    -c * (smp.path_m + s_m)
+                )
+
+
+@wp.kernel
+def reduce_samples(
+    samples: wp.array2d[wp.float32],
+    sample_weight: wp.array[wp.float32],
+    per_texel: int,
+    out: wp.array2d[wp.float32],
+):
+    """out[k, texel] = Σ_s samples[k, texel · per_texel + s] · sample_weight[…] (the floor map of a
+    relief from its sub-texel samples)."""
+    k, texel = wp.tid()
+    total = float(0.0)
+    for s in range(per_texel):
+        idx = texel * per_texel + s
+        total += samples[k, idx] * sample_weight[idx]
+    out[k, texel] = total

@@ -1,0 +1,410 @@
+"""Beam caustics (host side): build the warped beam volumes, bin them into tiles, gather.
+
+See ``warpcaustics/kernels/beams.py`` for the method. Two tile grids are used: a horizontal grid
+over the patch for every query at a point (floor texels, receiver faces, the receiver points the
+camera sees), and the camera's screen tiles for the view rays of the volume caustics. The stage
+owns its buffers and reuses them from frame to frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config, FloorShape
+from warpcaustics.kernels import beams as beam_kernels
+from warpcaustics.receivers import Receivers, floor_relief_height
+from warpcaustics.water import Surface
+
+BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 4 + 12 + 16
+"""Per beam: base vertices, directions, transmittances, edge ends, weight, A(z), span."""
+
+FLOOR_SAMPLES = 4
+"""A relief floor's map averages FLOOR_SAMPLES² point samples per texel (DESIGN: ≥ 4×4)."""
+
+FACE_SUBDIVISIONS = 4
+"""Irradiance on a receiver face is the mean over the centroids of its FACE_SUBDIVISIONS²
+congruent sub-triangles (a face cut by a shadow or the water line is integrated to ~1/16)."""
+
+FACE_SAMPLES = FACE_SUBDIVISIONS**2
+
+SCREEN_TILE_PIXELS = 8
+"""Side of a screen tile of the volume-caustics rasteriser [pixels]."""
+
+
+def beam_count(n: int, groups: int, periodic: bool) -> int:
+    quads = n if periodic else n + 1
+    return groups * quads * quads * 2
+
+
+def texels_per_tile(m: int) -> int:
+    """Floor texels per side of a horizontal tile: the largest of 8, 4, 2, 1 that divides M (the
+    tiles must tile a periodic patch exactly)."""
+    return next(t for t in (8, 4, 2, 1) if m % t == 0)
+
+
+def beams_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int) -> int:
+    """Device memory of the beam stage, receivers and floor map included (not the tile lists, whose
+    length depends on the frame: about one entry per beam and tile it touches) [bytes]."""
+    m = cfg.caustics.map_resolution
+    beams = beam_count(n, groups, periodic)
+    relief = cfg.floor.shape is not FloorShape.FLAT
+    samples = m * m * FLOOR_SAMPLES**2 if relief else 0
+    return (
+        beams * BEAM_BYTES
+        + 2 * k * m * m * 4
+        + samples * (k * 4 + 12 + 12 + 4 + 4)
+        + face_count * (k * 4 + 64 + FACE_SAMPLES * (k * 4 + 28))
+        + n * n * 4
+        + 8 * beams
+    )
+
+
+class TileBins:
+    """Beams binned into the tiles of one grid: count → exclusive scan → scatter."""
+
+    def __init__(self, grid: beam_kernels.TileGrid, items: int, device: str):
+        self.grid = grid
+        self.device = device
+        tiles = grid.nx * grid.ny
+        self.spans = wp.empty((items, 4), dtype=wp.int32, device=device)
+        """Tile range (i0, j0, i1, j1) of each item; filled by the caller's span kernel."""
+        self.count = wp.zeros(tiles, dtype=wp.int32, device=device)
+        self.start = wp.zeros(tiles, dtype=wp.int32, device=device)
+        self.fill = wp.zeros(tiles, dtype=wp.int32, device=device)
+        self.items = wp.zeros(max(items, 1), dtype=wp.int32, device=device)
+        self.use_boxes = 0
+        self.box_axis = wp.zeros(1, dtype=wp.vec2, device=device)
+        self.box_lo = wp.zeros(1, dtype=wp.vec2, device=device)
+        self.box_hi = wp.zeros(1, dtype=wp.vec2, device=device)
+        self.entries = 0
+        """Entries in the tile lists after the last :meth:`bin`."""
+
+    def with_boxes(self) -> TileBins:
+        """Also test each tile against an oriented box per item (filled by the span kernel)."""
+        n = self.spans.shape[0]
+        self.use_boxes = 1
+        self.box_axis = wp.zeros(n, dtype=wp.vec2, device=self.device)
+        self.box_lo = wp.zeros(n, dtype=wp.vec2, device=self.device)
+        self.box_hi = wp.zeros(n, dtype=wp.vec2, device=self.device)
+        return self
+
+    def bin(self) -> None:
+        dev = self.device
+        n = self.spans.shape[0]
+        self.count.zero_()
+        boxes = [self.use_boxes, self.box_axis, self.box_lo, self.box_hi]
+        wp.launch(
+            beam_kernels.count_tiles,
+            dim=n,
+            inputs=[self.grid, self.spans, *boxes],
+            outputs=[self.count],
+            device=dev,
+        )
+        wp.utils.array_scan(self.count, self.start, inclusive=False)
+        total = int(self.start[-1:].numpy()[0] + self.count[-1:].numpy()[0])
+        self.entries = total
+        if total > self.items.shape[0]:
+            self.items = wp.zeros(int(total * 1.25) + 1, dtype=wp.int32, device=dev)
+        self.fill.zero_()
+        wp.launch(
+            beam_kernels.scatter_tiles,
+            dim=n,
+            inputs=[self.grid, self.spans, *boxes, self.start, self.fill],
+            outputs=[self.items],
+            device=dev,
+        )
+
+    def inputs(self) -> list:
+        return [self.grid, self.start, self.count, self.items]
+
+
+@dataclass
+class BeamStats:
+    beams: int
+    """Beams built (all index groups)."""
+    carrying: int
+    """Beams with flux (lit from the front, refracted downwards at some vertex)."""
+    dropped: int
+    """Beams dropped: facing away from the sun, total internal reflection or degenerate."""
+    tile_entries: int
+    """Entries of the floor's horizontal tile lists (beam × tile pairs)."""
+
+
+def _horizontal_grid(extent_m: float, m: int, periodic: bool) -> tuple[beam_kernels.TileGrid, int]:
+    tpt = texels_per_tile(m)
+    grid = beam_kernels.TileGrid()
+    grid.origin = wp.vec2(-0.5 * extent_m, -0.5 * extent_m)
+    size = extent_m * tpt / m
+    grid.size = wp.vec2(size, size)
+    grid.nx = m // tpt
+    grid.ny = m // tpt
+    grid.wrap = int(periodic)
+    return grid, tpt
+
+
+def floor_samples(cfg: Config, relief: np.ndarray | None, texel_area_m2: np.ndarray):
+    """Sample points, unit normals and weights of a relief floor's map: S×S per texel on a regular
+    horizontal grid, each weighted by its share of the texel's true area (dA_h / n_z / A_texel)."""
+    m = cfg.caustics.map_resolution
+    extent = cfg.water.extent_m
+    s = FLOOR_SAMPLES
+    texel = extent / m
+    u = (np.arange(m * s) + 0.5) * (texel / s) - 0.5 * extent
+    x, y = np.meshgrid(u, u)
+    z = floor_relief_height(cfg.floor, relief, extent, x, y)
+    h = 1e-4 * texel
+    dzdx = (
+        floor_relief_height(cfg.floor, relief, extent, x + h, y)
+        - floor_relief_height(cfg.floor, relief, extent, x - h, y)
+    ) / (2 * h)
+    dzdy = (
+        floor_relief_height(cfg.floor, relief, extent, x, y + h)
+        - floor_relief_height(cfg.floor, relief, extent, x, y - h)
+    ) / (2 * h)
+    normal = np.stack([-dzdx, -dzdy, np.ones_like(z)], axis=-1)
+    slope_area = np.linalg.norm(normal, axis=-1)  # dA_true / dA_h = 1 / n_z
+    normal /= slope_area[..., None]
+
+    # (M·S, M·S) → texel-major order: index (ty, tx, sy, sx).
+    def texel_major(a):
+        return a.reshape(m, s, m, s, *a.shape[2:]).swapaxes(1, 2).reshape(m * m * s * s, *a.shape[2:])
+
+    points = texel_major(np.stack([x, y, z], axis=-1))
+    normals = texel_major(normal)
+    weight = texel_major(slope_area) * (texel / s) ** 2 / np.repeat(texel_area_m2.ravel(), s * s)
+    return points, normals, weight
+
+
+def face_samples(receivers: Receivers) -> tuple[np.ndarray, np.ndarray]:
+    """Sample points and unit normals of the non-floor faces: the centroids of each face's
+    FACE_SUBDIVISIONS² congruent sub-triangles (equal areas), face-major."""
+    from warpcaustics.reference import subtriangle_centroids
+
+    tris = receivers.points[receivers.triangles[receivers.floor_face_count :]]
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    uv, _ = subtriangle_centroids(FACE_SUBDIVISIONS)
+    points = a[:, None] + uv[None, :, 0, None] * (b - a)[:, None] + uv[None, :, 1, None] * (c - a)[:, None]
+    cross = np.cross(b - a, c - a)
+    normal = cross / np.maximum(np.linalg.norm(cross, axis=-1, keepdims=True), 1e-30)
+    return points.reshape(-1, 3), np.repeat(normal, FACE_SAMPLES, axis=0)
+
+
+class BeamCaustics:
+    """Owns the beam stage's device buffers for one scene, reused from frame to frame."""
+
+    def __init__(
+        self,
+        cfg: Config,
+        receivers: Receivers,
+        n: int,
+        sun_irradiance: np.ndarray,
+        attenuation_per_m: np.ndarray,
+        group_ior: np.ndarray,
+        sun_dir: np.ndarray,
+        device: str,
+        *,
+        periodic: bool,
+        relief: np.ndarray | None,
+    ):
+        self.cfg = cfg
+        self.device = device
+        self.receivers = receivers
+        self.periodic = periodic
+        self.quads = n if periodic else n + 1
+        self.groups = len(group_ior)
+        self.ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
+        count = beam_count(n, self.groups, periodic)
+        self.beams_per_group = count // self.groups
+        k = len(sun_irradiance)
+        self.k = k
+        m = cfg.caustics.map_resolution
+        self.m = m
+        self.extent_m = float(cfg.water.extent_m)
+        self.sun_irradiance = wp.array(
+            np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device
+        )
+        self.attenuation_per_m = wp.array(
+            np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
+        )
+        self.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
+        self.plane_z = -cfg.floor.depth_m
+        self.base = wp.empty((count, 3), dtype=wp.vec3, device=device)
+        self.direction = wp.empty((count, 3), dtype=wp.vec3, device=device)
+        self.transmit = wp.empty((count, 3), dtype=wp.float32, device=device)
+        self.end_m = wp.empty((count, 3), dtype=wp.float32, device=device)
+        self.weight = wp.empty(count, dtype=wp.float32, device=device)
+        """A⊥ per beam [m²] (0: dropped)."""
+        self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
+        self.dropped = wp.zeros(1, dtype=wp.int32, device=device)
+        grid, self.texels_per_tile = _horizontal_grid(self.extent_m, m, periodic)
+        self.flat_floor = cfg.floor.shape is FloorShape.FLAT
+        self.floor_bins = TileBins(grid, count, device) if self.flat_floor else None
+        """Bins of the floor's sections only (flat floor: the clipped-texel map)."""
+        self.point_bins = TileBins(grid, count, device)
+        """Bins of each beam's whole length (receiver points at any height)."""
+        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
+        if not self.flat_floor:
+            points, normals, weights = floor_samples(cfg, relief, receivers.floor_texel_area_m2)
+            self.floor_points = wp.array(points.astype(np.float32), dtype=wp.vec3, device=device)
+            self.floor_normals = wp.array(normals.astype(np.float32), dtype=wp.vec3, device=device)
+            self.floor_weights = wp.array(weights.astype(np.float32), dtype=wp.float32, device=device)
+            self.floor_ids = wp.zeros(len(points), dtype=wp.int32, device=device)
+            self.floor_values = wp.empty((k, len(points)), dtype=wp.float32, device=device)
+        other = receivers.face_count - receivers.floor_face_count
+        self.face_count = other
+        self.face_flux = wp.zeros((max(other, 1), k), dtype=wp.float32, device=device)
+        """Flux on each non-floor face (F_other, K) [W nm^-1]."""
+        if other:
+            points, normals = face_samples(receivers)
+            self.face_points = wp.array(points.astype(np.float32), dtype=wp.vec3, device=device)
+            self.face_normals = wp.array(normals.astype(np.float32), dtype=wp.vec3, device=device)
+            self.face_ids = wp.zeros(len(points), dtype=wp.int32, device=device)
+            self.face_values = wp.empty((k, len(points)), dtype=wp.float32, device=device)
+        self.occluders = (
+            (not periodic) or bool(receivers.face_count - receivers.floor_face_count) or (not self.flat_floor)
+        )
+        """Whether anything but a flat floor can shadow a receiver point (then shadow rays decide)."""
+        lo, hi = receivers.bounds()
+        self.query_z = (float(lo[2]), float(hi[2]))
+
+    # --- per frame --------------------------------------------------------------------------
+
+    def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:
+        """Build and bin the beams; fill :attr:`irradiance` (floor) and :attr:`face_flux`."""
+        dev = self.device
+        self.dropped.zero_()
+        wp.launch(
+            beam_kernels.build_beams,
+            dim=(self.groups, self.quads, self.quads, 2),
+            inputs=[
+                surface.positions,
+                surface.normals,
+                visible,
+                self.ior,
+                self.sun_dir,
+                self.extent_m,
+                int(self.periodic),
+                float(self.plane_z),
+                self.receivers.mesh.id,
+                self.quads,
+            ],
+            outputs=[
+                self.base,
+                self.direction,
+                self.transmit,
+                self.end_m,
+                self.weight,
+                self.area_coef,
+                self.dropped,
+            ],
+            device=dev,
+        )
+        self._points_binned = False
+        k, m = self.k, self.m
+        if self.flat_floor:
+            self._bin_horizontal(self.floor_bins, self.plane_z, self.plane_z)
+            wp.launch(
+                beam_kernels.flat_floor_texels,
+                dim=(m, m),
+                inputs=[
+                    *self.floor_bins.inputs(),
+                    self.texels_per_tile,
+                    *self._beam_inputs(),
+                    float(self.plane_z),
+                ],
+                outputs=[self.irradiance.reshape((k, m * m))],
+                device=dev,
+            )
+        else:
+            self.points(self.floor_points, self.floor_normals, self.floor_ids, self.floor_values)
+            wp.launch(
+                beam_kernels.reduce_samples,
+                dim=(k, m * m),
+                inputs=[self.floor_values, self.floor_weights, FLOOR_SAMPLES**2],
+                outputs=[self.irradiance.reshape((k, m * m))],
+                device=dev,
+            )
+        if self.face_count:
+            self.points(self.face_points, self.face_normals, self.face_ids, self.face_values)
+        return self.irradiance
+
+    def _beam_inputs(self) -> list:
+        return [
+            self.base,
+            self.direction,
+            self.transmit,
+            self.end_m,
+            self.weight,
+            self.area_coef,
+            self.beams_per_group,
+            self.k // self.groups,
+            self.sun_irradiance,
+            self.attenuation_per_m,
+            self.extent_m,
+            int(self.periodic),
+            self.receivers.mesh.id,
+            int(self.occluders),
+        ]
+
+    def _bin_horizontal(self, bins: TileBins, lo_z: float, hi_z: float) -> None:
+        wp.launch(
+            beam_kernels.horizontal_spans,
+            dim=self.weight.shape[0],
+            inputs=[
+                bins.grid,
+                self.base,
+                self.direction,
+                self.end_m,
+                self.weight,
+                self.area_coef,
+                float(lo_z),
+                float(hi_z),
+            ],
+            outputs=[bins.spans],
+            device=self.device,
+        )
+        bins.bin()
+
+    def points(self, points: wp.array, normals: wp.array, ids: wp.array, out: wp.array2d) -> wp.array2d:
+        """Irradiance (K, P) [W m^-2 nm^-1] on receivers at ``points`` with unit ``normals`` (ids < 0
+        are skipped and get 0) from the last :meth:`run`'s beams."""
+        if not self._points_binned:  # binned on first use: a flat floor alone does not need it
+            self._bin_horizontal(self.point_bins, *self.query_z)
+            self._points_binned = True
+        wp.launch(
+            beam_kernels.point_irradiance,
+            dim=points.shape[0],
+            inputs=[*self.point_bins.inputs(), *self._beam_inputs(), points, normals, ids],
+            outputs=[out],
+            device=self.device,
+        )
+        return out
+
+    def face_flux_w_nm(self) -> np.ndarray:
+        """(F_other, K) flux on each non-floor face [W nm^-1]: mean sample irradiance × area."""
+        if not self.face_count:
+            return np.zeros((0, self.k))
+        values = self.face_values.numpy().astype(np.float64).reshape(self.k, self.face_count, FACE_SAMPLES)
+        area = self.receivers.face_area_m2[self.receivers.floor_face_count :]
+        return (values.mean(axis=2) * area[None, :]).T
+
+    def transmitted_flux(self) -> np.ndarray:
+        """(K,) flux the beams carry into the water before attenuation [W nm^-1] (float64)."""
+        w = self.weight.numpy().astype(np.float64)
+        t = self.transmit.numpy().astype(np.float64).mean(axis=1)
+        per_group = (w * t).reshape(self.groups, -1).sum(axis=1)
+        e = self.sun_irradiance.numpy().astype(np.float64)
+        return e * np.repeat(per_group, len(e) // self.groups)
+
+    def stats(self) -> BeamStats:
+        w = self.weight.numpy()
+        return BeamStats(
+            beams=len(w),
+            carrying=int(np.count_nonzero(w > 0)),
+            dropped=int(self.dropped.numpy()[0]),
+            tile_entries=(self.floor_bins or self.point_bins).entries,
+        )
