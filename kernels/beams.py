@@ -158,9 +158,12 @@ def build_beams(
     q2 = r2 - r0
     area_coef[b] = 0.5 * wp.vec3(cross2(u1, u2), cross2(u1, q2) + cross2(q1, u2), cross2(q1, q2))
     if w > 0.0:
-        end_m[b, 0] = edge_end(mesh, p0, d0, plane_z)
-        end_m[b, 1] = edge_end(mesh, p1, d1, plane_z)
-        end_m[b, 2] = edge_end(mesh, p2, d2, plane_z)
+        # Edges are traced from a hair inside the triangle: a wall vertex of a walled pool lies on
+        # the wall, and its edge running down the wall would otherwise stop there at once.
+        c = (p0 + p1 + p2) / 3.0
+        end_m[b, 0] = edge_end(mesh, p0 + 1.0e-5 * (c - p0), d0, plane_z)
+        end_m[b, 1] = edge_end(mesh, p1 + 1.0e-5 * (c - p1), d1, plane_z)
+        end_m[b, 2] = edge_end(mesh, p2 + 1.0e-5 * (c - p2), d2, plane_z)
     else:
         wp.atomic_add(dropped, 0, 1)
         end_m[b, 0] = 0.0

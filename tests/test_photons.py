@@ -246,14 +246,14 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool(pitch_deg, sees):
     np.testing.assert_allclose(measured, expected, rtol=0.04)
 
 
-def shaft_block(pitch_deg, sees, resolution=128):
+def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
     """(measured, expected): block means per band of the camera radiance in the shaft scene."""
     z_cam = -0.75
     x_cam = -1.5
     pitch = np.radians(pitch_deg)
     look_at = [x_cam + np.cos(pitch), 0.0, z_cam + np.sin(pitch)]
     overrides = {
-        **PHOTONS,
+        "caustics.method": method,
         "water.model": "pool",
         "water.resolution": resolution,
         "water.extent_m": 4.0,
