@@ -8,11 +8,12 @@ the analytic single-scattering integral of a lit pool.
 import numpy as np
 import pytest
 import warp as wp
-from conftest import fresnel_t_angles
 from test_photons import shaft_block
 
 import warpcaustics as wc
 from warpcaustics.kernels import beams as beam_kernels
+
+from conftest import fresnel_t_angles
 
 BEAMS = {"caustics.method": "beams"}
 
