@@ -482,21 +482,122 @@ def scatter_tiles(
 
 
 @wp.func
+def ring_density(
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    base: wp.array2d[wp.vec3],
+    g: int,
+    vx: int,
+    vy: int,
+    quads: int,
+    periodic: int,
+    z: float,
+) -> float:
+    """Wave-front density at lattice vertex (vx, vy) and height z: the flux weight of the (up to
+    six) carrying beams around the vertex over the area of their sections, Σ w / Σ |A(z)|."""
+    num = float(0.0)
+    den = float(0.0)
+    for r in range(6):
+        # The six triangles at a vertex: quads (0,0) both halves, (−1,0) half 0, (−1,−1) both,
+        # (0,−1) half 1 (see kernels/floor.py for the corner order of each half).
+        dx = int(0)
+        dy = int(0)
+        half = int(0)
+        if r == 1:
+            half = 1
+        elif r == 2:
+            dx = -1
+        elif r == 3:
+            dx = -1
+            dy = -1
+        elif r == 4:
+            dx = -1
+            dy = -1
+            half = 1
+        elif r == 5:
+            dy = -1
+            half = 1
+        qx = vx + dx
+        qy = vy + dy
+        if periodic != 0:
+            qx = (qx + quads) % quads
+            qy = (qy + quads) % quads
+        elif qx < 0 or qy < 0 or qx >= quads or qy >= quads:
+            continue
+        bb = ((g * quads + qy) * quads + qx) * 2 + half
+        if weight[bb] > 0.0:
+            num += weight[bb]
+            den += safe_area(area_coef[bb], z, (base[bb, 0][2] + base[bb, 1][2] + base[bb, 2][2]) / 3.0)
+    if den <= 0.0:
+        return 0.0
+    return num / den
+
+
+@wp.func
+def corner_offset(half: int, corner: int) -> wp.vec2i:
+    """Lattice offset (dx, dy) of a triangle corner in its quad (kernels/floor.py quad_corner)."""
+    if corner == 0:
+        return wp.vec2i(0, 0)
+    if half == 0:
+        if corner == 1:
+            return wp.vec2i(1, 0)
+        return wp.vec2i(1, 1)
+    if corner == 1:
+        return wp.vec2i(1, 1)
+    return wp.vec2i(0, 1)
+
+
+@wp.func
+def flux_density(
+    weight: wp.array[wp.float32],
+    transmit: wp.array2d[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    base: wp.array2d[wp.vec3],
+    b: int,
+    s: BeamSample,
+    z: float,
+    quads: int,
+    periodic: int,
+    smooth: int,
+) -> float:
+    """Horizontal flux density at a point of beam b per unit solar irradiance, before attenuation
+    [-]. ``smooth == 0``: the beam's own ``w Σλ_i T_i / |A(z)|`` (each section receives exactly its
+    flux). ``smooth == 1`` (Ernst et al. 2005's interpolation across beams): ``Σ λ_i T_i ρ_i`` with
+    ρ_i the wave-front density of the beams around vertex i at this height, so the irradiance is
+    continuous from beam to beam and no triangle edges show; flux is then conserved only to the
+    interpolation's accuracy (docs/validation.md)."""
+    if smooth == 0:
+        return weight[b] * s.transmit / s.area
+    per_group = quads * quads * 2
+    g = b / per_group
+    rest = b - g * per_group
+    half = rest % 2
+    qx = (rest / 2) % quads
+    qy = (rest / 2) / quads
+    total = float(0.0)
+    for c in range(3):
+        o = corner_offset(half, c)
+        rho = ring_density(weight, area_coef, base, g, qx + o[0], qy + o[1], quads, periodic, z)
+        total += s.lam[c] * transmit[b, c] * rho
+    return total
+
+
+@wp.func
 def add_beam_irradiance(
     out: wp.array2d[wp.float32],
     point: int,
     scale: float,
     b: int,
     s: BeamSample,
+    density: float,
     beams_per_group: int,
     wavelengths_per_group: int,
-    weight: wp.array[wp.float32],
     sun_irradiance: wp.array[wp.float32],
     attenuation_per_m: wp.array[wp.float32],
 ):
-    """out[k, point] += scale · E_sun(k) w Σλ T exp(−c(k) ℓ) / |A| for the bands of b's group."""
+    """out[k, point] += scale · E_sun(k) · density · exp(−c(k) ℓ) for the bands of b's group."""
     g = b / beams_per_group
-    f = scale * weight[b] * s.transmit / s.area
+    f = scale * density
     for j in range(wavelengths_per_group):
         k = g * wavelengths_per_group + j
         out[k, point] = out[k, point] + f * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * s.path_m)
@@ -522,6 +623,8 @@ def point_irradiance(
     periodic: int,
     mesh: wp.uint64,
     occluders: int,
+    quads: int,
+    smooth: int,
     points: wp.array[wp.vec3],
     normals: wp.array[wp.vec3],
     point_ids: wp.array[wp.int32],
@@ -557,9 +660,9 @@ def point_irradiance(
             cos_factor,
             b,
             s,
+            flux_density(weight, transmit, area_coef, base, b, s, q[2], quads, periodic, smooth),
             beams_per_group,
             wavelengths_per_group,
-            weight,
             sun_irradiance,
             attenuation_per_m,
         )
@@ -630,6 +733,8 @@ def flat_floor_texels(
     periodic: int,
     mesh: wp.uint64,
     occluders: int,
+    quads: int,
+    smooth: int,
     floor_z: float,
     out: wp.array2d[wp.float32],
 ):
@@ -707,9 +812,9 @@ def flat_floor_texels(
             share,
             b,
             s,
+            flux_density(weight, transmit, area_coef, base, b, s, floor_z, quads, periodic, smooth),
             beams_per_group,
             wavelengths_per_group,
-            weight,
             sun_irradiance,
             attenuation_per_m,
         )
@@ -965,6 +1070,8 @@ def scan_plane_radiance(
     area_coef: wp.array[wp.vec3],
     copies: int,
     extent_m: float,
+    quads: int,
+    smooth: int,
     box_axis: wp.array[wp.vec2],
     box_lo: wp.array[wp.vec2],
     box_hi: wp.array[wp.vec2],
@@ -996,6 +1103,9 @@ def scan_plane_radiance(
     start = tile_start[t]
     per_beam = copies * copies
     centre = wp.vec2(float(i) + 0.5, float(j) + 0.5)
+    lattice_wraps = int(0)
+    if copies > 1:
+        lattice_wraps = 1  # a periodic sea
     count = tile_count[t]
     wp.atomic_add(pairs, 0, count)
     for item in range(count):
@@ -1032,7 +1142,10 @@ def scan_plane_radiance(
                 phase = henyey_greenstein(cos_theta, hg_g)
             else:
                 phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
-            e_perp = weight[b] * smp.transmit / (smp.area * wp.abs(smp.d[2]))
+            density = flux_density(
+                weight, transmit, area_coef, base, b, smp, x[2], quads, lattice_wraps, smooth
+            )
+            e_perp = density / wp.abs(smp.d[2])
             f = piece * phase * e_perp
             for jj in range(wavelengths_per_group):
                 k = g * wavelengths_per_group + jj

@@ -317,3 +317,26 @@ def test_grazing_sun_folds_and_degenerate_beams_stay_finite():
     assert result.beam_stats["dropped"] > 0
     assert np.isfinite(result.floor_irradiance).all() and np.isfinite(result.camera_radiance).all()
     assert np.all(result.floor_flux_w_nm <= result.transmitted_flux_w_nm * (1 + 1e-4))
+
+
+def test_smooth_interpolation_hides_beam_edges_and_keeps_the_flux():
+    """A coarse ocean (32² surface) on a fine map (8 texels per cell), water_type none: the smooth
+    (Ernst) interpolation conserves the flux like the flat beams (the ring densities of the
+    vertices share each beam's flux exactly on a plane) and its largest jump between neighbouring
+    texels is under a fifth of the flat map's (measured: 0.42 vs 5.9 × the mean)."""
+    base = {
+        **BEAMS,
+        "water.resolution": 32,
+        "caustics.map_resolution": 256,
+        "optics.wavelengths": "rgb",
+        "optics.water_type": "none",
+    }
+    jumps = {}
+    for interp in ("flat", "smooth"):
+        r = wc.render(
+            wc.load_scene("configs/ocean.toml", {**base, "caustics.beam_interpolation": interp}), device="cpu"
+        )
+        np.testing.assert_allclose(r.floor_flux_w_nm, r.transmitted_flux_w_nm, rtol=1e-4)
+        f = r.floor_irradiance[1].astype(np.float64)
+        jumps[interp] = max(np.abs(np.diff(f, axis=0)).max(), np.abs(np.diff(f, axis=1)).max()) / f.mean()
+    assert jumps["smooth"] < 0.2 * jumps["flat"]

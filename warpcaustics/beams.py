@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config, FloorShape
+from warpcaustics.config import BeamInterpolation, Config, FloorShape
 from warpcaustics.kernels import beams as beam_kernels
 from warpcaustics.receivers import Receivers, floor_relief_height
 from warpcaustics.water import Surface
@@ -230,6 +230,7 @@ class BeamCaustics:
             np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
         )
         self.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
+        self.smooth = cfg.caustics.beam_interpolation is BeamInterpolation.SMOOTH
         self.plane_z = -cfg.floor.depth_m
         self.base = wp.empty((count, 3), dtype=wp.vec3, device=device)
         self.direction = wp.empty((count, 3), dtype=wp.vec3, device=device)
@@ -348,6 +349,8 @@ class BeamCaustics:
             int(self.periodic),
             self.receivers.mesh.id,
             int(self.occluders),
+            self.quads,
+            int(self.smooth),
         ]
 
     def _bin_horizontal(self, bins: TileBins, lo_z: float, hi_z: float) -> None:

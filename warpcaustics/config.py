@@ -114,6 +114,11 @@ class FloorShape(str, enum.Enum):
     FILE = "file"
 
 
+class BeamInterpolation(str, enum.Enum):
+    SMOOTH = "smooth"
+    FLAT = "flat"
+
+
 class DeviceChoice(str, enum.Enum):
     AUTO = "auto"
     CPU = "cpu"
@@ -326,6 +331,11 @@ class CausticsConfig:
     """Iterations k of the ``newton`` intersection [-]."""
     newton_buffer_resolution: int = field(default=1024, metadata=_range(16, 16384))
     """Texels per side of the ``newton`` receiver-position buffer seen from the sun [-]."""
+    beam_interpolation: BeamInterpolation = BeamInterpolation.FLAT
+    """How ``beams`` spread a beam's light over its section: ``flat`` (each beam's own flux over its
+    own section, as the flux-ratio map; triangle facets can show in close-ups) or ``smooth`` (after
+    Ernst et al. 2005: per-vertex wave-front densities of the surrounding beams interpolated across
+    each beam, continuous from beam to beam but blurred over about two surface cells)."""
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""
