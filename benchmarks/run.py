@@ -166,6 +166,9 @@ def main(argv: list[str] | None = None) -> int:
     # Photon splatting vs its numpy twin, both in one child process (benchmarks/photons.py).
     photons = _in_child("run", args.quick, args.device, module="photons")
 
+    # The beam rasteriser vs its numpy twins, in one child process (benchmarks/beams.py).
+    beams = _in_child("run", args.quick, args.device, module="beams")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -185,6 +188,7 @@ def main(argv: list[str] | None = None) -> int:
         "steps": steps,
         "bins": bins_rows,
         "photons": photons,
+        "beams": beams,
         "sweep": sweeps,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)

@@ -111,6 +111,7 @@ def build_beams(
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
     end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     weight: wp.array[wp.float32],
     area_coef: wp.array[wp.vec3],
     dropped: wp.array[wp.int32],
@@ -169,6 +170,9 @@ def build_beams(
         end_m[b, 0] = 0.0
         end_m[b, 1] = 0.0
         end_m[b, 2] = 0.0
+    e0, ne = end_plane(base, direction, end_m, b)
+    ends[b, 0] = e0
+    ends[b, 1] = ne
     weight[b] = w
 
 
@@ -227,7 +231,7 @@ def sample_beam(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     area_coef: wp.array[wp.vec3],
     b: int,
     p: wp.vec3,
@@ -257,7 +261,7 @@ def sample_beam(
     out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
     out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
     out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
-    out.beyond_end_m = beyond_end(base, direction, end_m, b, p)
+    out.beyond_end_m = beyond_end(ends, b, p)
     return out
 
 
@@ -281,15 +285,9 @@ def end_plane(
 
 
 @wp.func
-def beyond_end(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    end_m: wp.array2d[wp.float32],
-    b: int,
-    p: wp.vec3,
-) -> float:
-    e0, nrm = end_plane(base, direction, end_m, b)
-    return wp.dot(p - e0, nrm)
+def beyond_end(ends: wp.array2d[wp.vec3], b: int, p: wp.vec3) -> float:
+    """How far p lies beyond the beam's end plane (``ends[b] = (point, unit normal)``) [m]."""
+    return wp.dot(p - ends[b, 0], ends[b, 1])
 
 
 @wp.func
@@ -612,7 +610,7 @@ def point_irradiance(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     weight: wp.array[wp.float32],
     area_coef: wp.array[wp.vec3],
     beams_per_group: int,
@@ -648,7 +646,7 @@ def point_irradiance(
         anchor = section_vertex(base[b, 0], direction[b, 0], p[2])
         shift = period_shift(anchor, xy(p), extent_m, periodic)
         q = p + wp.vec3(shift[0], shift[1], 0.0)
-        s = sample_beam(base, direction, transmit, end_m, area_coef, b, q)
+        s = sample_beam(base, direction, transmit, ends, area_coef, b, q)
         if s.inside == 0:
             continue
         if not lit(mesh, occluders, s, q):
@@ -673,12 +671,14 @@ def clamped_sample(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     area_coef: wp.array[wp.vec3],
     b: int,
     p: wp.vec3,
 ) -> BeamSample:
-    """:func:`sample_beam` with barycentrics clamped to the triangle (for points on its edge)."""
+    """:func:`sample_beam` with the barycentrics clamped to the triangle and renormalised: for points
+    on a section's edge to rounding, and for scan-plane samples of a warped beam, whose chord
+    follows the edge lines' plane cut rather than the horizontal sections exactly."""
     v0 = base[b, 0]
     v1 = base[b, 1]
     v2 = base[b, 2]
@@ -693,22 +693,14 @@ def clamped_sample(
         lam = wp.vec3(1.0 / 3.0)
     else:
         lam = lam / total
-    q = (
-        lam[0] * section_vertex(v0, d0, z)
-        + lam[1] * section_vertex(v1, d1, z)
-        + lam[2] * section_vertex(v2, d2, z)
-    )
-    out = sample_beam(base, direction, transmit, end_m, area_coef, b, wp.vec3(q[0], q[1], z))
-    if out.inside == 0:
-        out.inside = 1
-        out.lam = lam
-        out.path_m = (
-            lam[0] * (v0[2] - z) / -d0[2] + lam[1] * (v1[2] - z) / -d1[2] + lam[2] * (v2[2] - z) / -d2[2]
-        )
-        out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
-        out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
-        out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
-        out.beyond_end_m = beyond_end(base, direction, end_m, b, p)
+    out = BeamSample()
+    out.inside = 1
+    out.lam = lam
+    out.path_m = lam[0] * (v0[2] - z) / -d0[2] + lam[1] * (v1[2] - z) / -d1[2] + lam[2] * (v2[2] - z) / -d2[2]
+    out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
+    out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
+    out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
+    out.beyond_end_m = beyond_end(ends, b, p)
     return out
 
 
@@ -722,7 +714,7 @@ def flat_floor_texels(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     weight: wp.array[wp.float32],
     area_coef: wp.array[wp.vec3],
     beams_per_group: int,
@@ -799,11 +791,11 @@ def flat_floor_texels(
             mx = mx / float(rn)
             my = my / float(rn)
         p = wp.vec3(origin[0] + mx * texel_m, origin[1] + my * texel_m, floor_z)
-        s = sample_beam(base, direction, transmit, end_m, area_coef, b, p)
+        s = sample_beam(base, direction, transmit, ends, area_coef, b, p)
         lam_ok = s.inside
         if lam_ok == 0:
             # The centroid sits on the section's boundary to rounding: take the clamped barycentrics.
-            s = clamped_sample(base, direction, transmit, end_m, area_coef, b, p)
+            s = clamped_sample(base, direction, transmit, ends, area_coef, b, p)
         if not lit(mesh, occluders, s, p):
             continue
         add_beam_irradiance(
@@ -987,7 +979,7 @@ def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
 def scan_chord(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     b: int,
     shift: wp.vec3,
     o: wp.vec3,
@@ -1047,7 +1039,8 @@ def scan_chord(
     if wp.dot(nb, dbar) < 0.0:
         nb = -nb
     s_a, s_b = clip_halfspace(s_a, s_b, wp.dot(o - v0, nb), wp.dot(v, nb))
-    e0, ne = end_plane(base, direction, end_m, b)
+    e0 = ends[b, 0]
+    ne = ends[b, 1]
     e0 = e0 + shift
     s_a, s_b = clip_halfspace(s_a, s_b, -wp.dot(o - e0, ne), -wp.dot(v, ne))
     return s_a, s_b
@@ -1065,7 +1058,7 @@ def scan_plane_radiance(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
-    end_m: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
     weight: wp.array[wp.float32],
     area_coef: wp.array[wp.vec3],
     copies: int,
@@ -1107,7 +1100,8 @@ def scan_plane_radiance(
     if copies > 1:
         lattice_wraps = 1  # a periodic sea
     count = tile_count[t]
-    wp.atomic_add(pairs, 0, count)
+    boxed = int(0)
+    chords = int(0)
     for item in range(count):
         bc = tile_items[start + item]
         q = in_frame(centre, box_axis[bc])
@@ -1115,15 +1109,15 @@ def scan_plane_radiance(
         hi = box_hi[bc]
         if q[0] < lo[0] - 1.0e-3 or q[0] > hi[0] + 1.0e-3 or q[1] < lo[1] - 1.0e-3 or q[1] > hi[1] + 1.0e-3:
             continue  # the ray passes outside the beam's hull
-        wp.atomic_add(pairs, 1, 1)
+        boxed += 1
         b = bc / per_beam
         shift = copy_offset(bc % per_beam, copies, extent_m)
-        s_a, s_b = scan_chord(base, direction, end_m, b, shift, o, v)
+        s_a, s_b = scan_chord(base, direction, ends, b, shift, o, v)
         s_a = wp.max(s_a, 0.0)
         s_b = wp.min(s_b, s_max)
         if s_b <= s_a:
             continue
-        wp.atomic_add(pairs, 2, 1)
+        chords += 1
         ds = s_b - s_a
         mid = o + (0.5 * (s_a + s_b)) * v - shift
         width = wp.sqrt(safe_area(area_coef[b], mid[2], base[b, 0][2]))
@@ -1133,7 +1127,7 @@ def scan_plane_radiance(
         for n in range(pieces):
             s_m = s_a + (float(n) + 0.5) * piece
             x = o + s_m * v - shift
-            smp = clamped_sample(base, direction, transmit, end_m, area_coef, b, x)
+            smp = clamped_sample(base, direction, transmit, ends, area_coef, b, x)
             if smp.beyond_end_m > shadow_slack(smp.area):
                 continue
             cos_theta = -wp.dot(smp.d, v)
@@ -1153,6 +1147,9 @@ def scan_plane_radiance(
                 radiance[k, j, i] = radiance[k, j, i] + f * scattering_per_m[k] * sun_irradiance[k] * wp.exp(
                     -c * (smp.path_m + s_m)
                 )
+    wp.atomic_add(pairs, 0, count)
+    wp.atomic_add(pairs, 1, boxed)
+    wp.atomic_add(pairs, 2, chords)
 
 
 @wp.kernel

@@ -157,10 +157,14 @@ def _chords(
     end_m: wp.array2d[wp.float32],
     origins: wp.array[wp.vec3],
     rays: wp.array[wp.vec3],
+    ends: wp.array2d[wp.vec3],
     out: wp.array[wp.vec2],
 ):
     i = wp.tid()
-    a, b = beam_kernels.scan_chord(base, direction, end_m, 0, wp.vec3(0.0), origins[i], rays[i])
+    e0, ne = beam_kernels.end_plane(base, direction, end_m, i)
+    ends[i, 0] = e0
+    ends[i, 1] = ne
+    a, b = beam_kernels.scan_chord(base, direction, ends, i, wp.vec3(0.0), origins[i], rays[i])
     out[i] = wp.vec2(a, b)
 
 
@@ -204,18 +208,19 @@ def test_scan_plane_chord_of_a_straight_prism_is_exact():
     # Rays along the beam: one inside the base triangle, one outside.
     origins = np.vstack([origins, v.mean(axis=0) - 3.0 * d, v[0] - 3.0 * d + np.array([-0.2, -0.2, 0.0])])
     rays = np.vstack([rays, d, d])
-    out = wp.zeros(len(rays), dtype=wp.vec2, device="cpu")
+    n = len(rays)
+    out = wp.zeros(n, dtype=wp.vec2, device="cpu")
     wp.launch(
         _chords,
         dim=len(rays),
         inputs=[
-            wp.array(v[None].astype(np.float32), dtype=wp.vec3, device="cpu"),
-            wp.array(np.repeat(d[None, None], 3, axis=1).astype(np.float32), dtype=wp.vec3, device="cpu"),
-            wp.array(ends[None].astype(np.float32), dtype=wp.float32, device="cpu"),
+            wp.array(np.repeat(v[None], n, axis=0).astype(np.float32), dtype=wp.vec3, device="cpu"),
+            wp.array(np.broadcast_to(d, (n, 3, 3)).astype(np.float32), dtype=wp.vec3, device="cpu"),
+            wp.array(np.repeat(ends[None], n, axis=0).astype(np.float32), dtype=wp.float32, device="cpu"),
             wp.array(origins.astype(np.float32), dtype=wp.vec3, device="cpu"),
             wp.array(rays.astype(np.float32), dtype=wp.vec3, device="cpu"),
         ],
-        outputs=[out],
+        outputs=[wp.zeros((n, 2), dtype=wp.vec3, device="cpu"), out],
         device="cpu",
     )
     got = out.numpy().astype(np.float64)

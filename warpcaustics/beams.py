@@ -18,8 +18,8 @@ from warpcaustics.kernels import beams as beam_kernels
 from warpcaustics.receivers import Receivers, floor_relief_height
 from warpcaustics.water import Surface
 
-BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 4 + 12 + 16
-"""Per beam: base vertices, directions, transmittances, edge ends, weight, A(z), span."""
+BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 2 * 12 + 4 + 12 + 16
+"""Per beam: base vertices, directions, transmittances, edge ends, end plane, weight, A(z), span."""
 
 FLOOR_SAMPLES = 4
 """A relief floor's map averages FLOOR_SAMPLES² point samples per texel (DESIGN: ≥ 4×4)."""
@@ -236,6 +236,8 @@ class BeamCaustics:
         self.direction = wp.empty((count, 3), dtype=wp.vec3, device=device)
         self.transmit = wp.empty((count, 3), dtype=wp.float32, device=device)
         self.end_m = wp.empty((count, 3), dtype=wp.float32, device=device)
+        self.ends = wp.empty((count, 2), dtype=wp.vec3, device=device)
+        """End plane of each beam: (point, unit normal along the beam)."""
         self.weight = wp.empty(count, dtype=wp.float32, device=device)
         """A⊥ per beam [m²] (0: dropped)."""
         self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
@@ -298,6 +300,7 @@ class BeamCaustics:
                 self.direction,
                 self.transmit,
                 self.end_m,
+                self.ends,
                 self.weight,
                 self.area_coef,
                 self.dropped,
@@ -338,7 +341,7 @@ class BeamCaustics:
             self.base,
             self.direction,
             self.transmit,
-            self.end_m,
+            self.ends,
             self.weight,
             self.area_coef,
             self.beams_per_group,

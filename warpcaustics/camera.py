@@ -254,7 +254,7 @@ class UnderwaterCamera:
                 beam_kernels.scan_plane_radiance,
                 dim=(h, w),
                 inputs=[*bins.inputs(), SCREEN_TILE_PIXELS, self.cam, self.depth, beams.base, beams.direction,
-                        beams.transmit, beams.end_m, beams.weight, beams.area_coef, copies, beams.extent_m,
+                        beams.transmit, beams.ends, beams.weight, beams.area_coef, copies, beams.extent_m,
                         beams.quads, int(beams.smooth),
                         bins.box_axis, bins.box_lo, bins.box_hi, beams.beams_per_group, k // beams.groups,
                         beams.sun_irradiance, beams.attenuation_per_m, self.scattering_per_m, ph.kind, ph.g,
