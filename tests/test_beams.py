@@ -345,3 +345,38 @@ def test_smooth_interpolation_hides_beam_edges_and_keeps_the_flux():
         f = r.floor_irradiance[1].astype(np.float64)
         jumps[interp] = max(np.abs(np.diff(f, axis=0)).max(), np.abs(np.diff(f, axis=1)).max()) / f.mean()
     assert jumps["smooth"] < 0.2 * jumps["flat"]
+
+
+def test_both_methods_write_both_results_and_their_difference(tmp_path):
+    """``caustics.method = "both"``: the beams' result carries the photons' as its comparison; the
+    frame is saved with the photons' files and the beams − photons floor map, and run.json records
+    their relative L1 and the photons' flux."""
+    import json
+
+    import OpenEXR
+
+    from warpcaustics.output import spectral_channel_name
+
+    overrides = {
+        "caustics.method": "both",
+        "water.resolution": 32,
+        "caustics.map_resolution": 32,
+        "optics.wavelengths": "rgb",
+        "camera.width": 32,
+        "camera.height": 24,
+    }
+    result = wc.render(wc.load_scene("configs/ocean_floor.toml", overrides), device="cpu")
+    other = result.comparison
+    assert result.beam_stats is not None and other is not None and other.photon_stats is not None
+    assert other.camera_radiance.shape == result.camera_radiance.shape
+    paths = result.save(tmp_path)
+    for key in ("exr", "photons_exr", "photons_png", "camera_photons_exr", "difference_exr"):
+        assert paths[key].exists(), key
+    with OpenEXR.File(str(paths["difference_exr"])) as exr:
+        band = np.asarray(exr.channels()[spectral_channel_name(result.wavelengths_nm[1])].pixels)
+    expected = (result.floor_irradiance[1] - other.floor_irradiance[1])[::-1]
+    np.testing.assert_allclose(band, expected, atol=1e-6 * np.abs(result.floor_irradiance).max())
+    entry = json.loads((tmp_path / "run.json").read_text())["frames"][0]["comparison"]
+    l1 = np.abs(result.floor_irradiance - other.floor_irradiance).sum() / np.abs(other.floor_irradiance).sum()
+    assert entry["floor_relative_l1_beams_vs_photons"] == pytest.approx(l1, rel=1e-5)
+    assert "frame_0000_beams_minus_photons.exr" in entry["files"]

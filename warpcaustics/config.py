@@ -95,11 +95,12 @@ class CausticsMethod(str, enum.Enum):
     FLUXRATIO = "fluxratio"
     PHOTONS = "photons"
     BEAMS = "beams"
+    BOTH = "both"
 
     @property
     def uses_receivers(self) -> bool:
         """Photons and beams light every receiver (relief, walls, meshes) and feed the camera."""
-        return self in (CausticsMethod.PHOTONS, CausticsMethod.BEAMS)
+        return self in (CausticsMethod.PHOTONS, CausticsMethod.BEAMS, CausticsMethod.BOTH)
 
 
 class Intersection(str, enum.Enum):
@@ -127,7 +128,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("both", "sunmap", "eikonal", "wave3d"),
+    "caustics.method": ("sunmap", "eikonal", "wave3d"),
     "water.model": ("procedural",),
 }
 
@@ -319,7 +320,8 @@ class CausticsConfig:
     """Caustics method: ``fluxratio`` (refracted triangle footprints on a flat floor),
     ``photons`` (photon splatting onto every receiver, Shah et al. 2007) or ``beams`` (warped beam
     volumes through a tile-binned rasteriser onto every receiver, with volume caustics in the
-    camera; Ernst et al. 2005, Liktor & Dachsbacher 2011)."""
+    camera; Ernst et al. 2005, Liktor & Dachsbacher 2011) or ``both`` (beams and photons on the same
+    frame, both saved with the difference of their floor maps)."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
     intersection: Intersection = Intersection.EXACT

@@ -112,6 +112,27 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
             "warpcaustics.quantity": "spectral radiance at the camera"}, RADIANCE_UNITS)
     if result.scene.config.output.vtk:
         paths.update(write_vtk(result, out_dir, frame=frame))
+    if result.comparison is not None:  # "both": the photons' frame and the beams − photons floor map
+        other = result.comparison
+        stem = f"frame_{frame:04d}_photons"
+        paths["photons_exr"], paths["photons_png"] = out_dir / f"{stem}.exr", out_dir / f"{stem}.png"
+        header = {"warpcaustics.quantity": "floor spectral irradiance (photons)",
+                  "warpcaustics.extent_m": f"{result.extent_m:g}"}
+        _write_spectral_image(other, other.floor_irradiance[:, ::-1, :], paths["photons_exr"],
+                              paths["photons_png"], header, EMISSIVE_UNITS)
+        if other.camera_radiance is not None:
+            stem = f"camera_{frame:04d}_photons"
+            paths["camera_photons_exr"] = out_dir / f"{stem}.exr"
+            paths["camera_photons_png"] = out_dir / f"{stem}.png"
+            header = {"warpcaustics.quantity": "spectral radiance at the camera (photons)"}
+            _write_spectral_image(other, other.camera_radiance, paths["camera_photons_exr"],
+                                  paths["camera_photons_png"], header, RADIANCE_UNITS)
+        paths["difference_exr"] = out_dir / f"frame_{frame:04d}_beams_minus_photons.exr"
+        difference = (result.floor_irradiance - other.floor_irradiance)[:, ::-1, :]
+        write_exr(paths["difference_exr"], np.zeros(difference.shape[1:] + (3,), np.float32), difference,
+                  result.wavelengths_nm, {"warpcaustics.quantity": "floor spectral irradiance, beams minus "
+                                          "photons (R, G, B are zero: a signed difference has no colour)",
+                                          "warpcaustics.time_s": f"{result.time_s:g}"})
     return paths
 
 
@@ -137,7 +158,7 @@ def write_vtk(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     - ``surface_NNNN.vts``: the water surface's N×N vertices [m] with point data ``normal``;
     - ``floor_NNNN.vti``: the floor map as image cells over the patch at the floor's rest depth,
       cell data ``irradiance_<λ>nm`` [W m^-2 nm^-1] per band;
-    - ``receivers_NNNN.vtp`` (photons): the receiver meshes other than the floor, cell data
+    - ``receivers_NNNN.vtp`` (photons, beams): the receiver meshes other than the floor, cell data
       ``irradiance_<λ>nm`` per band and ``receiver`` (1 = walls, 2 + i = ``receivers[i]``).
     """
     import warnings
@@ -199,6 +220,20 @@ def _write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, heade
     write_png(png, colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))
 
 
+def comparison_entry(frame: int, r) -> dict:
+    """``both``: the photons' files, flux and stats beside the beams', and how far the maps differ."""
+    other = r.comparison
+    a = r.floor_irradiance.astype(np.float64)
+    b = other.floor_irradiance.astype(np.float64)
+    files = [f"frame_{frame:04d}_photons.exr", f"frame_{frame:04d}_photons.png",
+             f"frame_{frame:04d}_beams_minus_photons.exr"]
+    if other.camera_radiance is not None:
+        files += [f"camera_{frame:04d}_photons.exr", f"camera_{frame:04d}_photons.png"]
+    return {"method": "photons", "files": files, "floor_flux_w_nm": other.floor_flux_w_nm,
+            "transmitted_flux_w_nm": other.transmitted_flux_w_nm, "photons": other.photon_stats,
+            "floor_relative_l1_beams_vs_photons": float(np.abs(a - b).sum() / max(np.abs(b).sum(), 1e-300))}
+
+
 def frame_entry(frame: int, r) -> dict:
     """run.json's record of one frame (JSON-ready: arrays become lists)."""
     entry = {
@@ -213,6 +248,7 @@ def frame_entry(frame: int, r) -> dict:
         "fold_fraction": r.fold_fraction,
         **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
         **({"beams": r.beam_stats} if r.beam_stats is not None else {}),
+        **({"comparison": comparison_entry(frame, r)} if r.comparison is not None else {}),
     }
     return json.loads(json.dumps(entry, default=_jsonable))
 

@@ -75,6 +75,9 @@ class RenderResult:
     """``photons``: photons emitted, carrying flux, and landed on a receiver."""
     beam_stats: dict[str, int] | None = None
     """``beams``: beams built, carrying flux, dropped, and tile-list entries."""
+    comparison: RenderResult | None = None
+    """``both``: the photon method's result of the same frame (this result is the beams'); saved
+    beside it with the difference of the floor maps."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -145,10 +148,11 @@ def scene_bytes(scene: Scene) -> int:
         periodic = not cfg.water.walled
         faces = receiver_face_estimate(scene, periodic)
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
-        if cfg.caustics.method is CausticsMethod.BEAMS:
-            stage = beams.beams_bytes(cfg, n, k, groups, periodic, faces)
-        else:
-            stage = photons.photons_bytes(cfg, n, k, groups, periodic, faces)
+        stage = 0
+        if cfg.caustics.method in (CausticsMethod.BEAMS, CausticsMethod.BOTH):
+            stage += beams.beams_bytes(cfg, n, k, groups, periodic, faces)
+        if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
+            stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
         return water_bytes(cfg, n) + stage + cam
     return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
 
@@ -210,16 +214,14 @@ class Renderer:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
                                            water_top_z=_WALL_TOP_M, base_dir=scene.base_dir)
-                stage = (beams.BeamCaustics if cfg.caustics.method is CausticsMethod.BEAMS
-                         else photons.PhotonCaustics)
-                extra = {"relief": scene.floor_relief} if stage is beams.BeamCaustics else {}
-                built = stage(cfg, self.receivers, n, self.sun_irradiance, self.attenuation_per_m,
-                              self.group_ior, scene.sun_direction, self.device,
-                              periodic=self.water.periodic, **extra)
-                if stage is beams.BeamCaustics:
-                    self.beams = built
-                else:
-                    self.photons = built
+                method = cfg.caustics.method
+                args = (cfg, self.receivers, n, self.sun_irradiance, self.attenuation_per_m, self.group_ior,
+                        scene.sun_direction, self.device)
+                if method in (CausticsMethod.BEAMS, CausticsMethod.BOTH):
+                    self.beams = beams.BeamCaustics(*args, periodic=self.water.periodic,
+                                                    relief=scene.floor_relief)
+                if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
+                    self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic)
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
                     photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, scene.sun_direction,
@@ -260,8 +262,8 @@ class Renderer:
         with watch.stage("shading"):
             visible = sun_visibility(surface, sun_dir, highest, dev, out=self.visible)
         extra = {}
-        stage = self.photons if self.photons is not None else self.beams
-        if stage is not None:
+        comparison = None
+        if self.photons is not None or self.beams is not None:
             if self.receivers.mesh_top_z >= lowest:
                 raise WarpcausticsError(
                     f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
@@ -272,35 +274,9 @@ class Renderer:
                     f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
                     f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
                     "above the water is not implemented yet: lower the camera")
-            with watch.stage("photons" if self.photons is not None else "beams"):
-                floor = stage.run(surface, visible)
-            if self.camera is not None:
-                with watch.stage("camera"):
-                    if self.photons is not None:
-                        n = self.scene.water_resolution
-                        spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
-                        self.camera.render(self.photons, spacing, cfg.caustics.shafts)
-                    else:
-                        self.camera.render_beams(self.beams, cfg.caustics.shafts)
-                    extra["camera_radiance"] = self.camera.radiance.numpy().copy()
-                    extra["camera_gbuffer"] = self.camera.gbuffer()
-            with watch.stage("readback"):
-                floor_np = floor.numpy().copy()
-                transmitted = stage.transmitted_flux()
-                rec = self.receivers
-                other = rec.face_count - rec.floor_face_count
-                if self.photons is not None:
-                    face_flux = self.photons.face_flux.numpy()[:other].copy()
-                    extra["photon_stats"] = vars(self.photons.stats())
-                else:
-                    face_flux = self.beams.face_flux_w_nm()
-                    extra["beam_stats"] = vars(self.beams.stats())
-                extra.update(face_flux_w_nm=face_flux,
-                             face_receiver=rec.face_receiver_np[rec.floor_face_count:],
-                             face_area_m2=rec.face_area_m2[rec.floor_face_count:],
-                             face_centres_m=rec.face_centres_m[rec.floor_face_count:],
-                             floor_texel_area_m2=rec.floor_texel_area_m2,
-                             receiver_mesh=rec.non_floor_mesh())
+            stages = [st for st in (self.beams, self.photons) if st is not None]
+            outputs = [self._receiver_stage(st, surface, visible, watch) for st in stages]
+            floor_np, transmitted, extra = outputs[0]
         else:
             with watch.stage("refraction"):
                 refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,
@@ -315,13 +291,54 @@ class Renderer:
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
             folds = float(np.mean(surface.jacobian.numpy() <= 0.0)) if surface.jacobian is not None else 0.0
-        return RenderResult(
+        common = dict(
             scene=self.scene, time_s=time_s, device=dev, wavelengths_nm=self.bins.centres_nm,
-            bin_widths_nm=self.bins.widths_nm, floor_irradiance=floor_np,
-            attenuation_per_m=self.attenuation_per_m, ior=self.ior,
-            sun_irradiance=self.sun_irradiance, transmitted_flux_w_nm=transmitted,
-            surface_positions=positions, surface_normals=normals, bins=self.bins, fold_fraction=folds,
-            timings_s=watch.timings, **extra)
+            bin_widths_nm=self.bins.widths_nm, attenuation_per_m=self.attenuation_per_m, ior=self.ior,
+            sun_irradiance=self.sun_irradiance, surface_positions=positions, surface_normals=normals,
+            bins=self.bins, fold_fraction=folds, timings_s=watch.timings)
+        if self.photons is not None and self.beams is not None:  # "both": photons as the comparison
+            other_floor, other_transmitted, other_extra = outputs[1]
+            comparison = RenderResult(floor_irradiance=other_floor, transmitted_flux_w_nm=other_transmitted,
+                                      **common, **other_extra)
+        return RenderResult(floor_irradiance=floor_np, transmitted_flux_w_nm=transmitted,
+                            comparison=comparison, **common, **extra)
+
+    def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:
+        """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the
+        RenderResult fields of receivers and camera), all on the host."""
+        cfg = self.scene.config
+        photons = stage is self.photons
+        extra = {}
+        with watch.stage("photons" if photons else "beams"):
+            floor = stage.run(surface, visible)
+        if self.camera is not None:
+            with watch.stage("camera" if photons or self.photons is None else "camera_beams"):
+                if photons:
+                    n = self.scene.water_resolution
+                    spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
+                    self.camera.render(stage, spacing, cfg.caustics.shafts)
+                else:
+                    self.camera.render_beams(stage, cfg.caustics.shafts)
+                extra["camera_radiance"] = self.camera.radiance.numpy().copy()
+                extra["camera_gbuffer"] = self.camera.gbuffer()
+        with watch.stage("readback"):
+            # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
+            floor_np = floor.numpy().copy()
+            transmitted = stage.transmitted_flux()
+            rec = self.receivers
+            other = rec.face_count - rec.floor_face_count
+            if photons:
+                extra["face_flux_w_nm"] = stage.face_flux.numpy()[:other].copy()
+                extra["photon_stats"] = vars(stage.stats())
+            else:
+                extra["face_flux_w_nm"] = stage.face_flux_w_nm()
+                extra["beam_stats"] = vars(stage.stats())
+            extra.update(face_receiver=rec.face_receiver_np[rec.floor_face_count:],
+                         face_area_m2=rec.face_area_m2[rec.floor_face_count:],
+                         face_centres_m=rec.face_centres_m[rec.floor_face_count:],
+                         floor_texel_area_m2=rec.floor_texel_area_m2,
+                         receiver_mesh=rec.non_floor_mesh())
+        return floor_np, transmitted, extra
 
 
 _WALL_TOP_M = 1.0

@@ -1,6 +1,6 @@
 """``warpcaustics preview``: an off-screen 3-D view (pyvista) of a rendered frame.
 
-The floor (and, with photons, every receiver) is coloured by its band-integrated irradiance
+The floor (and, with photons or beams, every receiver) is coloured by its band-integrated irradiance
 [W m^-2] on a logarithmic scale; the water surface is drawn translucent above it. Meant for
 checking a scene's set-up at a glance, not as a rendering: the pictures of record are the EXRs.
 """

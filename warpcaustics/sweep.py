@@ -285,6 +285,8 @@ def summary_row(task: Task, result, k: int) -> dict:
     row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
     if result.photon_stats:
         row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
+    if result.beam_stats:
+        row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
     row["render_s"] = float(sum(result.timings_s.values()))
     return row
 
