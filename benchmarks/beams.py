@@ -60,6 +60,17 @@ def _median_time(func, repeats: int) -> float:
     return float(np.median(times))
 
 
+def _timed_runs(func, repeats: int):
+    """(first result, median wall time over ``repeats`` calls): numpy needs no warm-up."""
+    times, out = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = func()
+        times.append(time.perf_counter() - t0)
+        out = result if out is None else out
+    return out, float(np.median(times))
+
+
 def _beam_arrays(stage) -> dict:
     return {
         "base": stage.base.numpy().astype(np.float64),
@@ -399,8 +410,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
     def numpy_run():
         return numpy_points(beams, tiles, grid, points, normals, stage.extent_m, stage.periodic)
 
-    numpy_out = numpy_run()
-    numpy_s = _median_time(numpy_run, numpy_repeats)
+    numpy_out, numpy_s = _timed_runs(numpy_run, numpy_repeats)
     pairs = int(tiles[1][horizontal_tile(points, grid, stage.periodic)].sum())
     return {
         "water_n": n,
@@ -415,6 +425,120 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
         "numpy_points_per_s": len(points) / numpy_s,
         "relative_l1_numpy_vs_warp": relative_l1(numpy_out, warp_out),
     }
+
+
+def _convex_area_on_screen(points: np.ndarray, width: int, height: int) -> float:
+    """Area [pixels] of the convex hull of 2-D points clipped to the screen (≈ pixels a rasteriser
+    touches)."""
+    pts = sorted(map(tuple, points))
+    if len(pts) < 3:
+        return 0.0
+
+    def half(seq):
+        out = []
+        for q in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (q[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (q[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(q)
+        return out
+
+    poly = half(pts)[:-1] + half(pts[::-1])[:-1]
+    for axis, bound, keep_above in ((0, 0.0, True), (0, float(width), False), (1, 0.0, True),
+                                    (1, float(height), False)):
+        clipped = []
+        for a, b in zip(poly, poly[1:] + poly[:1]):
+            sa = (a[axis] - bound) * (1 if keep_above else -1)
+            sb = (b[axis] - bound) * (1 if keep_above else -1)
+            if sa >= 0:
+                clipped.append(a)
+            if (sa >= 0) != (sb >= 0):
+                t = sa / (sa - sb)
+                clipped.append((a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+        poly = clipped
+        if len(poly) < 3:
+            return 0.0
+    x, y = np.array(poly).T
+    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+
+def prism_ends(v: np.ndarray, d: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """(B, 3, 3) end vertices of a bounding prism of each beam in the manner of Ernst et al. 2005:
+    each side is the plane through a base edge tilted just enough to hold all three end points;
+    neighbouring sides meet in a line through the shared base vertex, cut by the plane of
+    the three edge ends. NaN where a corner line runs parallel to the end plane."""
+    e = v + ends[..., None] * d
+    normals = []
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        u = v[:, j] - v[:, i]
+        inward = v[:, k] - v[:, i]
+        best = np.full_like(u, np.nan)
+        for cand in range(3):  # the plane through the edge and the end that holds all three ends
+            n = np.cross(u, e[:, cand] - v[:, i])
+            n *= np.where((n * inward).sum(-1) < 0, -1.0, 1.0)[:, None]
+            tol = 1e-9 * np.linalg.norm(n, axis=-1, keepdims=True)
+            ok = np.all(((e - v[:, i][:, None]) * n[:, None]).sum(-1) >= -tol, axis=1)
+            best = np.where(ok[:, None] & np.isnan(best), n, best)
+        normals.append(best)
+    dbar = d.sum(axis=1)
+    e0 = e.mean(axis=1)
+    ne = np.cross(e[:, 1] - e[:, 0], e[:, 2] - e[:, 0])
+    out = np.empty_like(v)
+    for i in range(3):
+        line = np.cross(normals[(i + 2) % 3], normals[i])  # sides (k, i) and (i, j) meet at v_i
+        line *= np.where((line * dbar).sum(-1) < 0, -1.0, 1.0)[:, None]
+        t = ((e0 - v[:, i]) * ne).sum(-1) / (line * ne).sum(-1)
+        out[:, i] = v[:, i] + t[:, None] * line
+    return out
+
+
+def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dict:
+    """Pixels a rasteriser would touch for the beams' bounding volumes, on a sample of the beam copies
+    wholly in front of the camera: the tight hull (convex hull of base and end vertices) against a
+    bounding prism in Ernst's manner (:func:`prism_ends`), each projected and clipped to the frame."""
+    cam = camera.cam
+    pos = np.array(cam.position, np.float64)
+    right, up, fwd = (np.array(a, np.float64) for a in (cam.right, cam.up, cam.forward))
+    w, h = int(cam.width), int(cam.height)
+    v = stage.base.numpy().astype(np.float64)
+    d = stage.direction.numpy().astype(np.float64)
+    ends = stage.end_m.numpy().astype(np.float64)
+    carrying = np.flatnonzero(stage.weight.numpy() > 0)
+    rng = np.random.default_rng(seed)
+    items = rng.choice(len(carrying) * copies * copies, size=min(samples * 4, len(carrying) * copies**2),
+                       replace=False)
+    b = carrying[items // (copies * copies)]
+    c = items % (copies * copies)
+    r = copies // 2
+    shift = np.stack([(c % copies - r) * stage.extent_m, (c // copies - r) * stage.extent_m, 0 * c], 1)
+    vb = v[b] + shift[:, None]
+    hull = np.concatenate([vb, vb + ends[b][..., None] * d[b]], axis=1)
+    prism = np.concatenate([vb, prism_ends(vb, d[b], ends[b])], axis=1)
+
+    def project(x):
+        rel = x - pos
+        z = rel @ fwd
+        px = (rel @ right / (z * cam.tan_half_fov * cam.aspect) + 1.0) * 0.5 * w
+        py = (1.0 - rel @ up / (z * cam.tan_half_fov)) * 0.5 * h
+        return np.stack([px, py], -1), z
+
+    hp, hz = project(hull)
+    pp, pz = project(prism)
+    good = np.all(hz > 1e-3, axis=1) & np.all(pz > 1e-3, axis=1) & np.all(np.isfinite(pp), axis=(1, 2))
+    hull_px, prism_px, counted = 0.0, 0.0, 0
+    for i in np.flatnonzero(good):
+        a_hull = _convex_area_on_screen(hp[i], w, h)
+        a_prism = _convex_area_on_screen(pp[i], w, h)
+        if a_prism <= 0.0 and a_hull <= 0.0:
+            continue
+        hull_px += a_hull
+        prism_px += a_prism
+        counted += 1
+        if counted >= samples:
+            break
+    return {"beams_measured": counted, "hull_pixels": hull_px, "prism_pixels": prism_px,
+            "hull_over_prism": hull_px / max(prism_px, 1e-300)}
 
 
 def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, numpy_repeats: int) -> dict:
@@ -452,6 +576,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     camera.render_beams(stage, True)
     warp_out = camera.shafts.numpy().astype(np.float64)
     fill = camera.beam_fill()
+    fill.update(fill_measure(stage, camera, 3 if stage.periodic else 1, samples=3000))
     bins = camera._screen_bins
     cam = camera.cam
     cam_np = {
@@ -482,8 +607,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
             SCREEN_TILE_PIXELS,
         )
 
-    numpy_out = numpy_run()
-    numpy_s = _median_time(numpy_run, numpy_repeats)
+    numpy_out, numpy_s = _timed_runs(numpy_run, numpy_repeats)
     pixels = size[0] * size[1]
     return {
         "water_n": n,
@@ -545,7 +669,7 @@ def run(quick: bool, device: str) -> dict:
     from benchmarks.run import _cpu_name
 
     sizes = QUICK if quick else FULL
-    warp_repeats, numpy_repeats = (2, 1) if quick else (5, 2)
+    warp_repeats, numpy_repeats = (2, 1) if quick else (5, 3)
     wp_name = str(wp.get_device(device).name)
     print(f"beams        warp {wp.__version__} [{device}: {wp_name}] | cpu {_cpu_name()} | numpy twins "
           "float64, same beams and tile lists", flush=True)
@@ -566,6 +690,9 @@ def run(quick: bool, device: str) -> dict:
     print(f"beams        fill: (pixel, beam) pairs in axis-aligned boxes {fill['box_pixels']:.3g}, in tile "
           f"lists {fill['tile_pairs']:.3g}, in oriented boxes {fill['oriented_box_pairs']:.3g}, with a "
           f"chord {fill['inside_pairs']:.3g}", flush=True)
+    print(f"beams        bounding volumes on {fill['beams_measured']} beams in view: tight hull "
+          f"{fill['hull_pixels']:.4g} px, Ernst-style prism {fill['prism_pixels']:.4g} px, hull/prism "
+          f"{fill['hull_over_prism']:.2f}", flush=True)
     by_n = [_stage_time(n, sizes["scaling_m"][1], device, warp_repeats) for n in sizes["scaling_n"]]
     by_m = [_stage_time(sizes["scaling_n"][1], m, device, warp_repeats) for m in sizes["scaling_m"]]
     for rows, key in ((by_n, "beams"), (by_m, "map_m")):
