@@ -181,6 +181,7 @@ def main() -> int:
         print(f"{n}²: {np.linalg.norm(water.from_vec2(a) - ref) / np.linalg.norm(ref):.2e}")
 
     _photons()
+    _beams()
     return 0
 
 
@@ -280,3 +281,81 @@ def _camera_floor() -> None:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _beams() -> None:
+    """Beam caustics: the figures of docs/validation.md's beam section."""
+    import warp as wp
+    from test_beams import BEAMS, _chords, _flat, _flat_floor_irradiance, _prism_chord, _sphere_bins
+    from test_photons import shaft_block
+
+    import warpcaustics as wc
+
+    print("\n## Beams on flat water vs E_sun cosθ T(θ) exp(-c D / cosθ_t)  (pure water, 8 bins, 3 m)")
+    worst = 0.0
+    for el in (5.0, 20.0, 55.0, 90.0):
+        r = wc.render(_flat(el, 3.0), device="cpu")
+        e = _flat_floor_irradiance(r, el, 3.0)
+        worst = max(worst, float(np.abs(r.floor_irradiance / e[:, None, None] - 1).max()))
+    print(f"max relative error over elevations 5°, 20°, 55°, 90° and all texels {worst:.1e}")
+
+    print("\n## Beam floor map, configs/ocean.toml (128² surface, 64² map, rgb)")
+    base = {"water.resolution": 128, "caustics.map_resolution": 64, "optics.wavelengths": "rgb"}
+    ocean = ROOT / "configs" / "ocean.toml"
+    ref = wc.render(wc.load_scene(ocean, base), device="cpu").floor_irradiance
+    for interp in ("flat", "smooth"):
+        b = wc.render(wc.load_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp,
+                                            "optics.water_type": "none"}), device="cpu")
+        flux = np.abs(b.floor_flux_w_nm / b.transmitted_flux_w_nm - 1).max()
+        f = wc.render(wc.load_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp}),
+                      device="cpu").floor_irradiance
+        print(f"{interp:6s}: flux (water_type none) floor / transmitted - 1 = {flux:.1e}; pure water, "
+              f"relative L1 vs the flux-ratio map {np.abs(f - ref).sum() / np.abs(ref).sum():.1e}")
+
+    print("\n## Beams vs exact photons (16 per cell, 256 per texel), ocean.toml + sphere r = 1 m at z = -2.5")
+    centre = [0.0, 0.0, -2.5]
+    base = {"water.resolution": 128, "caustics.map_resolution": 32, "optics.wavelengths": "rgb",
+            "optics.water_type": "none",
+            "receivers": [{"mesh": "sphere", "scale": 2.0, "translate_m": centre}]}
+    ph = wc.render(wc.load_scene(ocean, {**base, "caustics.method": "photons",
+                                         "caustics.photon_subdivisions": 4}), device="cpu")
+    bm = wc.render(wc.load_scene(ocean, {**base, **BEAMS}), device="cpu")
+    floor_l1 = np.abs(bm.floor_irradiance - ph.floor_irradiance).sum() / np.abs(ph.floor_irradiance).sum()
+    sb, sp = _sphere_bins(bm, 2, centre), _sphere_bins(ph, 2, centre)
+    total = bm.floor_flux_w_nm + bm.face_flux_w_nm.sum(axis=0)
+    print(f"floor relative L1 {floor_l1:.2%}; sphere (8×8 elevation-azimuth cells) relative L1 "
+          f"{np.abs(sb - sp).sum() / np.abs(sp).sum():.2%}; (floor + sphere) / transmitted - 1 = "
+          f"{np.abs(total / bm.transmitted_flux_w_nm - 1).max():.1e}")
+
+    print("\n## Scan-plane chord of a straight prism vs the exact float64 ray-prism chord")
+    rng = np.random.default_rng(5)
+    v = np.array([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
+    d = np.array([0.2, -0.1, -1.0]) / np.linalg.norm([0.2, -0.1, -1.0])
+    ends = np.array([2.0, 2.3, 1.8])
+    n = 4000
+    origins = rng.uniform(-3.0, 3.0, (n, 3)) + np.array([0.0, 0.0, -1.0])
+    targets = v.mean(axis=0) + rng.uniform(-0.5, 0.5, (n, 3)) + d * rng.uniform(0.0, 2.0, (n, 1))
+    rays = (targets - origins) / np.linalg.norm(targets - origins, axis=1, keepdims=True)
+    out = wp.zeros(n, dtype=wp.vec2, device="cpu")
+    wp.launch(_chords, dim=n, inputs=[
+        wp.array(np.repeat(v[None], n, axis=0).astype(np.float32), dtype=wp.vec3, device="cpu"),
+        wp.array(np.broadcast_to(d, (n, 3, 3)).astype(np.float32), dtype=wp.vec3, device="cpu"),
+        wp.array(np.repeat(ends[None], n, axis=0).astype(np.float32), dtype=wp.float32, device="cpu"),
+        wp.array(origins.astype(np.float32), dtype=wp.vec3, device="cpu"),
+        wp.array(rays.astype(np.float32), dtype=wp.vec3, device="cpu")],
+        outputs=[wp.zeros((n, 2), dtype=wp.vec3, device="cpu"), out], device="cpu")
+    got = out.numpy().astype(np.float64)
+    errs = []
+    for i in range(n):
+        lo, hi = _prism_chord(v, d, ends, origins[i], rays[i])
+        if hi - lo > 1e-4:
+            errs.append(max(abs(got[i, 0] - lo), abs(got[i, 1] - hi)))
+    print(f"{len(errs)} rays crossing the prism: max |Δs_a|, |Δs_b| = {max(errs) * 1e6:.2f} µm, "
+          f"mean {np.mean(errs) * 1e6:.2f} µm")
+
+    print("\n## Beam light shafts vs single scattering, sun at the zenith over a still pool (clear_ocean)")
+    for n in (32, 64):
+        for pitch, sees, view in ((0.0, 1, "level"), (35.0, -1, "35° up"), (-35.0, 0, "35° down")):
+            measured, expected = shaft_block(pitch, sees, n, method="beams")
+            print(f"{n}² surface, {view}: block mean / analytic - 1 per band: "
+                  + ", ".join(f"{x - 1:+.1e}" for x in measured / expected))

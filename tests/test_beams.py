@@ -126,7 +126,8 @@ def test_beams_agree_with_exact_photons_on_the_floor_and_on_a_sphere():
     """configs/ocean.toml with a sphere (radius 1 m, centre 2.5 m down), water_type none: beams and
     exact photons at 16 per cell (256 per map texel, 32² map) agree within 3 % relative L1 on the
     floor, and on the sphere over 8×8 (elevation, azimuth) cells of its faces (≥ 64 photons each
-    where lit); the light reaching the floor and the sphere adds up to what entered the water."""
+    where lit); the light reaching the floor and the sphere adds up to what entered the water
+    (measured: 1.04 %, 1.35 % and 3.3e-5; the sphere's 4×4 samples per face leave ~1e-4)."""
     centre = [0.0, 0.0, -2.5]
     base = {
         "water.resolution": 128,
@@ -147,7 +148,7 @@ def test_beams_agree_with_exact_photons_on_the_floor_and_on_a_sphere():
     s_b, s_p = _sphere_bins(beams, 2, centre), _sphere_bins(photons, 2, centre)
     assert np.abs(s_b - s_p).sum() / np.abs(s_p).sum() < 0.03
     total = beams.floor_flux_w_nm + beams.face_flux_w_nm.sum(axis=0)
-    np.testing.assert_allclose(total, beams.transmitted_flux_w_nm, rtol=5e-3)
+    np.testing.assert_allclose(total, beams.transmitted_flux_w_nm, rtol=5e-4)
 
 
 @wp.kernel
