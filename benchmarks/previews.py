@@ -4,7 +4,11 @@
 - ``docs/images/pool_frames.png``: six frames of configs/pool.toml side by side (0.25 s apart),
   the pool stepping forward from frame to frame;
 - ``docs/images/{ocean_floor,pool_pots,buried_in_sand}.png``: the camera images of the photon
-  configs (the pools stepped to 1 s, so that their drops have spread into waves).
+  configs (the pools stepped to 1 s, so that their drops have spread into waves);
+- ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots and ocean_floor by
+  photons (left) and by beams (right, ``caustics.method = "both"``);
+- ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
+  an Ernst-style bounding prism projected on the screen.
 """
 
 from __future__ import annotations
@@ -54,7 +58,84 @@ def main() -> int:
         renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / f"{name}.toml"), device="cpu")
         write_png(images / f"{name}.png", _camera_preview(renderer.render(time_s)))
         print(f"wrote {images / f'{name}.png'}")
+    _beam_pictures(images)
     return 0
+
+
+def _beam_pictures(images: Path) -> None:
+    import warpcaustics as wc
+    from warpcaustics.output import write_png
+
+    rows = []
+    for name in ("pool_pots", "ocean_floor"):
+        scene = wc.load_scene(ROOT / "configs" / f"{name}.toml", {"caustics.method": "both"})
+        renderer = wc.Renderer(scene, device="cpu")
+        result = renderer.render(CAMERA_SCENES[name])
+        gap = np.full((result.camera_radiance.shape[1], 6, 3), 255, np.uint8)
+        pair = [_camera_preview(result.comparison), gap, _camera_preview(result)]
+        rows.append(np.concatenate(pair, axis=1))
+        if name == "ocean_floor":
+            _bounds_plot(renderer, images / "beam_bounds.png")
+    gap = np.full((6, rows[0].shape[1], 3), 255, np.uint8)
+    write_png(images / "beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1]], axis=0))
+    print(f"wrote {images / 'beams_vs_photons.png'} and {images / 'beam_bounds.png'}")
+
+
+def _bounds_plot(renderer, path: Path) -> None:
+    """Outlines of a few beams' projected tight hull and Ernst-style prism."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.spatial import ConvexHull
+
+    from benchmarks.beams import prism_ends
+
+    stage, camera = renderer.beams, renderer.camera
+    cam = camera.cam
+    pos = np.array(cam.position, np.float64)
+    right, up, fwd = (np.array(a, np.float64) for a in (cam.right, cam.up, cam.forward))
+    w, h = int(cam.width), int(cam.height)
+
+    def project(x):
+        rel = x - pos
+        z = rel @ fwd
+        return np.stack([(rel @ right / (z * cam.tan_half_fov * cam.aspect) + 1) * 0.5 * w,
+                         (1 - rel @ up / (z * cam.tan_half_fov)) * 0.5 * h], -1), z
+
+    v = stage.base.numpy().astype(np.float64)
+    d = stage.direction.numpy().astype(np.float64)
+    ends = stage.end_m.numpy().astype(np.float64)
+    rng = np.random.default_rng(3)
+    fig, ax = plt.subplots(figsize=(7, 4.7))
+    drawn = 0
+    for b in rng.permutation(len(v)):
+        hull = np.concatenate([v[b], v[b] + ends[b][:, None] * d[b]])
+        prism = np.concatenate([v[b], prism_ends(v[b][None], d[b][None], ends[b][None])[0]])
+        hp, hz = project(hull)
+        pp, pz = project(prism)
+        if (hz <= 0.5).any() or (pz <= 0.5).any() or not np.isfinite(pp).all():
+            continue
+        if not (np.all((hp > 0) & (hp < [w, h]))):
+            continue
+        for pts, style in ((pp, "r-"), (hp, "b-")):
+            loop = pts[ConvexHull(pts).vertices]
+            ax.plot(*np.vstack([loop, loop[:1]]).T, style, lw=0.8)
+        drawn += 1
+        if drawn == 40:
+            break
+    ax.plot([], [], "b-", label="tight hull (base + end vertices)")
+    ax.plot([], [], "r-", label="Ernst-style bounding prism")
+    ax.set_xlim(0, w)
+    ax.set_ylim(h, 0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("pixel column")
+    ax.set_ylabel("pixel row")
+    ax.set_title(f"{drawn} beams of configs/ocean_floor.toml projected on its camera")
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
