@@ -32,11 +32,13 @@ ROOT = Path(__file__).resolve().parents[1]
 
 FULL = {
     "gather_n": 128,
-    "gather_m": 256,
-    "camera": (320, 240),
-    "camera_n": 128,
+    "gather_m": 128,
+    "camera": (160, 120),
+    "camera_n": 64,
     "scaling_n": (32, 64, 128, 256),
     "scaling_m": (128, 256, 512, 1024),
+    "adaptive_n": 256,
+    "adaptive_m": 256,
 }
 QUICK = {
     "gather_n": 32,
@@ -45,6 +47,8 @@ QUICK = {
     "camera_n": 32,
     "scaling_n": (16, 32),
     "scaling_m": (32, 64),
+    "adaptive_n": 32,
+    "adaptive_m": 32,
 }
 WAVELENGTHS = "rgb"
 MIN_AREA_FRACTION = 1.0e-6  # as kernels/beams.py
@@ -659,6 +663,36 @@ def _stage_time(n: int, m: int, device: str, repeats: int) -> dict:
     }
 
 
+def _adaptive_rows(n: int, m: int, device: str, repeats: int) -> list[dict]:
+    """Adaptive beams (caustics.beam_levels) against the uniform grid on ocean.toml: beams, stage time
+    and the floor map's relative L1 from the uniform grid's, for a range of tolerances; the coarse
+    uniform grids (every quad kept at level 1 or 2: tolerance ∞) are the equal-cost baselines."""
+    import warpcaustics as wc
+
+    base = {"caustics.method": "beams", "water.resolution": n, "caustics.map_resolution": m,
+            "optics.wavelengths": WAVELENGTHS, "optics.water_type": "none"}
+    rows = []
+    reference = None
+    cases = [(0, 0.0)] + [(2, t) for t in (0.05, 0.1, 0.25, 0.5, 1.0)] + [(1, 1e30), (2, 1e30)]
+    for levels, tol in cases:
+        renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / "ocean.toml", {
+            **base, "caustics.beam_levels": levels, "caustics.beam_tolerance": tol}), device)
+        result = renderer.render(0.0)
+        s = _median_time(lambda renderer=renderer: renderer.render(0.0), repeats)
+        result = renderer.render(0.0)
+        if reference is None:
+            reference = result.floor_irradiance.astype(np.float64)
+        l1 = relative_l1(reference, result.floor_irradiance)
+        label = "uniform" if levels == 0 else (f"uniform x{1 << levels} cells" if tol > 1e20 else
+                                               f"adaptive L={levels} tol={tol:g}")
+        rows.append({"case": label, "beam_levels": levels, "beam_tolerance": None if tol > 1e20 else tol,
+                     "beams": result.beam_stats["beams"], "frame_s": s,
+                     "beams_stage_s": result.timings_s["beams"], "relative_l1_vs_uniform": l1})
+        print(f"beams        {label:28s} {rows[-1]['beams']:8d} beams | frame {s * 1e3:8.1f} ms | L1 vs "
+              f"uniform {l1:.2e}", flush=True)
+    return rows
+
+
 def _slope(rows: list[dict], x: str, y: str) -> float:
     return float(np.polyfit(np.log([r[x] for r in rows]), np.log([r[y] for r in rows]), 1)[0])
 
@@ -707,7 +741,9 @@ def run(quick: bool, device: str) -> dict:
         print(f"  log-log slope of stage time vs {what}: {slope:.2f}")
         for r in rows:
             r[f"loglog_slope_vs_{key}"] = slope
+    adaptive = _adaptive_rows(sizes["adaptive_n"], sizes["adaptive_m"], device, warp_repeats)
     return {
+        "adaptive_vs_uniform": adaptive,
         "benchmark": "beam_rasteriser",
         "device": device,
         "device_name": wp_name,

@@ -55,6 +55,7 @@ def corner_ray(
     visible: wp.array2d[wp.float32],
     qx: int,
     qy: int,
+    level: int,
     half: int,
     corner: int,
     extent_m: float,
@@ -63,11 +64,41 @@ def corner_ray(
     eta: float,
 ):
     """Surface vertex of a triangle corner (periodic wrap / wall offset applied), its refracted
-    unit direction and its transmittance (Fresnel × sun visibility)."""
+    unit direction and its transmittance (Fresnel × sun visibility). A quad of ``level`` > 0 spans
+    2^level cells (periodic seas only): (qx, qy) index the quads of that size."""
     n = positions.shape[0]
-    x, y, s = quad_corner(qx, qy, half, corner, n, extent_m, periodic)
+    x = int(0)
+    y = int(0)
+    s = wp.vec2(0.0)
+    if level == 0:
+        x, y, s = quad_corner(qx, qy, half, corner, n, extent_m, periodic)
+    else:
+        size = 1 << level
+        o = corner_offset(half, corner)
+        x = (qx + o[0]) * size
+        y = (qy + o[1]) * size
+        if x >= n:
+            x -= n
+            s[0] = extent_m
+        if y >= n:
+            y -= n
+            s[1] = extent_m
     d, t = sun_into_water(normals[y, x], sun_dir, eta)
     return lift(positions[y, x], s), d, t * visible[y, x]
+
+
+@wp.func
+def corner_offset(half: int, corner: int) -> wp.vec2i:
+    """Lattice offset (dx, dy) of a triangle corner in its quad (kernels/floor.py quad_corner)."""
+    if corner == 0:
+        return wp.vec2i(0, 0)
+    if half == 0:
+        if corner == 1:
+            return wp.vec2i(1, 0)
+        return wp.vec2i(1, 1)
+    if corner == 1:
+        return wp.vec2i(1, 1)
+    return wp.vec2i(0, 1)
 
 
 @wp.func
@@ -106,7 +137,7 @@ def build_beams(
     periodic: int,
     plane_z: float,
     mesh: wp.uint64,
-    quads: int,
+    leaves: wp.array[wp.vec3i],
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
@@ -116,14 +147,25 @@ def build_beams(
     area_coef: wp.array[wp.vec3],
     dropped: wp.array[wp.int32],
 ):
-    """Build beam ((g Q + qy) Q + qx) 2 + half. On a periodic sea the beam is moved by whole
-    periods so that its mean ray lands inside the patch on the plane ``plane_z`` (as photons are)."""
-    g, qy, qx, half = wp.tid()
-    b = ((g * quads + qy) * quads + qx) * 2 + half
+    """Build beam (g · leaves + leaf) · 2 + half from the leaf quad (qx, qy, level). The uniform grid
+    lists every quad at level 0 in row-major order, so its beam index is ((g Q + qy) Q + qx) 2 + half.
+    On a periodic sea the beam is moved by whole periods so that its mean ray lands inside the patch
+    on the plane ``plane_z`` (as photons are)."""
+    g, leaf, half = wp.tid()
+    b = (g * leaves.shape[0] + leaf) * 2 + half
+    qx = leaves[leaf][0]
+    qy = leaves[leaf][1]
+    lv = leaves[leaf][2]
     eta = 1.0 / ior[g]
-    p0, d0, t0 = corner_ray(positions, normals, visible, qx, qy, half, 0, extent_m, periodic, sun_dir, eta)
-    p1, d1, t1 = corner_ray(positions, normals, visible, qx, qy, half, 1, extent_m, periodic, sun_dir, eta)
-    p2, d2, t2 = corner_ray(positions, normals, visible, qx, qy, half, 2, extent_m, periodic, sun_dir, eta)
+    p0, d0, t0 = corner_ray(
+        positions, normals, visible, qx, qy, lv, half, 0, extent_m, periodic, sun_dir, eta
+    )
+    p1, d1, t1 = corner_ray(
+        positions, normals, visible, qx, qy, lv, half, 1, extent_m, periodic, sun_dir, eta
+    )
+    p2, d2, t2 = corner_ray(
+        positions, normals, visible, qx, qy, lv, half, 2, extent_m, periodic, sun_dir, eta
+    )
     a_perp = 0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir)
     w = float(0.0)
     if a_perp > 0.0 and t0 + t1 + t2 > 0.0:
@@ -174,6 +216,118 @@ def build_beams(
     ends[b, 0] = e0
     ends[b, 1] = ne
     weight[b] = w
+
+
+@wp.kernel
+def vertex_rays(
+    positions: wp.array2d[wp.vec3],
+    normals: wp.array2d[wp.vec3],
+    ior: float,
+    sun_dir: wp.vec3,
+    extent_m: float,
+    plane_z: float,
+    mesh: wp.uint64,
+    direction: wp.array2d[wp.vec3],
+    length_m: wp.array2d[wp.float32],
+):
+    """Refracted direction of every surface vertex and its length to the first receiver (moved by
+    whole periods to land in the patch, as beams are): what the refinement criteria look at."""
+    j, i = wp.tid()
+    d, t = sun_into_water(normals[j, i], sun_dir, 1.0 / ior)
+    p = positions[j, i]
+    land = p + ((plane_z - p[2]) / wp.min(d[2], -1.0e-6)) * d
+    p = p - wp.vec3(
+        extent_m * wp.floor(land[0] / extent_m + 0.5), extent_m * wp.floor(land[1] / extent_m + 0.5), 0.0
+    )
+    direction[j, i] = d
+    length_m[j, i] = edge_end(mesh, p, d, plane_z)
+
+
+@wp.func
+def vertex_index(c: int, n: int) -> int:
+    return ((c % n) + n) % n
+
+
+@wp.kernel
+def refine_quads(
+    quads: wp.array[wp.vec3i],
+    positions: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    length_m: wp.array2d[wp.float32],
+    tolerance_m: float,
+    end_jump: float,
+    extent_m: float,
+    use_camera: int,
+    cam: PinholeCamera,
+    max_pixels: float,
+    split: wp.array[wp.int32],
+):
+    """Liktor & Dachsbacher (2011) §4.2, on our lattice: split quad (qx, qy, level) of 2^level cells
+    into its four children where (a) some vertex inside it, followed along its own refracted ray to
+    its receiver, misses the ray the coarse quad interpolates bilinearly from its corners by more
+    than ``tolerance_m`` (curvature: strong focusing, normal discontinuities), (b) its corners'
+    lengths to the receivers differ by more than ``end_jump`` (a depth discontinuity: an object's
+    edge), or (c) its footprint on the camera's screen spans more than ``max_pixels``."""
+    q = wp.tid()
+    qx = quads[q][0]
+    qy = quads[q][1]
+    size = 1 << quads[q][2]
+    n = direction.shape[0]
+    x0 = qx * size
+    y0 = qy * size
+    x1 = vertex_index(x0 + size, n)
+    y1 = vertex_index(y0 + size, n)
+    d00 = direction[y0, x0]
+    d10 = direction[y0, x1]
+    d01 = direction[y1, x0]
+    d11 = direction[y1, x1]
+    e00 = length_m[y0, x0]
+    e10 = length_m[y0, x1]
+    e01 = length_m[y1, x0]
+    e11 = length_m[y1, x1]
+    lo = wp.min(wp.min(e00, e10), wp.min(e01, e11))
+    hi = wp.max(wp.max(e00, e10), wp.max(e01, e11))
+    result = int(0)
+    if hi > (1.0 + end_jump) * lo + 1.0e-6:
+        result = 1
+    for jj in range(size + 1):
+        for ii in range(size + 1):
+            if result == 0:
+                u = float(ii) / float(size)
+                v = float(jj) / float(size)
+                d_int = wp.normalize(
+                    (1.0 - v) * ((1.0 - u) * d00 + u * d10) + v * ((1.0 - u) * d01 + u * d11)
+                )
+                yi = vertex_index(y0 + jj, n)
+                xi = vertex_index(x0 + ii, n)
+                if length_m[yi, xi] * wp.length(direction[yi, xi] - d_int) > tolerance_m:
+                    result = 1
+    if result == 0 and use_camera != 0:
+        # The periodic copy of the quad nearest the camera, its base and end corners on the screen.
+        shift = period_shift(xy(cam.position), xy(positions[y0, x0]), extent_m, 1)
+        lo2 = wp.vec2(1.0e30)
+        hi2 = wp.vec2(-1.0e30)
+        for c in range(4):
+            xi = x0 + (c % 2) * size
+            yi = y0 + (c / 2) * size
+            lift_m = wp.vec3(shift[0], shift[1], 0.0)
+            if xi >= n:
+                lift_m = lift_m + wp.vec3(extent_m, 0.0, 0.0)
+            if yi >= n:
+                lift_m = lift_m + wp.vec3(0.0, extent_m, 0.0)
+            xi = vertex_index(xi, n)
+            yi = vertex_index(yi, n)
+            p = positions[yi, xi] + lift_m
+            for k in range(2):
+                x = p + (float(k) * length_m[yi, xi]) * direction[yi, xi]
+                z = wp.dot(x - cam.position, cam.forward)
+                if z > NEAR_M:
+                    sp = screen_xy(cam, x, z)
+                    lo2 = wp.min(lo2, sp)
+                    hi2 = wp.max(hi2, sp)
+        if hi2[0] > lo2[0] and wp.max(hi2[0] - lo2[0], hi2[1] - lo2[1]) > max_pixels:
+            result = 1
+    split[q] = result
 
 
 @wp.func
@@ -529,20 +683,6 @@ def ring_density(
     if den <= 0.0:
         return 0.0
     return num / den
-
-
-@wp.func
-def corner_offset(half: int, corner: int) -> wp.vec2i:
-    """Lattice offset (dx, dy) of a triangle corner in its quad (kernels/floor.py quad_corner)."""
-    if corner == 0:
-        return wp.vec2i(0, 0)
-    if half == 0:
-        if corner == 1:
-            return wp.vec2i(1, 0)
-        return wp.vec2i(1, 1)
-    if corner == 1:
-        return wp.vec2i(1, 1)
-    return wp.vec2i(0, 1)
 
 
 @wp.func

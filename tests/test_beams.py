@@ -11,6 +11,7 @@ import warp as wp
 from test_photons import shaft_block
 
 import warpcaustics as wc
+from warpcaustics.errors import ConfigError
 from warpcaustics.kernels import beams as beam_kernels
 
 from conftest import fresnel_t_angles
@@ -381,3 +382,79 @@ def test_both_methods_write_both_results_and_their_difference(tmp_path):
     l1 = np.abs(result.floor_irradiance - other.floor_irradiance).sum() / np.abs(other.floor_irradiance).sum()
     assert entry["floor_relative_l1_beams_vs_photons"] == pytest.approx(l1, rel=1e-5)
     assert "frame_0000_beams_minus_photons.exr" in entry["files"]
+
+
+def test_adaptive_beams_refine_where_the_light_bends_and_keep_the_flux():
+    """caustics.beam_levels (Liktor & Dachsbacher 2011 §4.2): still water needs no refinement (every
+    leaf stays at the top level and the floor is still analytic); a zero tolerance refines
+    everything and gives back the uniform grid's map exactly; in between, fewer beams than the
+    uniform grid carry all the flux, and the map error shrinks as the tolerance does."""
+    flat = wc.Renderer(_flat(55.0, 3.0, **{"caustics.beam_levels": 3, "water.resolution": 64}), "cpu")
+    r = flat.render(0.0)
+    assert flat.beams.level_counts[3] == (64 // 8) ** 2 and r.beam_stats["beams"] == 2 * 8 * 8
+    expected = _flat_floor_irradiance(r, 55.0, 3.0)
+    np.testing.assert_allclose(
+        r.floor_irradiance, np.broadcast_to(expected[:, None, None], r.floor_irradiance.shape), rtol=2e-5
+    )
+
+    base = {
+        **BEAMS,
+        "water.resolution": 128,
+        "caustics.map_resolution": 64,
+        "optics.wavelengths": "rgb",
+        "optics.water_type": "none",
+    }
+    uniform = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
+    l1, counts = [], []
+    for tol in (0.0, 0.1, 1.0):
+        r = wc.render(
+            wc.load_scene(
+                "configs/ocean.toml", {**base, "caustics.beam_levels": 2, "caustics.beam_tolerance": tol}
+            ),
+            device="cpu",
+        )
+        np.testing.assert_allclose(r.floor_flux_w_nm, r.transmitted_flux_w_nm, rtol=1e-4)
+        l1.append(
+            np.abs(r.floor_irradiance - uniform.floor_irradiance).sum() / uniform.floor_irradiance.sum()
+        )
+        counts.append(r.beam_stats["beams"])
+    assert l1[0] == 0.0 and counts[0] == uniform.beam_stats["beams"]
+    assert l1[0] < l1[1] < l1[2] and counts[0] > counts[1] > counts[2]
+
+
+def test_adaptive_beams_refine_near_the_camera_and_refuse_what_they_cannot_do():
+    """Near the camera a quad is split until its beam spans at most 16 pixels; walled pools, the
+    smooth interpolation and resolutions not divisible by 2^levels are refused in one line."""
+    overrides = {
+        "caustics.beam_levels": 3,
+        "water.resolution": 64,
+        "caustics.beam_tolerance": 1e6,
+        "caustics.shafts": False,
+    }
+    far = wc.Renderer(_flat(70.0, 3.0, **overrides), "cpu")
+    far.render(0.0)
+    near = wc.Renderer(
+        _flat(
+            70.0,
+            3.0,
+            **overrides,
+            **{
+                "camera.enabled": True,
+                "camera.position_m": [0.0, 0.0, -0.5],
+                "camera.look_at_m": [1.0, 0.0, -1.0],
+                "camera.width": 64,
+                "camera.height": 48,
+            },
+        ),
+        "cpu",
+    )
+    near.render(0.0)
+    assert far.beams.leaf_count == 64 and near.beams.leaf_count > far.beams.leaf_count
+    assert near.beams.level_counts[0] > 0
+    for bad, match in (
+        ({"water.model": "pool"}, "needs a periodic sea"),
+        ({"caustics.beam_interpolation": "smooth"}, "needs the uniform grid"),
+        ({"water.resolution": 36}, "divisible by 8"),
+    ):
+        with pytest.raises(ConfigError, match=match):
+            wc.load_scene(None, {**BEAMS, "caustics.beam_levels": 3, **bad})

@@ -31,6 +31,12 @@ congruent sub-triangles (a face cut by a shadow or the water line is integrated 
 FACE_SAMPLES = FACE_SUBDIVISIONS**2
 
 SCREEN_TILE_PIXELS = 8
+
+REFINE_END_JUMP = 0.1
+"""An adaptive quad is split where its corners' lengths to the receivers differ by more than 10 %."""
+
+REFINE_MAX_PIXELS = 16.0
+"""An adaptive quad is split where its beam covers more than this many pixels of the camera."""
 """Side of a screen tile of the volume-caustics rasteriser [pixels]."""
 
 
@@ -273,6 +279,29 @@ class BeamCaustics:
         """Whether anything but a flat floor can shadow a receiver point (then shadow rays decide)."""
         lo, hi = receivers.bounds()
         self.query_z = (float(lo[2]), float(hi[2]))
+        self.levels = cfg.caustics.beam_levels
+        quads = self.quads
+        uniform = np.stack(np.meshgrid(np.arange(quads), np.arange(quads)), -1).reshape(-1, 2)
+        self.uniform_leaves = wp.array(
+            np.concatenate([uniform, np.zeros((len(uniform), 1), int)], 1).astype(np.int32),
+            dtype=wp.vec3i,
+            device=device,
+        )
+        """Every quad at level 0, row-major: the uniform grid."""
+        self.leaf_count = quads * quads
+        self.camera = None
+        """The camera whose screen footprint the refinement limits (set by the renderer)."""
+        if self.levels and n % (1 << self.levels):
+            from warpcaustics.errors import ConfigError
+
+            raise ConfigError(
+                f"caustics.beam_levels = {self.levels} needs a water resolution divisible by "
+                f"{1 << self.levels} (it is {n}); lower caustics.beam_levels"
+            )
+        if self.levels:
+            self.vertex_direction = wp.empty((n, n), dtype=wp.vec3, device=device)
+            self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
+            self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
 
     # --- per frame --------------------------------------------------------------------------
 
@@ -280,9 +309,14 @@ class BeamCaustics:
         """Build and bin the beams; fill :attr:`irradiance` (floor) and :attr:`face_flux`."""
         dev = self.device
         self.dropped.zero_()
+        leaves = self.uniform_leaves if not self.levels else self._refine(surface)
+        self.leaf_count = leaves.shape[0]
+        self.beams_per_group = 2 * self.leaf_count
+        if self.levels:
+            self.weight.zero_()  # slots past this frame's beams carry nothing
         wp.launch(
             beam_kernels.build_beams,
-            dim=(self.groups, self.quads, self.quads, 2),
+            dim=(self.groups, self.leaf_count, 2),
             inputs=[
                 surface.positions,
                 surface.normals,
@@ -293,7 +327,7 @@ class BeamCaustics:
                 int(self.periodic),
                 float(self.plane_z),
                 self.receivers.mesh.id,
-                self.quads,
+                leaves,
             ],
             outputs=[
                 self.base,
@@ -335,6 +369,73 @@ class BeamCaustics:
         if self.face_count:
             self.points(self.face_points, self.face_normals, self.face_ids, self.face_values)
         return self.irradiance
+
+    def _refine(self, surface: Surface) -> wp.array:
+        """Leaf quads (qx, qy, level) of the adaptive beams: from quads of 2^levels cells, split by
+        ``refine_quads`` level by level down to single cells. Leaves come sorted (level, then row),
+        so the beams do not depend on the order the device finds them in."""
+        dev = self.device
+        n = surface.resolution
+        wp.launch(
+            beam_kernels.vertex_rays,
+            dim=(n, n),
+            inputs=[
+                surface.positions,
+                surface.normals,
+                float(self.ior.numpy()[0]),
+                self.sun_dir,
+                self.extent_m,
+                float(self.plane_z),
+                self.receivers.mesh.id,
+            ],
+            outputs=[self.vertex_direction, self.vertex_length],
+            device=dev,
+        )
+        top = self.levels
+        q = n >> top
+        grid = np.stack(np.meshgrid(np.arange(q), np.arange(q)), -1).reshape(-1, 2)
+        active = np.concatenate([grid, np.full((len(grid), 1), top)], 1).astype(np.int32)
+        leaves = []
+        cam = self.camera
+        for level in range(top, 0, -1):
+            if not len(active):
+                break
+            quads = wp.array(active, dtype=wp.vec3i, device=dev)
+            split = wp.zeros(len(active), dtype=wp.int32, device=dev)
+            wp.launch(
+                beam_kernels.refine_quads,
+                dim=len(active),
+                inputs=[
+                    quads,
+                    surface.positions,
+                    self.vertex_direction,
+                    self.vertex_length,
+                    float(self.tolerance_m),
+                    REFINE_END_JUMP,
+                    self.extent_m,
+                    int(cam is not None),
+                    cam.cam if cam is not None else beam_kernels.PinholeCamera(),
+                    REFINE_MAX_PIXELS,
+                ],
+                outputs=[split],
+                device=dev,
+            )
+            cut = split.numpy().astype(bool)
+            leaves.append(active[~cut])
+            parents = active[cut]
+            children = [
+                np.stack(
+                    [2 * parents[:, 0] + dx, 2 * parents[:, 1] + dy, np.full(len(parents), level - 1)], 1
+                )
+                for dy in (0, 1)
+                for dx in (0, 1)
+            ]
+            active = np.concatenate(children).astype(np.int32) if len(parents) else active[:0]
+        leaves.append(active)
+        ordered = np.concatenate(leaves)
+        ordered = ordered[np.lexsort((ordered[:, 0], ordered[:, 1], -ordered[:, 2]))]
+        self.level_counts = {int(lv): int(np.count_nonzero(ordered[:, 2] == lv)) for lv in range(top + 1)}
+        return wp.array(ordered, dtype=wp.vec3i, device=dev)
 
     def _beam_inputs(self) -> list:
         return [
@@ -400,8 +501,9 @@ class BeamCaustics:
 
     def transmitted_flux(self) -> np.ndarray:
         """(K,) flux the beams carry into the water before attenuation [W nm^-1] (float64)."""
-        w = self.weight.numpy().astype(np.float64)
-        t = self.transmit.numpy().astype(np.float64).mean(axis=1)
+        used = self.groups * self.beams_per_group  # adaptive beams fill only part of the buffers
+        w = self.weight.numpy()[:used].astype(np.float64)
+        t = self.transmit.numpy()[:used].astype(np.float64).mean(axis=1)
         per_group = (w * t).reshape(self.groups, -1).sum(axis=1)
         e = self.sun_irradiance.numpy().astype(np.float64)
         return e * np.repeat(per_group, len(e) // self.groups)
@@ -409,7 +511,7 @@ class BeamCaustics:
     def stats(self) -> BeamStats:
         w = self.weight.numpy()
         return BeamStats(
-            beams=len(w),
+            beams=self.groups * self.beams_per_group,
             carrying=int(np.count_nonzero(w > 0)),
             dropped=int(self.dropped.numpy()[0]),
             tile_entries=(self.floor_bins or self.point_bins).entries,

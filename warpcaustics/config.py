@@ -338,6 +338,12 @@ class CausticsConfig:
     own section, as the flux-ratio map; triangle facets can show in close-ups) or ``smooth`` (after
     Ernst et al. 2005: per-vertex wave-front densities of the surrounding beams interpolated across
     each beam, continuous from beam to beam but blurred over about two surface cells)."""
+    beam_levels: int = field(default=0, metadata=_range(0, 4))
+    """Adaptive beams (Liktor & Dachsbacher 2011 §4.2): start from quads of 2^beam_levels surface
+    cells and split where needed down to single cells; 0 = one beam pair per cell (uniform) [-]."""
+    beam_tolerance: float = field(default=0.25, metadata=_range(0.0, None))
+    """Split an adaptive quad where a vertex's refracted ray, followed to its receiver, misses the
+    quad's interpolated ray by more than this many surface cells [-]."""
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""
@@ -610,8 +616,27 @@ def _check_periodic_floor(cfg: Config) -> None:
                 f"floor.ripple_direction_deg = {direction:.12g}")
 
 
+def _check_beam_levels(cfg: Config) -> None:
+    """Adaptive beams refine quads of 2^levels cells of a periodic sea."""
+    levels = cfg.caustics.beam_levels
+    if not levels:
+        return
+    if cfg.water.walled:
+        raise ConfigError(f"caustics.beam_levels = {levels} needs a periodic sea (water.model fft, flat "
+                          f"or heightfield), not the walled {cfg.water.model.value!r}; set "
+                          "caustics.beam_levels = 0")
+    n = cfg.water.resolution
+    if n is not None and n % (1 << levels):
+        raise ConfigError(f"caustics.beam_levels = {levels} needs water.resolution divisible by "
+                          f"{1 << levels} (it is {n}); lower caustics.beam_levels or change water.resolution")
+    if cfg.caustics.beam_interpolation is BeamInterpolation.SMOOTH:
+        raise ConfigError("caustics.beam_interpolation = 'smooth' needs the uniform grid of beams; set "
+                          "caustics.beam_levels = 0 or caustics.beam_interpolation = 'flat'")
+
+
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
+    _check_beam_levels(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []
     if cfg.floor.shape is not FloorShape.FLAT:

@@ -232,6 +232,8 @@ class Renderer:
                     self.camera = UnderwaterCamera(cfg.camera, self.receivers, optics.scattering_per_m,
                                                    PhaseFunction.from_optics(cfg.optics, self.device),
                                                    self.device)
+                    if self.beams is not None:
+                        self.beams.camera = self.camera  # adaptive beams refine near it
             else:
                 self.floor_top_z = -cfg.floor.depth_m
                 self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
