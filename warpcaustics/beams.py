@@ -45,10 +45,18 @@ def beam_count(n: int, groups: int, periodic: bool) -> int:
     return groups * quads * quads * 2
 
 
-def texels_per_tile(m: int) -> int:
-    """Floor texels per side of a horizontal tile: the largest of 8, 4, 2, 1 that divides M (the
-    tiles must tile a periodic patch exactly)."""
-    return next(t for t in (8, 4, 2, 1) if m % t == 0)
+TILE_CELLS = 2
+"""A horizontal tile spans about this many surface cells: a beam's section (about a cell, more or
+less as the light focuses or spreads) touches few tiles, and a tile's list stays short."""
+
+
+def texels_per_tile(m: int, n: int) -> int:
+    """Floor texels per side of a horizontal tile: the largest power of two up to TILE_CELLS surface
+    cells (N per side) that divides M (the tiles must tile a periodic patch exactly)."""
+    t = 1
+    while t * 2 <= max(TILE_CELLS * m / n, 1.0) and m % (t * 2) == 0:
+        t *= 2
+    return t
 
 
 def beams_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int) -> int:
@@ -139,16 +147,16 @@ class BeamStats:
     """Entries of the floor's horizontal tile lists (beam × tile pairs)."""
 
 
-def _horizontal_grid(extent_m: float, m: int, periodic: bool) -> tuple[beam_kernels.TileGrid, int]:
-    tpt = texels_per_tile(m)
+def _horizontal_grid(extent_m: float, tiles: int, periodic: bool) -> beam_kernels.TileGrid:
+    """tiles × tiles tiles over the patch (wrapping on a periodic sea)."""
     grid = beam_kernels.TileGrid()
     grid.origin = wp.vec2(-0.5 * extent_m, -0.5 * extent_m)
-    size = extent_m * tpt / m
+    size = extent_m / tiles
     grid.size = wp.vec2(size, size)
-    grid.nx = m // tpt
-    grid.ny = m // tpt
+    grid.nx = tiles
+    grid.ny = tiles
     grid.wrap = int(periodic)
-    return grid, tpt
+    return grid
 
 
 def floor_samples(cfg: Config, relief: np.ndarray | None, texel_area_m2: np.ndarray):
@@ -248,11 +256,13 @@ class BeamCaustics:
         """A⊥ per beam [m²] (0: dropped)."""
         self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
         self.dropped = wp.zeros(1, dtype=wp.int32, device=device)
-        grid, self.texels_per_tile = _horizontal_grid(self.extent_m, m, periodic)
+        self.texels_per_tile = texels_per_tile(m, n)
+        floor_grid = _horizontal_grid(self.extent_m, m // self.texels_per_tile, periodic)
+        point_grid = _horizontal_grid(self.extent_m, max(n // TILE_CELLS, 1), periodic)
         self.flat_floor = cfg.floor.shape is FloorShape.FLAT
-        self.floor_bins = TileBins(grid, count, device) if self.flat_floor else None
+        self.floor_bins = TileBins(floor_grid, count, device) if self.flat_floor else None
         """Bins of the floor's sections only (flat floor: the clipped-texel map)."""
-        self.point_bins = TileBins(grid, count, device)
+        self.point_bins = TileBins(point_grid, count, device)
         """Bins of each beam's whole length (receiver points at any height)."""
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
