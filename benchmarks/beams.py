@@ -663,33 +663,34 @@ def _stage_time(n: int, m: int, device: str, repeats: int) -> dict:
     }
 
 
-def _adaptive_rows(n: int, m: int, device: str, repeats: int) -> list[dict]:
-    """Adaptive beams (caustics.beam_levels) against the uniform grid on ocean.toml: beams, stage time
-    and the floor map's relative L1 from the uniform grid's, for a range of tolerances; the coarse
-    uniform grids (every quad kept at level 1 or 2: tolerance ∞) are the equal-cost baselines."""
+def _adaptive_rows(config: str, overrides: dict, levels: int, device: str, repeats: int) -> list[dict]:
+    """Adaptive beams (caustics.beam_levels) against the uniform grid: beams, frame time and the
+    floor map's relative L1 from the uniform grid's, for a range of tolerances; the coarse uniform
+    grids (every quad kept at level 1, 2, …: tolerance ∞) are the baselines at equal beam counts."""
     import warpcaustics as wc
 
-    base = {"caustics.method": "beams", "water.resolution": n, "caustics.map_resolution": m,
-            "optics.wavelengths": WAVELENGTHS, "optics.water_type": "none"}
+    base = {"caustics.method": "beams", "optics.wavelengths": WAVELENGTHS, "optics.water_type": "none",
+            **overrides}
     rows = []
     reference = None
-    cases = [(0, 0.0)] + [(2, t) for t in (0.05, 0.1, 0.25, 0.5, 1.0)] + [(1, 1e30), (2, 1e30)]
-    for levels, tol in cases:
-        renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / "ocean.toml", {
-            **base, "caustics.beam_levels": levels, "caustics.beam_tolerance": tol}), device)
-        result = renderer.render(0.0)
+    cases = ([(0, 0.0)] + [(levels, t) for t in (0.05, 0.1, 0.25, 0.5, 1.0)]
+             + [(lv, 1e30) for lv in range(1, levels + 1)])
+    for lv, tol in cases:
+        renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / config, {
+            **base, "caustics.beam_levels": lv, "caustics.beam_tolerance": tol}), device)
+        renderer.render(0.0)  # warm-up
         s = _median_time(lambda renderer=renderer: renderer.render(0.0), repeats)
         result = renderer.render(0.0)
         if reference is None:
             reference = result.floor_irradiance.astype(np.float64)
         l1 = relative_l1(reference, result.floor_irradiance)
-        label = "uniform" if levels == 0 else (f"uniform x{1 << levels} cells" if tol > 1e20 else
-                                               f"adaptive L={levels} tol={tol:g}")
-        rows.append({"case": label, "beam_levels": levels, "beam_tolerance": None if tol > 1e20 else tol,
-                     "beams": result.beam_stats["beams"], "frame_s": s,
-                     "beams_stage_s": result.timings_s["beams"], "relative_l1_vs_uniform": l1})
-        print(f"beams        {label:28s} {rows[-1]['beams']:8d} beams | frame {s * 1e3:8.1f} ms | L1 vs "
-              f"uniform {l1:.2e}", flush=True)
+        label = "uniform" if lv == 0 else (f"uniform x{1 << lv} cells" if tol > 1e20 else
+                                           f"adaptive L={lv} tol={tol:g}")
+        rows.append({"config": config, "case": label, "beam_levels": lv,
+                     "beam_tolerance": None if tol > 1e20 else tol, "beams": result.beam_stats["beams"],
+                     "frame_s": s, "beams_stage_s": result.timings_s["beams"], "relative_l1_vs_uniform": l1})
+        print(f"beams        {config:11s} {label:24s} {rows[-1]['beams']:8d} beams | frame {s * 1e3:8.1f} ms "
+              f"| L1 vs uniform {l1:.2e}", flush=True)
     return rows
 
 
@@ -741,7 +742,11 @@ def run(quick: bool, device: str) -> dict:
         print(f"  log-log slope of stage time vs {what}: {slope:.2f}")
         for r in rows:
             r[f"loglog_slope_vs_{key}"] = slope
-    adaptive = _adaptive_rows(sizes["adaptive_n"], sizes["adaptive_m"], device, warp_repeats)
+    adaptive = _adaptive_rows("ocean.toml", {"water.resolution": sizes["adaptive_n"],
+                                             "caustics.map_resolution": sizes["adaptive_m"]}, 2, device,
+                              warp_repeats)
+    adaptive += _adaptive_rows("lens.toml", {} if not quick else {"caustics.map_resolution": 64}, 3, device,
+                               warp_repeats)
     return {
         "adaptive_vs_uniform": adaptive,
         "benchmark": "beam_rasteriser",

@@ -59,9 +59,12 @@ def texels_per_tile(m: int, n: int) -> int:
     return t
 
 
-def beams_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int) -> int:
+def beams_bytes(
+    cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int, sampled_faces: int
+) -> int:
     """Device memory of the beam stage, receivers and floor map included (not the tile lists, whose
-    length depends on the frame: about one entry per beam and tile it touches) [bytes]."""
+    length depends on the frame: about one entry per beam and tile it touches) [bytes].
+    ``face_count``: faces of the receivers' BVH; ``sampled_faces``: those that are not floor."""
     m = cfg.caustics.map_resolution
     beams = beam_count(n, groups, periodic)
     relief = cfg.floor.shape is not FloorShape.FLAT
@@ -70,9 +73,11 @@ def beams_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_c
         beams * BEAM_BYTES
         + 2 * k * m * m * 4
         + samples * (k * 4 + 12 + 12 + 4 + 4)
-        + face_count * (k * 4 + 64 + FACE_SAMPLES * (k * 4 + 28))
+        + face_count * 84
+        + sampled_faces * (k * 4 + FACE_SAMPLES * (k * 4 + 28))
         + n * n * 4
         + 8 * beams
+        + (beams * (9 if periodic else 1) * 44 if cfg.camera.enabled else 0)  # screen spans and boxes
     )
 
 

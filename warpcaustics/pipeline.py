@@ -150,7 +150,9 @@ def scene_bytes(scene: Scene) -> int:
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
         stage = 0
         if cfg.caustics.method in (CausticsMethod.BEAMS, CausticsMethod.BOTH):
-            stage += beams.beams_bytes(cfg, n, k, groups, periodic, faces)
+            walls = 0 if periodic else 4 * 2 * 32 * 8
+            sampled = sum(len(m.triangles) for m in scene.receiver_meshes) + walls
+            stage += beams.beams_bytes(cfg, n, k, groups, periodic, faces, sampled)
         if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
             stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
         return water_bytes(cfg, n) + stage + cam
