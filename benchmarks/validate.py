@@ -279,9 +279,6 @@ def _camera_floor() -> None:
     print(f"max |L π / (albedo E) - 1| over {seen.sum()} pixels: {err:.1e}")
 
 
-if __name__ == "__main__":
-    sys.exit(main())
-
 
 def _beams() -> None:
     """Beam caustics: the figures of docs/validation.md's beam section."""
@@ -359,3 +356,7 @@ def _beams() -> None:
             measured, expected = shaft_block(pitch, sees, n, method="beams")
             print(f"{n}² surface, {view}: block mean / analytic - 1 per band: "
                   + ", ".join(f"{x - 1:+.1e}" for x in measured / expected))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
