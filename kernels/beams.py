@@ -356,6 +356,68 @@ def barycentrics(a: wp.vec2, b: wp.vec2, c: wp.vec2, p: wp.vec2) -> wp.vec3:
 
 
 @wp.func
+def edge_function(p: wp.vec2, q: wp.vec2, x: wp.vec2) -> float:
+    """cross(q − p, x − p), computed from the lexicographically smaller end point so that the two
+    triangles sharing an edge get exactly opposite values (a watertight inside test)."""
+    if p[0] > q[0] or (p[0] == q[0] and p[1] > q[1]):
+        return -cross2(p - q, x - q)
+    return cross2(q - p, x - p)
+
+
+@wp.func
+def owns_edge(p: wp.vec2, q: wp.vec2, orientation: float) -> bool:
+    """Tie-break for points exactly on edge p → q of a triangle of the given orientation (sign of
+    its area): the edge belongs to the triangle if, walked counter-clockwise, it points down, or
+    left when horizontal; the neighbour walks it the other way, so exactly one of them owns it."""
+    e = (q - p) * orientation
+    return e[1] < 0.0 or (e[1] == 0.0 and e[0] < 0.0)
+
+
+@wp.func
+def inside_triangle(a: wp.vec2, b: wp.vec2, c: wp.vec2, x: wp.vec2):
+    """(inside, barycentrics) of x in triangle (a, b, c), either orientation. Points on an edge
+    shared by two triangles count in exactly one of them (``owns_edge``), so neighbouring beams
+    neither double-count nor miss a sample on their common edge."""
+    det = cross2(b - a, c - a)
+    if det == 0.0:
+        return False, wp.vec3(-1.0, 0.0, 0.0)
+    o = wp.sign(det)
+    e0 = edge_function(b, c, x) * o
+    e1 = edge_function(c, a, x) * o
+    e2 = edge_function(a, b, x) * o
+    inside = True
+    if e0 < 0.0 or e1 < 0.0 or e2 < 0.0:
+        inside = False
+    if e0 == 0.0 and not owns_edge(b, c, o):
+        inside = False
+    if e1 == 0.0 and not owns_edge(c, a, o):
+        inside = False
+    if e2 == 0.0 and not owns_edge(a, b, o):
+        inside = False
+    return inside, wp.vec3(e0, e1, e2) / wp.abs(det)
+
+
+MAX_COPIES_PER_AXIS = 64
+"""A section wider than this many periods of the patch (a beam of near-horizontal rays) is gathered
+in its MAX_COPIES_PER_AXIS central copies per axis only."""
+
+
+@wp.func
+def copy_range(lo: float, hi: float, a: float, width: float, extent_m: float, periodic: int):
+    """Whole periods k for which the interval [a + k L, a + k L + width] meets [lo, hi] (k = 0 only
+    on a walled pool), at most MAX_COPIES_PER_AXIS of them; an empty range has k1 < k0."""
+    if periodic == 0:
+        return 0, 0
+    k0 = wp.ceil((lo - a - width) / extent_m)
+    k1 = wp.floor((hi - a) / extent_m)
+    if k1 - k0 >= float(MAX_COPIES_PER_AXIS):
+        mid = wp.floor(0.5 * (k0 + k1))
+        k0 = mid - float(MAX_COPIES_PER_AXIS / 2)
+        k1 = k0 + float(MAX_COPIES_PER_AXIS - 1)
+    return int(k0), int(k1)
+
+
+@wp.func
 def period_shift(target: wp.vec2, p: wp.vec2, extent_m: float, periodic: int) -> wp.vec2:
     """The whole-period shift that moves p nearest to target (zero on a walled pool)."""
     if periodic == 0:
@@ -400,8 +462,10 @@ def sample_beam(
     d1 = direction[b, 1]
     d2 = direction[b, 2]
     z = p[2]
-    lam = barycentrics(section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p))
-    if lam[0] < 0.0 or lam[1] < 0.0 or lam[2] < 0.0:
+    inside, lam = inside_triangle(
+        section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p)
+    )
+    if not inside:
         return out
     l0 = (v0[2] - z) / -d0[2]
     l1 = (v1[2] - z) / -d1[2]
@@ -783,27 +847,35 @@ def point_irradiance(
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
-        anchor = section_vertex(base[b, 0], direction[b, 0], p[2])
-        shift = period_shift(anchor, xy(p), extent_m, periodic)
-        q = p + wp.vec3(shift[0], shift[1], 0.0)
-        s = sample_beam(base, direction, transmit, ends, area_coef, b, q)
-        if s.inside == 0:
-            continue
-        if not lit(mesh, occluders, s, q):
-            continue
-        cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
-        add_beam_irradiance(
-            out,
-            p_index,
-            cos_factor,
-            b,
-            s,
-            flux_density(weight, transmit, area_coef, base, b, s, q[2], quads, periodic, smooth),
-            beams_per_group,
-            wavelengths_per_group,
-            sun_irradiance,
-            attenuation_per_m,
-        )
+        s0 = section_vertex(base[b, 0], direction[b, 0], p[2])
+        s1 = section_vertex(base[b, 1], direction[b, 1], p[2])
+        s2 = section_vertex(base[b, 2], direction[b, 2], p[2])
+        lo = wp.min(wp.min(s0, s1), s2)
+        hi = wp.max(wp.max(s0, s1), s2)
+        kx0, kx1 = copy_range(lo[0], hi[0], p[0], 0.0, extent_m, periodic)
+        ky0, ky1 = copy_range(lo[1], hi[1], p[1], 0.0, extent_m, periodic)
+        for ky in range(ky0, ky1 + 1):
+            for kx in range(kx0, kx1 + 1):  # every periodic copy of the point the section may hold
+                q = p + wp.vec3(float(kx) * extent_m, float(ky) * extent_m, 0.0)
+                s = sample_beam(base, direction, transmit, ends, area_coef, b, q)
+                if s.inside == 0:
+                    continue
+                if not lit(mesh, occluders, s, q):
+                    continue
+                cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
+                density = flux_density(weight, transmit, area_coef, base, b, s, q[2], quads, periodic, smooth)
+                add_beam_irradiance(
+                    out,
+                    p_index,
+                    cos_factor,
+                    b,
+                    s,
+                    density,
+                    beams_per_group,
+                    wavelengths_per_group,
+                    sun_irradiance,
+                    attenuation_per_m,
+                )
 
 
 @wp.func
@@ -844,8 +916,37 @@ def clamped_sample(
     return out
 
 
+@wp.func
+def clip_side(px: vec8, py: vec8, count: int, nx: float, ny: float, c: float):
+    """Sutherland–Hodgman step: keep the part of polygon (px, py) where nx x + ny y + c >= 0."""
+    qx = vec8()
+    qy = vec8()
+    m = int(0)
+    for j in range(count):
+        jn = (j + 1) % count
+        sa = nx * px[j] + ny * py[j] + c
+        sb = nx * px[jn] + ny * py[jn] + c
+        if sa >= 0.0:
+            qx[m] = px[j]
+            qy[m] = py[j]
+            m += 1
+        if (sa >= 0.0) != (sb >= 0.0):
+            t = sa / (sa - sb)
+            qx[m] = px[j] + t * (px[jn] - px[j])
+            qy[m] = py[j] + t * (py[jn] - py[j])
+            m += 1
+    return qx, qy, m
+
+
+@wp.func
+def plane_cut(v: wp.vec3, d: wp.vec3, a: wp.vec3, n: wp.vec3) -> wp.vec2:
+    """(x, y) where the edge line v + t d meets the plane through a with normal n."""
+    t = wp.dot(a - v, n) / wp.dot(d, n)
+    return xy(v + t * d)
+
+
 @wp.kernel
-def flat_floor_texels(
+def floor_texels(
     grid: TileGrid,
     tile_start: wp.array[wp.int32],
     tile_count: wp.array[wp.int32],
@@ -867,13 +968,18 @@ def flat_floor_texels(
     occluders: int,
     quads: int,
     smooth: int,
-    floor_z: float,
+    corner_z: wp.array2d[wp.float32],
+    texel_area_m2: wp.array2d[wp.float32],
     out: wp.array2d[wp.float32],
 ):
-    """Irradiance of each texel of a flat floor at z = floor_z (K, M·M) [W m^-2 nm^-1]: every beam
-    section is clipped exactly against the texel square and contributes its flux density at the
-    clipped piece's centroid times the piece's area share (exact for the barycentric-linear
-    transmittance, so flux is conserved to rounding)."""
+    """Irradiance on the floor's true area over each texel (K, M·M) [W m^-2 nm^-1]. The floor over a
+    texel is the two planar triangles on its corners (heights ``corner_z``, (M+1)², as the floor
+    mesh; a flat floor is one plane). For each beam of the texel's tile and each triangle, the
+    beam's three edge lines cut the triangle's plane in a triangle, which is clipped exactly
+    against the triangle's footprint (Sutherland–Hodgman). ``flat``: the piece gets the share of the
+    beam's flux that its area is of the cut, with the transmittance at its area centroid (exact for
+    the barycentric-linear transmittance: flux is conserved to rounding, on a relief too);
+    ``smooth``: the interpolated irradiance on the plane at the centroid times the piece's area."""
     ty, tx = wp.tid()
     m = texels_per_tile * grid.nx
     texel_m = extent_m / float(m)
@@ -882,74 +988,120 @@ def flat_floor_texels(
         out[k, point] = 0.0
     t = tile_index(grid, tx / texels_per_tile, ty / texels_per_tile)
     corner = wp.vec2(float(tx) * texel_m - 0.5 * extent_m, float(ty) * texel_m - 0.5 * extent_m)
-    centre = corner + wp.vec2(0.5 * texel_m)
+    za = corner_z[ty, tx]
+    zb = corner_z[ty, tx + 1]
+    zc = corner_z[ty + 1, tx]
+    zd = corner_z[ty + 1, tx + 1]
+    flat = za == zb and za == zc and za == zd
+    pieces = 2
+    if flat:
+        pieces = 1
+    inv_area = 1.0 / texel_area_m2[ty, tx]
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
-        q0 = section_vertex(base[b, 0], direction[b, 0], floor_z)
-        q1 = section_vertex(base[b, 1], direction[b, 1], floor_z)
-        q2 = section_vertex(base[b, 2], direction[b, 2], floor_z)
-        shift = period_shift(q0, centre, extent_m, periodic)
-        origin = corner + shift
-        px = vec8()
-        py = vec8()
-        px[0] = (q0[0] - origin[0]) / texel_m
-        py[0] = (q0[1] - origin[1]) / texel_m
-        px[1] = (q1[0] - origin[0]) / texel_m
-        py[1] = (q1[1] - origin[1]) / texel_m
-        px[2] = (q2[0] - origin[0]) / texel_m
-        py[2] = (q2[1] - origin[1]) / texel_m
-        cx, cy, cn = clip_to_slab(px, py, 3, 0, 0.0, 1.0)
-        if cn < 3:
-            continue
-        rx, ry, rn = clip_to_slab(cx, cy, cn, 1, 0.0, 1.0)
-        if rn < 3:
-            continue
-        share = polygon_area(rx, ry, rn)  # of the texel
-        if share <= 0.0:
-            continue
-        mx = float(0.0)
-        my = float(0.0)
-        for v in range(rn):
-            mx += rx[v]
-            my += ry[v]
-        # The vertex mean lies inside the convex piece; for a linear integrand the exact centroid
-        # matters, so use the area centroid.
-        ax = float(0.0)
-        ay = float(0.0)
-        a2 = float(0.0)
-        for v in range(rn):
-            vn = (v + 1) % rn
-            cr = rx[v] * ry[vn] - rx[vn] * ry[v]
-            a2 += cr
-            ax += (rx[v] + rx[vn]) * cr
-            ay += (ry[v] + ry[vn]) * cr
-        if wp.abs(a2) > 1.0e-12:
-            mx = ax / (3.0 * a2)
-            my = ay / (3.0 * a2)
-        else:
-            mx = mx / float(rn)
-            my = my / float(rn)
-        p = wp.vec3(origin[0] + mx * texel_m, origin[1] + my * texel_m, floor_z)
-        s = sample_beam(base, direction, transmit, ends, area_coef, b, p)
-        lam_ok = s.inside
-        if lam_ok == 0:
-            # The centroid sits on the section's boundary to rounding: take the clamped barycentrics.
-            s = clamped_sample(base, direction, transmit, ends, area_coef, b, p)
-        if not lit(mesh, occluders, s, p):
-            continue
-        add_beam_irradiance(
-            out,
-            point,
-            share,
-            b,
-            s,
-            flux_density(weight, transmit, area_coef, base, b, s, floor_z, quads, periodic, smooth),
-            beams_per_group,
-            wavelengths_per_group,
-            sun_irradiance,
-            attenuation_per_m,
-        )
+        for piece in range(pieces):
+            # Triangle (a, b, d) below the diagonal a→d (x ≥ y in texel units), (a, d, c) above it.
+            a3 = wp.vec3(corner[0], corner[1], za)
+            n = wp.vec3(0.0, 0.0, 1.0)
+            if not flat:
+                d3 = wp.vec3(corner[0] + texel_m, corner[1] + texel_m, zd)
+                if piece == 0:
+                    n = wp.normalize(wp.cross(wp.vec3(corner[0] + texel_m, corner[1], zb) - a3, d3 - a3))
+                else:
+                    n = wp.normalize(wp.cross(d3 - a3, wp.vec3(corner[0], corner[1] + texel_m, zc) - a3))
+            q0 = plane_cut(base[b, 0], direction[b, 0], a3, n)
+            q1 = plane_cut(base[b, 1], direction[b, 1], a3, n)
+            q2 = plane_cut(base[b, 2], direction[b, 2], a3, n)
+            lo = wp.min(wp.min(q0, q1), q2)
+            hi = wp.max(wp.max(q0, q1), q2)
+            kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, extent_m, periodic)
+            ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, extent_m, periodic)
+            for ky in range(ky0, ky1 + 1):
+                for kx in range(kx0, kx1 + 1):  # every periodic copy of the texel the cut may cover
+                    shift = wp.vec2(float(kx) * extent_m, float(ky) * extent_m)
+                    origin = corner + shift
+                    px = vec8()
+                    py = vec8()
+                    px[0] = (q0[0] - origin[0]) / texel_m
+                    py[0] = (q0[1] - origin[1]) / texel_m
+                    px[1] = (q1[0] - origin[0]) / texel_m
+                    py[1] = (q1[1] - origin[1]) / texel_m
+                    px[2] = (q2[0] - origin[0]) / texel_m
+                    py[2] = (q2[1] - origin[1]) / texel_m
+                    cx, cy, cn = clip_to_slab(px, py, 3, 0, 0.0, 1.0)
+                    if cn < 3:
+                        continue
+                    rx, ry, rn = clip_to_slab(cx, cy, cn, 1, 0.0, 1.0)
+                    if rn < 3:
+                        continue
+                    if not flat:
+                        if piece == 0:
+                            rx, ry, rn = clip_side(rx, ry, rn, 1.0, -1.0, 0.0)
+                        else:
+                            rx, ry, rn = clip_side(rx, ry, rn, -1.0, 1.0, 0.0)
+                        if rn < 3:
+                            continue
+                    share = polygon_area(rx, ry, rn)  # of the texel's horizontal area
+                    if share <= 0.0:
+                        continue
+                    # Area centroid of the piece: exact for an integrand linear over it.
+                    ax = float(0.0)
+                    ay = float(0.0)
+                    a2 = float(0.0)
+                    mx = float(0.0)
+                    my = float(0.0)
+                    for v in range(rn):
+                        vn = (v + 1) % rn
+                        cr = rx[v] * ry[vn] - rx[vn] * ry[v]
+                        a2 += cr
+                        ax += (rx[v] + rx[vn]) * cr
+                        ay += (ry[v] + ry[vn]) * cr
+                        mx += rx[v]
+                        my += ry[v]
+                    if wp.abs(a2) > 1.0e-12:
+                        mx = ax / (3.0 * a2)
+                        my = ay / (3.0 * a2)
+                    else:
+                        mx = mx / float(rn)
+                        my = my / float(rn)
+                    x = corner[0] + mx * texel_m
+                    y = corner[1] + my * texel_m
+                    z = za + ((n[0] * (corner[0] - x) + n[1] * (corner[1] - y)) / n[2])
+                    p = wp.vec3(x + shift[0], y + shift[1], z)
+                    s = sample_beam(base, direction, transmit, ends, area_coef, b, p)
+                    if s.inside == 0:
+                        # The centroid sits on the section's boundary to rounding: clamp it in.
+                        s = clamped_sample(base, direction, transmit, ends, area_coef, b, p)
+                    if not lit(mesh, occluders, s, p):
+                        continue
+                    # The piece's flux over the texel's true area. Flat: the beam's flux w Σλ T spread
+                    # evenly over its cut through this plane (exact flux, as a section on a flat
+                    # floor). Smooth: its irradiance on the plane, E_h |d·n| / |d_z|, times the
+                    # piece's true area.
+                    scale = share * texel_m * texel_m * inv_area
+                    density = float(0.0)
+                    if smooth == 0:
+                        cut = 0.5 * wp.abs(cross2(q1 - q0, q2 - q0))
+                        density = weight[b] * s.transmit / wp.max(cut, MIN_AREA_FRACTION * s.area)
+                    else:
+                        cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
+                        scale = scale * cos_factor / n[2]
+                        density = flux_density(
+                            weight, transmit, area_coef, base, b, s, p[2], quads, periodic, smooth
+                        )
+                    add_beam_irradiance(
+                        out,
+                        point,
+                        scale,
+                        b,
+                        s,
+                        density,
+                        beams_per_group,
+                        wavelengths_per_group,
+                        sun_irradiance,
+                        attenuation_per_m,
+                    )
 
 
 # --- volume caustics: scan planes -----------------------------------------------------------------
@@ -1290,20 +1442,3 @@ def scan_plane_radiance(
     wp.atomic_add(pairs, 0, count)
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)
-
-
-@wp.kernel
-def reduce_samples(
-    samples: wp.array2d[wp.float32],
-    sample_weight: wp.array[wp.float32],
-    per_texel: int,
-    out: wp.array2d[wp.float32],
-):
-    """out[k, texel] = Σ_s samples[k, texel · per_texel + s] · sample_weight[…] (the floor map of a
-    relief from its sub-texel samples)."""
-    k, texel = wp.tid()
-    total = float(0.0)
-    for s in range(per_texel):
-        idx = texel * per_texel + s
-        total += samples[k, idx] * sample_weight[idx]
-    out[k, texel] = total

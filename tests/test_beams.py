@@ -299,7 +299,7 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform():
 def test_grazing_sun_folds_and_degenerate_beams_stay_finite():
     """A choppy ocean (folding surface, inverted and degenerate beams) under a grazing sun, seen by
     the camera with shafts: everything stays finite, beams facing away are dropped and counted,
-    and the floor never gets more flux than entered the water."""
+    and the floor gets the flux that entered the water."""
     scene = wc.load_scene(
         "configs/ocean_floor.toml",
         {
@@ -323,7 +323,9 @@ def test_grazing_sun_folds_and_degenerate_beams_stay_finite():
     assert result.fold_fraction > 0.0
     assert result.beam_stats["dropped"] > 0
     assert np.isfinite(result.floor_irradiance).all() and np.isfinite(result.camera_radiance).all()
-    assert np.all(result.floor_flux_w_nm <= result.transmitted_flux_w_nm * (1 + 1e-4))
+    # Sections of near-horizontal rays span many periods: every copy is gathered, so the flux stays
+    # (measured 5.4e-5 short, as the flux-ratio map's 4.4e-5).
+    np.testing.assert_allclose(result.floor_flux_w_nm, result.transmitted_flux_w_nm, rtol=1e-3)
 
 
 def test_smooth_interpolation_hides_beam_edges_and_keeps_the_flux():
@@ -458,3 +460,31 @@ def test_adaptive_beams_refine_near_the_camera_and_refuse_what_they_cannot_do():
     ):
         with pytest.raises(ConfigError, match=match):
             wc.load_scene(None, {**BEAMS, "caustics.beam_levels": 3, **bad})
+
+
+def test_beams_on_rippled_sand_keep_the_flux_and_agree_with_photons():
+    """Ripples that tile the patch under a rough ocean (water_type none, 64² surface, 64² map): each
+    texel's two mesh triangles are clipped exactly against the beams' cuts through their planes, so
+    the flux stays within the shadow decisions' rounding (a piece is lit or not as its centroid is),
+    and the map agrees with exact photons at 64 per cell (64 per texel). Measured: flux −3.7e-3,
+    L1 5.1 % (4.3 % against 256 photons per cell)."""
+    common = {
+        "water.resolution": 64,
+        "caustics.map_resolution": 64,
+        "optics.water_type": "none",
+        "optics.wavelengths": "rgb",
+        "floor.shape": "ripples",
+        "floor.ripple_amplitude_m": 0.1,
+        "floor.ripple_wavelength_m": 16.0 / np.hypot(7, 26),
+        "floor.ripple_direction_deg": np.degrees(np.arctan2(26, 7)),
+    }
+    beams = wc.render(wc.load_scene("configs/ocean.toml", {**common, **BEAMS}), device="cpu")
+    photons = wc.render(
+        wc.load_scene(
+            "configs/ocean.toml", {**common, "caustics.method": "photons", "caustics.photon_subdivisions": 8}
+        ),
+        device="cpu",
+    )
+    np.testing.assert_allclose(beams.floor_flux_w_nm, beams.transmitted_flux_w_nm, rtol=1e-2)
+    l1 = np.abs(beams.floor_irradiance - photons.floor_irradiance).sum() / photons.floor_irradiance.sum()
+    assert l1 < 0.08

@@ -21,9 +21,6 @@ from warpcaustics.water import Surface
 BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 2 * 12 + 4 + 12 + 16
 """Per beam: base vertices, directions, transmittances, edge ends, end plane, weight, A(z), span."""
 
-FLOOR_SAMPLES = 4
-"""A relief floor's map averages FLOOR_SAMPLES² point samples per texel (DESIGN: ≥ 4×4)."""
-
 FACE_SUBDIVISIONS = 4
 """Irradiance on a receiver face is the mean over the centroids of its FACE_SUBDIVISIONS²
 congruent sub-triangles (a face cut by a shadow or the water line is integrated to ~1/16)."""
@@ -67,12 +64,10 @@ def beams_bytes(
     ``face_count``: faces of the receivers' BVH; ``sampled_faces``: those that are not floor."""
     m = cfg.caustics.map_resolution
     beams = beam_count(n, groups, periodic)
-    relief = cfg.floor.shape is not FloorShape.FLAT
-    samples = m * m * FLOOR_SAMPLES**2 if relief else 0
     return (
         beams * BEAM_BYTES
         + 2 * k * m * m * 4
-        + samples * (k * 4 + 12 + 12 + 4 + 4)
+        + 2 * (m + 1) * (m + 1) * 4
         + face_count * 84
         + sampled_faces * (k * 4 + FACE_SAMPLES * (k * 4 + 28))
         + n * n * 4
@@ -164,39 +159,6 @@ def _horizontal_grid(extent_m: float, tiles: int, periodic: bool) -> beam_kernel
     return grid
 
 
-def floor_samples(cfg: Config, relief: np.ndarray | None, texel_area_m2: np.ndarray):
-    """Sample points, unit normals and weights of a relief floor's map: S×S per texel on a regular
-    horizontal grid, each weighted by its share of the texel's true area (dA_h / n_z / A_texel)."""
-    m = cfg.caustics.map_resolution
-    extent = cfg.water.extent_m
-    s = FLOOR_SAMPLES
-    texel = extent / m
-    u = (np.arange(m * s) + 0.5) * (texel / s) - 0.5 * extent
-    x, y = np.meshgrid(u, u)
-    z = floor_relief_height(cfg.floor, relief, extent, x, y)
-    h = 1e-4 * texel
-    dzdx = (
-        floor_relief_height(cfg.floor, relief, extent, x + h, y)
-        - floor_relief_height(cfg.floor, relief, extent, x - h, y)
-    ) / (2 * h)
-    dzdy = (
-        floor_relief_height(cfg.floor, relief, extent, x, y + h)
-        - floor_relief_height(cfg.floor, relief, extent, x, y - h)
-    ) / (2 * h)
-    normal = np.stack([-dzdx, -dzdy, np.ones_like(z)], axis=-1)
-    slope_area = np.linalg.norm(normal, axis=-1)  # dA_true / dA_h = 1 / n_z
-    normal /= slope_area[..., None]
-
-    # (M·S, M·S) → texel-major order: index (ty, tx, sy, sx).
-    def texel_major(a):
-        return a.reshape(m, s, m, s, *a.shape[2:]).swapaxes(1, 2).reshape(m * m * s * s, *a.shape[2:])
-
-    points = texel_major(np.stack([x, y, z], axis=-1))
-    normals = texel_major(normal)
-    weight = texel_major(slope_area) * (texel / s) ** 2 / np.repeat(texel_area_m2.ravel(), s * s)
-    return points, normals, weight
-
-
 def face_samples(receivers: Receivers) -> tuple[np.ndarray, np.ndarray]:
     """Sample points and unit normals of the non-floor faces: the centroids of each face's
     FACE_SUBDIVISIONS² congruent sub-triangles (equal areas), face-major."""
@@ -265,19 +227,21 @@ class BeamCaustics:
         floor_grid = _horizontal_grid(self.extent_m, m // self.texels_per_tile, periodic)
         point_grid = _horizontal_grid(self.extent_m, max(n // TILE_CELLS, 1), periodic)
         self.flat_floor = cfg.floor.shape is FloorShape.FLAT
-        self.floor_bins = TileBins(floor_grid, count, device) if self.flat_floor else None
-        """Bins of the floor's sections only (flat floor: the clipped-texel map)."""
+        self.floor_bins = TileBins(floor_grid, count, device)
+        """Bins of the sections over the floor's heights (the clipped-texel map)."""
         self.point_bins = TileBins(point_grid, count, device)
         """Bins of each beam's whole length (receiver points at any height)."""
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
-        if not self.flat_floor:
-            points, normals, weights = floor_samples(cfg, relief, receivers.floor_texel_area_m2)
-            self.floor_points = wp.array(points.astype(np.float32), dtype=wp.vec3, device=device)
-            self.floor_normals = wp.array(normals.astype(np.float32), dtype=wp.vec3, device=device)
-            self.floor_weights = wp.array(weights.astype(np.float32), dtype=wp.float32, device=device)
-            self.floor_ids = wp.zeros(len(points), dtype=wp.int32, device=device)
-            self.floor_values = wp.empty((k, len(points)), dtype=wp.float32, device=device)
+        coords = np.arange(m + 1) * (self.extent_m / m) - 0.5 * self.extent_m
+        cx, cy = np.meshgrid(coords, coords)
+        corner_z = floor_relief_height(cfg.floor, relief, self.extent_m, cx, cy)
+        self.floor_z_range = (float(corner_z.min()), float(corner_z.max()))
+        self.corner_z = wp.array(corner_z.astype(np.float32), dtype=wp.float32, device=device)
+        """Floor height at the texel corners (M+1, M+1) [m]: the floor mesh's vertices."""
+        self.texel_area = wp.array(
+            receivers.floor_texel_area_m2.astype(np.float32), dtype=wp.float32, device=device
+        )
         other = receivers.face_count - receivers.floor_face_count
         self.face_count = other
         self.face_flux = wp.zeros((max(other, 1), k), dtype=wp.float32, device=device)
@@ -358,29 +322,20 @@ class BeamCaustics:
         )
         self._points_binned = False
         k, m = self.k, self.m
-        if self.flat_floor:
-            self._bin_horizontal(self.floor_bins, self.plane_z, self.plane_z)
-            wp.launch(
-                beam_kernels.flat_floor_texels,
-                dim=(m, m),
-                inputs=[
-                    *self.floor_bins.inputs(),
-                    self.texels_per_tile,
-                    *self._beam_inputs(),
-                    float(self.plane_z),
-                ],
-                outputs=[self.irradiance.reshape((k, m * m))],
-                device=dev,
-            )
-        else:
-            self.points(self.floor_points, self.floor_normals, self.floor_ids, self.floor_values)
-            wp.launch(
-                beam_kernels.reduce_samples,
-                dim=(k, m * m),
-                inputs=[self.floor_values, self.floor_weights, FLOOR_SAMPLES**2],
-                outputs=[self.irradiance.reshape((k, m * m))],
-                device=dev,
-            )
+        self._bin_horizontal(self.floor_bins, *self.floor_z_range)
+        wp.launch(
+            beam_kernels.floor_texels,
+            dim=(m, m),
+            inputs=[
+                *self.floor_bins.inputs(),
+                self.texels_per_tile,
+                *self._beam_inputs(),
+                self.corner_z,
+                self.texel_area,
+            ],
+            outputs=[self.irradiance.reshape((k, m * m))],
+            device=dev,
+        )
         if self.face_count:
             self.points(self.face_points, self.face_normals, self.face_ids, self.face_values)
         return self.irradiance
@@ -529,5 +484,5 @@ class BeamCaustics:
             beams=self.groups * self.beams_per_group,
             carrying=int(np.count_nonzero(w > 0)),
             dropped=int(self.dropped.numpy()[0]),
-            tile_entries=(self.floor_bins or self.point_bins).entries,
+            tile_entries=self.floor_bins.entries,
         )
