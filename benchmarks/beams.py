@@ -5,8 +5,8 @@ the ratio measures the per-pixel work alone:
 
 - **surface gather** (``kernels/beams.py`` ``point_irradiance``): for every receiver point, the
   point-in-beam test of each beam in its horizontal tile, the flat flux density, the receiver's
-  cosine factor and the attenuation, summed per band. Points: the 4×4 samples per texel of a
-  rippled floor under the default ocean.
+  cosine factor and the attenuation, summed per band. Points: a regular grid of points (4×4 per
+  map texel) on a rippled floor under the default ocean, shadows by the beams' end planes.
 - **volume scan planes** (``scan_plane_radiance``): for every camera pixel, the oriented-box test
   and the scan-plane chord of each beam copy in its screen tile, then the midpoint pieces of the
   in-scattering integral (Henyey–Greenstein phase), summed per band. Camera: ``ocean_floor.toml``.
@@ -390,8 +390,25 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
     renderer = wc.Renderer(scene, device)
     renderer.render(0.0)  # warm-up: JIT compile, builds and bins the beams
     stage = renderer.beams
-    stage.occluders = False  # the twin does the end-plane test; a ripple floor this gentle casts no shadow
-    args = (stage.floor_points, stage.floor_normals, stage.floor_ids, stage.floor_values)
+    # Both sides decide shadows by the beam's end plane (the twin has no BVH for shadow rays).
+    stage.occluders = False
+    # Receiver points: (m·4)² points on the rippled relief (what a camera's G-buffer would hold).
+    from warpcaustics.receivers import floor_relief_height
+
+    cfg = scene.config
+    u = (np.arange(4 * m) + 0.5) * (cfg.water.extent_m / (4 * m)) - 0.5 * cfg.water.extent_m
+    x, y = (a.ravel() for a in np.meshgrid(u, u))
+    h = 1e-4
+    z = floor_relief_height(cfg.floor, None, cfg.water.extent_m, x, y)
+    dzdx = (floor_relief_height(cfg.floor, None, cfg.water.extent_m, x + h, y) - z) / h
+    dzdy = (floor_relief_height(cfg.floor, None, cfg.water.extent_m, x, y + h) - z) / h
+    nrm = np.stack([-dzdx, -dzdy, np.ones_like(z)], -1)
+    nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
+    pts = np.stack([x, y, z], -1)
+    args = (wp.array(pts.astype(np.float32), dtype=wp.vec3, device=device),
+            wp.array(nrm.astype(np.float32), dtype=wp.vec3, device=device),
+            wp.zeros(len(pts), dtype=wp.int32, device=device),
+            wp.empty((stage.k, len(pts)), dtype=wp.float32, device=device))
 
     def warp_run():
         stage.points(*args)
@@ -399,7 +416,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
 
     warp_run()
     warp_s = _median_time(warp_run, warp_repeats)
-    warp_out = stage.floor_values.numpy().astype(np.float64)
+    warp_out = args[3].numpy().astype(np.float64)
     beams = _beam_arrays(stage)
     bins = stage.point_bins
     grid = {
@@ -408,8 +425,8 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
         "n": bins.grid.nx,
     }
     tiles = _tile_lists(bins)
-    points = stage.floor_points.numpy().astype(np.float64)
-    normals = stage.floor_normals.numpy().astype(np.float64)
+    points = args[0].numpy().astype(np.float64)
+    normals = args[1].numpy().astype(np.float64)
 
     def numpy_run():
         return numpy_points(beams, tiles, grid, points, normals, stage.extent_m, stage.periodic)

@@ -170,6 +170,23 @@ def build_beams(
     w = float(0.0)
     if a_perp > 0.0 and t0 + t1 + t2 > 0.0:
         w = a_perp
+        # A vertex that carries nothing (lit from behind, or refracted upwards) has no refracted ray
+        # of its own: give its edge the mean direction of the carrying ones, so the beam is not
+        # warped by an arbitrary direction (its light fades to zero towards that vertex anyway).
+        mean = wp.vec3(0.0)
+        if t0 > 0.0:
+            mean = mean + d0
+        if t1 > 0.0:
+            mean = mean + d1
+        if t2 > 0.0:
+            mean = mean + d2
+        mean = wp.normalize(mean)
+        if t0 <= 0.0:
+            d0 = mean
+        if t1 <= 0.0:
+            d1 = mean
+        if t2 <= 0.0:
+            d2 = mean
     if periodic != 0:
         c = (p0 + p1 + p2) / 3.0
         dm = wp.normalize(d0 + d1 + d2)

@@ -72,7 +72,9 @@ def beams_bytes(
         + sampled_faces * (k * 4 + FACE_SAMPLES * (k * 4 + 28))
         + n * n * 4
         + 8 * beams
-        + (beams * (9 if periodic else 1) * 44 if cfg.camera.enabled else 0)  # screen spans and boxes
+        + 16 * beams  # the second tile grid's spans
+        + (beams * (9 if periodic else 1) * 48 if cfg.camera.enabled else 0)  # screen spans, boxes, lists
+        + (16 * n * n if cfg.caustics.beam_levels else 0)  # adaptive: vertex directions and lengths
     )
 
 
@@ -259,6 +261,10 @@ class BeamCaustics:
         lo, hi = receivers.bounds()
         self.query_z = (float(lo[2]), float(hi[2]))
         self.levels = cfg.caustics.beam_levels
+        if self.levels and self.smooth:
+            raise ValueError(
+                "smooth interpolation needs the uniform grid of beams (caustics.beam_levels = 0)"
+            )
         quads = self.quads
         uniform = np.stack(np.meshgrid(np.arange(quads), np.arange(quads)), -1).reshape(-1, 2)
         self.uniform_leaves = wp.array(
