@@ -84,6 +84,12 @@ def corner_ray(
             y -= n
             s[1] = extent_m
     d, t = sun_into_water(normals[y, x], sun_dir, eta)
+    if t <= 0.0:
+        # No refracted ray of its own (lit from behind, or refracted upwards): its edge follows the
+        # sun refracted by still water, the same for every beam at this vertex (so neighbouring beams
+        # keep sharing the edge); it carries nothing, so the beam's light fades to zero towards it.
+        d, t = sun_into_water(wp.vec3(0.0, 0.0, 1.0), sun_dir, eta)
+        t = 0.0
     return lift(positions[y, x], s), d, t * visible[y, x]
 
 
@@ -170,23 +176,6 @@ def build_beams(
     w = float(0.0)
     if a_perp > 0.0 and t0 + t1 + t2 > 0.0:
         w = a_perp
-        # A vertex that carries nothing (lit from behind, or refracted upwards) has no refracted ray
-        # of its own: give its edge the mean direction of the carrying ones, so the beam is not
-        # warped by an arbitrary direction (its light fades to zero towards that vertex anyway).
-        mean = wp.vec3(0.0)
-        if t0 > 0.0:
-            mean = mean + d0
-        if t1 > 0.0:
-            mean = mean + d1
-        if t2 > 0.0:
-            mean = mean + d2
-        mean = wp.normalize(mean)
-        if t0 <= 0.0:
-            d0 = mean
-        if t1 <= 0.0:
-            d1 = mean
-        if t2 <= 0.0:
-            d2 = mean
     if periodic != 0:
         c = (p0 + p1 + p2) / 3.0
         dm = wp.normalize(d0 + d1 + d2)
@@ -995,8 +984,10 @@ def floor_texels(
     beam's three edge lines cut the triangle's plane in a triangle, which is clipped exactly
     against the triangle's footprint (Sutherland–Hodgman). ``flat``: the piece gets the share of the
     beam's flux that its area is of the cut, with the transmittance at its area centroid (exact for
-    the barycentric-linear transmittance: flux is conserved to rounding, on a relief too);
-    ``smooth``: the interpolated irradiance on the plane at the centroid times the piece's area."""
+    the barycentric-linear transmittance: on a flat floor flux is conserved to rounding; on a relief
+    to the shadow decisions, made per piece at its centroid, and the cuts of a beam through two
+    planes, each normalised on its own); ``smooth``: the interpolated irradiance on the plane at
+    the centroid times the piece's area."""
     ty, tx = wp.tid()
     m = texels_per_tile * grid.nx
     texel_m = extent_m / float(m)
@@ -1027,17 +1018,38 @@ def floor_texels(
                     n = wp.normalize(wp.cross(wp.vec3(corner[0] + texel_m, corner[1], zb) - a3, d3 - a3))
                 else:
                     n = wp.normalize(wp.cross(d3 - a3, wp.vec3(corner[0], corner[1] + texel_m, zc) - a3))
-            q0 = plane_cut(base[b, 0], direction[b, 0], a3, n)
-            q1 = plane_cut(base[b, 1], direction[b, 1], a3, n)
-            q2 = plane_cut(base[b, 2], direction[b, 2], a3, n)
-            lo = wp.min(wp.min(q0, q1), q2)
-            hi = wp.max(wp.max(q0, q1), q2)
+            # Every edge must cross the plane downwards (grazing or back-facing triangles: skip).
+            if (
+                wp.dot(direction[b, 0], n) > -1.0e-6
+                or wp.dot(direction[b, 1], n) > -1.0e-6
+                or wp.dot(direction[b, 2], n) > -1.0e-6
+            ):
+                continue
+            # The copies of the texel the beam may reach: its sections between the texel's lowest and
+            # highest corners bound its cut through the triangle (sections are linear in z).
+            z_lo = wp.min(wp.min(za, zb), wp.min(zc, zd))
+            z_hi = wp.max(wp.max(za, zb), wp.max(zc, zd))
+            lo = wp.vec2(1.0e30)
+            hi = wp.vec2(-1.0e30)
+            for e in range(3):
+                for k in range(2):
+                    zz = z_lo
+                    if k == 1:
+                        zz = z_hi
+                    sv = section_vertex(base[b, e], direction[b, e], zz)
+                    lo = wp.min(lo, sv)
+                    hi = wp.max(hi, sv)
             kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, extent_m, periodic)
             ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, extent_m, periodic)
             for ky in range(ky0, ky1 + 1):
                 for kx in range(kx0, kx1 + 1):  # every periodic copy of the texel the cut may cover
                     shift = wp.vec2(float(kx) * extent_m, float(ky) * extent_m)
                     origin = corner + shift
+                    # The copy's own plane (a tilted plane does not repeat with the period).
+                    a_copy = a3 + wp.vec3(shift[0], shift[1], 0.0)
+                    q0 = plane_cut(base[b, 0], direction[b, 0], a_copy, n)
+                    q1 = plane_cut(base[b, 1], direction[b, 1], a_copy, n)
+                    q2 = plane_cut(base[b, 2], direction[b, 2], a_copy, n)
                     px = vec8()
                     py = vec8()
                     px[0] = (q0[0] - origin[0]) / texel_m
@@ -1060,7 +1072,7 @@ def floor_texels(
                         if rn < 3:
                             continue
                     share = polygon_area(rx, ry, rn)  # of the texel's horizontal area
-                    if share <= 0.0:
+                    if not (share > 0.0):
                         continue
                     # Area centroid of the piece: exact for an integrand linear over it.
                     ax = float(0.0)

@@ -466,8 +466,8 @@ def test_beams_on_rippled_sand_keep_the_flux_and_agree_with_photons():
     """Ripples that tile the patch under a rough ocean (water_type none, 64² surface, 64² map): each
     texel's two mesh triangles are clipped exactly against the beams' cuts through their planes, so
     the flux stays within the shadow decisions' rounding (a piece is lit or not as its centroid is),
-    and the map agrees with exact photons at 64 per cell (64 per texel). Measured: flux −3.7e-3,
-    L1 5.1 % (4.3 % against 256 photons per cell)."""
+    and the map agrees with exact photons at 64 per cell (64 per texel). Measured: flux −1.9e-4,
+    L1 4.5 % (3.8 % against 256 photons per cell)."""
     common = {
         "water.resolution": 64,
         "caustics.map_resolution": 64,
@@ -485,6 +485,6 @@ def test_beams_on_rippled_sand_keep_the_flux_and_agree_with_photons():
         ),
         device="cpu",
     )
-    np.testing.assert_allclose(beams.floor_flux_w_nm, beams.transmitted_flux_w_nm, rtol=1e-2)
+    np.testing.assert_allclose(beams.floor_flux_w_nm, beams.transmitted_flux_w_nm, rtol=1e-3)
     l1 = np.abs(beams.floor_irradiance - photons.floor_irradiance).sum() / photons.floor_irradiance.sum()
-    assert l1 < 0.08
+    assert l1 < 0.06
