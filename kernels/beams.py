@@ -1,22 +1,25 @@
 """Warped beam volumes (Sandberg & Falemo 2005; Ernst et al. 2005; Liktor & Dachsbacher 2011).
 
-One beam per surface triangle and index group: its base vertices v_i on the displaced surface,
-the unit refracted directions d_i of its three edges, the transmittance T_i at each vertex, the
-length e_i along each edge to the first receiver (a ray query on the receivers' BVH), and its
-flux weight ``w = A⊥`` [m²] (the triangle's area projected perpendicular to the sun). Beams are
-stored flat, index ``((g Q + qy) Q + qx) 2 + half``; a beam that carries nothing (facing away from
-the sun, total internal reflection at all three vertices, a degenerate triangle) has ``w = 0``.
+One beam per surface triangle (or adaptive leaf quad's triangle) and index group: its base
+vertices v_i on the displaced surface, the unit refracted directions d_i of its three edges, the
+transmittance T_i at each vertex, the length e_i along each edge to the first receiver (a ray
+query on the receivers' BVH), and its flux weight ``w = A⊥`` [m²] (the triangle's area projected
+perpendicular to the sun). Beams are stored flat, index ``(g · leaves + leaf) · 2 + half``; the
+uniform grid lists its quads row-major, so there ``((g Q + qy) Q + qx) 2 + half``. A beam that
+carries nothing (facing away from the sun, no vertex transmitting) has ``w = 0``.
 
 The horizontal section of a beam at height z has vertices ``p_i(z) = v_i + (z − v_iz)/d_iz · d_i``
 and signed area ``A(z) = a0 + a1 z + a2 z²`` (DESIGN.md). A point P is in the beam iff it lies in
-the section at P_z; its barycentrics λ there interpolate the transmittance, the path length
-ℓ = Σ λ_i (v_iz − P_z)/|d_iz| and the direction. The flux density on a horizontal plane is
+the section at P_z (a watertight test: a point on an edge shared by two beams counts once); its
+barycentrics λ there interpolate the transmittance, the path length ℓ = Σ λ_i (v_iz − P_z)/|d_iz|
+and the direction. The flux density on a horizontal plane is
 ``E_sun(k) · w · Σλ_i T_i · exp(−c(k) ℓ) / |A(P_z)|``; on a receiver with unit normal n it is
-multiplied by ``|d·n| / |d_z|`` (``constant`` interpolation: flux spread uniformly in barycentric
+multiplied by ``|d·n| / |d_z|`` (``flat`` interpolation: flux spread uniformly in barycentric
 terms, so a section receives exactly ``E_sun · w · mean(T)`` without absorption).
 
-A beam ends at the plane through its three edge ends: a point more than one beam width beyond
-that plane is in the shadow of whatever stopped the beam (``shadow_slack``).
+A beam ends at the plane through its three edge ends. Where something can shadow a receiver point
+(walls, meshes, a relief) a shadow ray through the BVH decides whether the beam reaches it;
+otherwise a point more than one beam width beyond the end plane is unlit (``shadow_slack``).
 
 Binning (Laine & Karras 2011; Kerbl et al. 2023): every beam (or periodic copy of a beam) gets a
 span of tiles, tiles count their beams (atomics), an exclusive scan gives each tile's start, and

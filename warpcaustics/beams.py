@@ -1,8 +1,8 @@
 """Beam caustics (host side): build the warped beam volumes, bin them into tiles, gather.
 
-See ``warpcaustics/kernels/beams.py`` for the method. Two tile grids are used: a horizontal grid
-over the patch for every query at a point (floor texels, receiver faces, the receiver points the
-camera sees), and the camera's screen tiles for the view rays of the volume caustics. The stage
+See ``warpcaustics/kernels/beams.py`` for the method. Horizontal tile grids over the patch serve
+the floor map (blocks of texels) and every query at a point (receiver faces, the receiver points
+the camera sees); the camera's screen tiles serve the view rays of the volume caustics. The stage
 owns its buffers and reuses them from frame to frame.
 """
 
