@@ -488,3 +488,40 @@ def test_beams_on_rippled_sand_keep_the_flux_and_agree_with_photons():
     np.testing.assert_allclose(beams.floor_flux_w_nm, beams.transmitted_flux_w_nm, rtol=1e-3)
     l1 = np.abs(beams.floor_irradiance - photons.floor_irradiance).sum() / photons.floor_irradiance.sum()
     assert l1 < 0.06
+
+
+@wp.kernel
+def _count_inside(tri: wp.array[wp.vec2], points: wp.array[wp.vec2], counts: wp.array[wp.int32]):
+    i = wp.tid()
+    total = int(0)  # noqa: UP018 (a Warp loop variable needs its type)
+    for t in range(tri.shape[0] // 3):
+        inside, lam = beam_kernels.inside_triangle(tri[3 * t], tri[3 * t + 1], tri[3 * t + 2], points[i])
+        if inside:
+            total += 1
+    counts[i] = total
+
+
+def test_points_on_shared_edges_and_vertices_count_in_exactly_one_beam():
+    """The watertight inside test: a 4×4 grid of quads split as the surface is (both windings), with
+    query points on the grid's vertices, on its edges and diagonals and inside its cells: every
+    point inside the grid lies in exactly one triangle."""
+    tris = []
+    for j in range(4):
+        for i in range(4):
+            a, b, c, d = (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)
+            tris += [a, b, d, a, d, c] if (i + j) % 2 == 0 else [a, d, b, a, c, d]  # mixed windings
+    q = np.arange(0, 17) * 0.25
+    pts = np.stack(np.meshgrid(q, q), -1).reshape(-1, 2)
+    pts = pts[np.all((pts > 0) & (pts < 4), axis=1)]  # the grid's border belongs to no neighbour
+    counts = wp.zeros(len(pts), dtype=wp.int32, device="cpu")
+    wp.launch(
+        _count_inside,
+        dim=len(pts),
+        inputs=[
+            wp.array(np.asarray(tris, np.float32), dtype=wp.vec2, device="cpu"),
+            wp.array(pts.astype(np.float32), dtype=wp.vec2, device="cpu"),
+        ],
+        outputs=[counts],
+        device="cpu",
+    )
+    assert np.all(counts.numpy() == 1)
