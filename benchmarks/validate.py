@@ -353,7 +353,7 @@ def _beams() -> None:
         wp.array(np.repeat(ends[None], n, axis=0).astype(np.float32), dtype=wp.float32, device="cpu"),
         wp.array(origins.astype(np.float32), dtype=wp.vec3, device="cpu"),
         wp.array(rays.astype(np.float32), dtype=wp.vec3, device="cpu")],
-        outputs=[wp.zeros((n, 2), dtype=wp.vec3, device="cpu"), out], device="cpu")
+        outputs=[wp.zeros((n, 4), dtype=wp.vec3, device="cpu"), out], device="cpu")
     got = out.numpy().astype(np.float64)
     errs = []
     for i in range(n):

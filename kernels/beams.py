@@ -221,9 +221,7 @@ def build_beams(
         end_m[b, 0] = 0.0
         end_m[b, 1] = 0.0
         end_m[b, 2] = 0.0
-    e0, ne = end_plane(base, direction, end_m, b)
-    ends[b, 0] = e0
-    ends[b, 1] = ne
+    fill_ends(base, direction, end_m, b, ends)
     weight[b] = w
 
 
@@ -509,6 +507,28 @@ def end_plane(
     if wp.dot(nrm, along) < 0.0:
         nrm = -nrm
     return e0, nrm
+
+
+@wp.func
+def fill_ends(
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    end_m: wp.array2d[wp.float32],
+    b: int,
+    ends: wp.array2d[wp.vec3],
+):
+    """ends[b] = (a point of the end plane, its unit normal along the beam, the unit mean edge
+    direction d̄, the base plane's unit normal towards d̄): what the shadow test and the scan planes
+    read per beam."""
+    e0, ne = end_plane(base, direction, end_m, b)
+    dbar = wp.normalize(direction[b, 0] + direction[b, 1] + direction[b, 2])
+    nb = wp.normalize(wp.cross(base[b, 1] - base[b, 0], base[b, 2] - base[b, 0]))
+    if wp.dot(nb, dbar) < 0.0:
+        nb = -nb
+    ends[b, 0] = e0
+    ends[b, 1] = ne
+    ends[b, 2] = dbar
+    ends[b, 3] = nb
 
 
 @wp.func
@@ -1319,7 +1339,7 @@ def scan_chord(
     d0 = direction[b, 0]
     d1 = direction[b, 1]
     d2 = direction[b, 2]
-    dbar = wp.normalize(d0 + d1 + d2)
+    dbar = ends[b, 2]
     w = wp.cross(v, dbar)
     s_a = float(-1.0e30)
     s_b = float(1.0e30)
@@ -1359,9 +1379,7 @@ def scan_chord(
         s_a = lo
         s_b = hi
     # Base plane: keep the side the beam goes to.
-    nb = wp.normalize(wp.cross(v1 - v0, v2 - v0))
-    if wp.dot(nb, dbar) < 0.0:
-        nb = -nb
+    nb = ends[b, 3]
     s_a, s_b = clip_halfspace(s_a, s_b, wp.dot(o - v0, nb), wp.dot(v, nb))
     e0 = ends[b, 0]
     ne = ends[b, 1]

@@ -163,9 +163,7 @@ def _chords(
     out: wp.array[wp.vec2],
 ):
     i = wp.tid()
-    e0, ne = beam_kernels.end_plane(base, direction, end_m, i)
-    ends[i, 0] = e0
-    ends[i, 1] = ne
+    beam_kernels.fill_ends(base, direction, end_m, i, ends)
     a, b = beam_kernels.scan_chord(base, direction, ends, i, wp.vec3(0.0), origins[i], rays[i])
     out[i] = wp.vec2(a, b)
 
@@ -222,7 +220,7 @@ def test_scan_plane_chord_of_a_straight_prism_is_exact():
             wp.array(origins.astype(np.float32), dtype=wp.vec3, device="cpu"),
             wp.array(rays.astype(np.float32), dtype=wp.vec3, device="cpu"),
         ],
-        outputs=[wp.zeros((n, 2), dtype=wp.vec3, device="cpu"), out],
+        outputs=[wp.zeros((n, 4), dtype=wp.vec3, device="cpu"), out],
         device="cpu",
     )
     got = out.numpy().astype(np.float64)

@@ -18,8 +18,9 @@ from warpcaustics.kernels import beams as beam_kernels
 from warpcaustics.receivers import Receivers, floor_relief_height
 from warpcaustics.water import Surface
 
-BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 2 * 12 + 4 + 12 + 16
-"""Per beam: base vertices, directions, transmittances, edge ends, end plane, weight, A(z), span."""
+BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 4 * 12 + 4 + 12 + 16
+"""Per beam: base vertices, directions, transmittances, edge ends, end and base planes, weight,
+A(z), span."""
 
 FACE_SUBDIVISIONS = 4
 """Irradiance on a receiver face is the mean over the centroids of its FACE_SUBDIVISIONS²
@@ -219,8 +220,9 @@ class BeamCaustics:
         self.direction = wp.empty((count, 3), dtype=wp.vec3, device=device)
         self.transmit = wp.empty((count, 3), dtype=wp.float32, device=device)
         self.end_m = wp.empty((count, 3), dtype=wp.float32, device=device)
-        self.ends = wp.empty((count, 2), dtype=wp.vec3, device=device)
-        """End plane of each beam: (point, unit normal along the beam)."""
+        self.ends = wp.empty((count, 4), dtype=wp.vec3, device=device)
+        """Per beam: a point of its end plane, the plane's unit normal along the beam, the unit mean
+        edge direction, the base plane's unit normal (``kernels/beams.py fill_ends``)."""
         self.weight = wp.empty(count, dtype=wp.float32, device=device)
         """A⊥ per beam [m²] (0: dropped)."""
         self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
