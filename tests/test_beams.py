@@ -523,3 +523,28 @@ def test_points_on_shared_edges_and_vertices_count_in_exactly_one_beam():
         device="cpu",
     )
     assert np.all(counts.numpy() == 1)
+
+
+def test_adaptive_beams_follow_the_waves_from_frame_to_frame():
+    """One Renderer, frames at several times: the adaptive leaves change with the waves, the buffers
+    are reused, and every frame keeps its flux (slots past a frame's beams carry nothing)."""
+    renderer = wc.Renderer(
+        wc.load_scene(
+            "configs/ocean.toml",
+            {
+                **BEAMS,
+                "caustics.beam_levels": 2,
+                "water.resolution": 64,
+                "caustics.map_resolution": 64,
+                "optics.water_type": "none",
+                "optics.wavelengths": "rgb",
+            },
+        ),
+        "cpu",
+    )
+    counts = []
+    for t in (0.0, 0.7, 1.4, 0.2):
+        r = renderer.render(t)
+        counts.append(r.beam_stats["beams"])
+        np.testing.assert_allclose(r.floor_flux_w_nm, r.transmitted_flux_w_nm, rtol=1e-6)
+    assert len(set(counts)) > 1
