@@ -711,6 +711,29 @@ def _adaptive_rows(config: str, overrides: dict, levels: int, device: str, repea
     return rows
 
 
+def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str) -> list[dict]:
+    """Hull / prism fill as the light focuses: ocean_floor.toml over a flat floor at several depths
+    (floor caustic contrast std/mean beside it), the camera aimed at the floor."""
+    import warpcaustics as wc
+
+    rows = []
+    for depth in depths:
+        scene = wc.load_scene(ROOT / "configs" / "ocean_floor.toml", {
+            "caustics.method": "beams", "water.resolution": n, "floor.shape": "flat",
+            "floor.depth_m": depth,
+            "camera.width": size[0], "camera.height": size[1], "caustics.shafts": False,
+            "optics.wavelengths": WAVELENGTHS, "camera.position_m": [0.0, -6.0, -1.0],
+            "camera.look_at_m": [0.0, 0.0, -0.6 * depth]})
+        renderer = wc.Renderer(scene, device)
+        result = renderer.render(0.0)
+        fill = fill_measure(renderer.beams, renderer.camera, 3, samples=2000)
+        floor = result.floor_irradiance[1].astype(np.float64)
+        rows.append({"floor_depth_m": depth, "contrast": float(floor.std() / floor.mean()), **fill})
+        print(f"beams        fill at floor depth {depth:5.1f} m (contrast {rows[-1]['contrast']:.2f}): "
+              f"hull/prism {fill['hull_over_prism']:.3f} on {fill['beams_measured']} beams", flush=True)
+    return rows
+
+
 def _slope(rows: list[dict], x: str, y: str) -> float:
     return float(np.polyfit(np.log([r[x] for r in rows]), np.log([r[y] for r in rows]), 1)[0])
 
@@ -759,6 +782,8 @@ def run(quick: bool, device: str) -> dict:
         print(f"  log-log slope of stage time vs {what}: {slope:.2f}")
         for r in rows:
             r[f"loglog_slope_vs_{key}"] = slope
+    fill_rows = _fill_vs_depth((3.0, 12.0) if quick else (3.0, 6.0, 12.0, 24.0), 32 if quick else 64,
+                               (64, 48) if quick else (160, 120), device)
     adaptive = _adaptive_rows("ocean.toml", {"water.resolution": sizes["adaptive_n"],
                                              "caustics.map_resolution": sizes["adaptive_m"]}, 2, device,
                               warp_repeats)
@@ -766,6 +791,7 @@ def run(quick: bool, device: str) -> dict:
                                warp_repeats)
     return {
         "adaptive_vs_uniform": adaptive,
+        "fill_vs_depth": fill_rows,
         "benchmark": "beam_rasteriser",
         "device": device,
         "device_name": wp_name,
