@@ -287,6 +287,9 @@ def summary_row(task: Task, result, k: int) -> dict:
         row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
     if result.beam_stats:
         row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
+    if result.comparison is not None:  # "both": how far the photons' floor map is from the beams'
+        other = result.comparison.floor_irradiance.astype(np.float64)
+        row["beams_vs_photons_l1"] = float(np.abs(floor - other).sum() / max(np.abs(other).sum(), 1e-300))
     row["render_s"] = float(sum(result.timings_s.values()))
     return row
 
