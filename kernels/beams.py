@@ -33,8 +33,8 @@ import warp as wp
 
 from warpcaustics.kernels.camera import PinholeCamera, pixel_ray
 from warpcaustics.kernels.floor import lift, quad_corner
-from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, sun_into_water, vec8
-from warpcaustics.kernels.phase import henyey_greenstein, tabulated_phase
+from warpcaustics.kernels.geometry import clip_side, clip_to_slab, polygon_area, sun_into_water, vec8
+from warpcaustics.kernels.phase import phase_value
 
 wp.set_module_options({"enable_backward": False})
 
@@ -685,42 +685,29 @@ def listed(
 
 
 @wp.kernel
-def count_tiles(
+def bin_tiles(
     grid: TileGrid,
     spans: wp.array2d[wp.int32],
     use_boxes: int,
     box_axis: wp.array[wp.vec2],
     box_lo: wp.array[wp.vec2],
     box_hi: wp.array[wp.vec2],
-    tile_count: wp.array[wp.int32],
-):
-    """Tiles of each item's span (that its oriented box touches, with ``use_boxes``) count it."""
-    b = wp.tid()
-    for j in range(spans[b, 1], spans[b, 3] + 1):
-        for i in range(spans[b, 0], spans[b, 2] + 1):
-            if listed(grid, i, j, use_boxes, box_axis, box_lo, box_hi, b):
-                wp.atomic_add(tile_count, tile_index(grid, i, j), 1)
-
-
-@wp.kernel
-def scatter_tiles(
-    grid: TileGrid,
-    spans: wp.array2d[wp.int32],
-    use_boxes: int,
-    box_axis: wp.array[wp.vec2],
-    box_lo: wp.array[wp.vec2],
-    box_hi: wp.array[wp.vec2],
+    scatter: int,
     tile_start: wp.array[wp.int32],
     tile_fill: wp.array[wp.int32],
     tile_items: wp.array[wp.int32],
 ):
+    """Each tile of an item's span (that its oriented box touches, with ``use_boxes``) takes the
+    item: ``scatter == 0`` only counts it in ``tile_fill``; ``scatter == 1`` also writes it at
+    ``tile_start[t]`` plus its place in the tile's count."""
     b = wp.tid()
     for j in range(spans[b, 1], spans[b, 3] + 1):
         for i in range(spans[b, 0], spans[b, 2] + 1):
             if listed(grid, i, j, use_boxes, box_axis, box_lo, box_hi, b):
                 t = tile_index(grid, i, j)
-                slot = tile_start[t] + wp.atomic_add(tile_fill, t, 1)
-                tile_items[slot] = b
+                slot = wp.atomic_add(tile_fill, t, 1)
+                if scatter != 0:
+                    tile_items[tile_start[t] + slot] = b
 
 
 # --- queries ------------------------------------------------------------------------------------
@@ -946,28 +933,6 @@ def clamped_sample(
 
 
 @wp.func
-def clip_side(px: vec8, py: vec8, count: int, nx: float, ny: float, c: float):
-    """Sutherland–Hodgman step: keep the part of polygon (px, py) where nx x + ny y + c >= 0."""
-    qx = vec8()
-    qy = vec8()
-    m = int(0)
-    for j in range(count):
-        jn = (j + 1) % count
-        sa = nx * px[j] + ny * py[j] + c
-        sb = nx * px[jn] + ny * py[jn] + c
-        if sa >= 0.0:
-            qx[m] = px[j]
-            qy[m] = py[j]
-            m += 1
-        if (sa >= 0.0) != (sb >= 0.0):
-            t = sa / (sa - sb)
-            qx[m] = px[j] + t * (px[jn] - px[j])
-            qy[m] = py[j] + t * (py[jn] - py[j])
-            m += 1
-    return qx, qy, m
-
-
-@wp.func
 def plane_cut(v: wp.vec3, d: wp.vec3, a: wp.vec3, n: wp.vec3) -> wp.vec2:
     """(x, y) where the edge line v + t d meets the plane through a with normal n."""
     t = wp.dot(a - v, n) / wp.dot(d, n)
@@ -1028,19 +993,37 @@ def floor_texels(
     if flat:
         pieces = 1
     inv_area = 1.0 / texel_area_m2[ty, tx]
+    z_lo = wp.min(wp.min(za, zb), wp.min(zc, zd))
+    z_hi = wp.max(wp.max(za, zb), wp.max(zc, zd))
+    # Triangle (a, b, d) below the diagonal a→d (x ≥ y in texel units), (a, d, c) above it.
+    a3 = wp.vec3(corner[0], corner[1], za)
+    n_lower = wp.vec3(0.0, 0.0, 1.0)
+    n_upper = wp.vec3(0.0, 0.0, 1.0)
+    if not flat:
+        d3 = wp.vec3(corner[0] + texel_m, corner[1] + texel_m, zd)
+        n_lower = wp.normalize(wp.cross(wp.vec3(corner[0] + texel_m, corner[1], zb) - a3, d3 - a3))
+        n_upper = wp.normalize(wp.cross(d3 - a3, wp.vec3(corner[0], corner[1] + texel_m, zc) - a3))
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
+        # The copies of the texel the beam may reach: its sections between the texel's lowest and
+        # highest corners bound its cuts through both triangles (sections are linear in z).
+        lo = wp.vec2(1.0e30)
+        hi = wp.vec2(-1.0e30)
+        for e in range(3):
+            for k in range(2):
+                zz = z_lo
+                if k == 1:
+                    zz = z_hi
+                sv = section_vertex(base[b, e], direction[b, e], zz)
+                lo = wp.min(lo, sv)
+                hi = wp.max(hi, sv)
+        kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, extent_m, periodic)
+        ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, extent_m, periodic)
         for piece in range(pieces):
-            # Triangle (a, b, d) below the diagonal a→d (x ≥ y in texel units), (a, d, c) above it.
-            a3 = wp.vec3(corner[0], corner[1], za)
-            n = wp.vec3(0.0, 0.0, 1.0)
-            if not flat:
-                d3 = wp.vec3(corner[0] + texel_m, corner[1] + texel_m, zd)
-                if piece == 0:
-                    n = wp.normalize(wp.cross(wp.vec3(corner[0] + texel_m, corner[1], zb) - a3, d3 - a3))
-                else:
-                    n = wp.normalize(wp.cross(d3 - a3, wp.vec3(corner[0], corner[1] + texel_m, zc) - a3))
+            n = n_lower
+            if piece == 1:
+                n = n_upper
             # Every edge must cross the plane downwards (grazing or back-facing triangles: skip).
             if (
                 wp.dot(direction[b, 0], n) > -1.0e-6
@@ -1048,22 +1031,6 @@ def floor_texels(
                 or wp.dot(direction[b, 2], n) > -1.0e-6
             ):
                 continue
-            # The copies of the texel the beam may reach: its sections between the texel's lowest and
-            # highest corners bound its cut through the triangle (sections are linear in z).
-            z_lo = wp.min(wp.min(za, zb), wp.min(zc, zd))
-            z_hi = wp.max(wp.max(za, zb), wp.max(zc, zd))
-            lo = wp.vec2(1.0e30)
-            hi = wp.vec2(-1.0e30)
-            for e in range(3):
-                for k in range(2):
-                    zz = z_lo
-                    if k == 1:
-                        zz = z_hi
-                    sv = section_vertex(base[b, e], direction[b, e], zz)
-                    lo = wp.min(lo, sv)
-                    hi = wp.max(hi, sv)
-            kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, extent_m, periodic)
-            ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, extent_m, periodic)
             for ky in range(ky0, ky1 + 1):
                 for kx in range(kx0, kx1 + 1):  # every periodic copy of the texel the cut may cover
                     shift = wp.vec2(float(kx) * extent_m, float(ky) * extent_m)
@@ -1473,11 +1440,7 @@ def scan_plane_radiance(
             if smp.beyond_end_m > shadow_slack(smp.area):
                 continue
             cos_theta = -wp.dot(smp.d, v)
-            phase = float(0.0)
-            if phase_kind == 0:
-                phase = henyey_greenstein(cos_theta, hg_g)
-            else:
-                phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+            phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, cos_theta)
             density = flux_density(
                 weight, transmit, area_coef, base, b, smp, x[2], quads, lattice_wraps, smooth
             )

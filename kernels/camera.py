@@ -9,7 +9,7 @@ with normal n is ``r² Ω / |cos(ray, n)|``.
 
 import warp as wp
 
-from warpcaustics.kernels.phase import henyey_greenstein, tabulated_phase
+from warpcaustics.kernels.phase import phase_value
 
 wp.set_module_options({"enable_backward": False})
 
@@ -593,11 +593,7 @@ def shaft_lines(
                 s = c[2]
                 to_cam = (cam.position - x) / s
                 cos_theta = wp.dot(d, to_cam)
-                phase = float(0.0)
-                if phase_kind == 0:
-                    phase = henyey_greenstein(cos_theta, hg_g)
-                else:
-                    phase = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+                phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, cos_theta)
                 level = int(0)
                 tube_pixels = tube_width_m / (s * angle)
                 while level < SHAFT_LEVELS - 1 and float(1 << level) < tube_pixels:

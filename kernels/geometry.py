@@ -89,27 +89,16 @@ def sun_into_water(normal: wp.vec3, sun_dir: wp.vec3, eta: float):
 
 
 @wp.func
-def clip_half_plane(px: vec8, py: vec8, count: int, axis: int, bound: float, keep_above: bool):
-    """Sutherland–Hodgman step: keep the part of polygon ``(px, py)`` on one side of a line.
-
-    The line is ``x = bound`` (``axis == 0``) or ``y = bound`` (``axis == 1``); ``keep_above``
-    keeps coordinates ``>= bound``. Returns the clipped polygon and its vertex count.
-    """
+def clip_side(px: vec8, py: vec8, count: int, nx: float, ny: float, c: float):
+    """Sutherland–Hodgman step: keep the part of polygon (px, py) where nx x + ny y + c >= 0.
+    Returns the clipped polygon and its vertex count."""
     qx = vec8()
     qy = vec8()
     m = int(0)
     for j in range(count):
         jn = (j + 1) % count
-        a = px[j]
-        b = px[jn]
-        if axis == 1:
-            a = py[j]
-            b = py[jn]
-        sa = a - bound
-        sb = b - bound
-        if not keep_above:
-            sa = -sa
-            sb = -sb
+        sa = nx * px[j] + ny * py[j] + c
+        sb = nx * px[jn] + ny * py[jn] + c
         if sa >= 0.0:
             qx[m] = px[j]
             qy[m] = py[j]
@@ -120,6 +109,18 @@ def clip_half_plane(px: vec8, py: vec8, count: int, axis: int, bound: float, kee
             qy[m] = py[j] + t * (py[jn] - py[j])
             m += 1
     return qx, qy, m
+
+
+@wp.func
+def clip_half_plane(px: vec8, py: vec8, count: int, axis: int, bound: float, keep_above: bool):
+    """Keep the part of polygon ``(px, py)`` on one side of the line ``x = bound`` (``axis == 0``)
+    or ``y = bound`` (``axis == 1``); ``keep_above`` keeps coordinates ``>= bound``."""
+    sign = float(1.0)
+    if not keep_above:
+        sign = -1.0
+    if axis == 0:
+        return clip_side(px, py, count, sign, 0.0, -sign * bound)
+    return clip_side(px, py, count, 0.0, sign, -sign * bound)
 
 
 @wp.func

@@ -33,13 +33,19 @@ def tabulated_phase(angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.flo
     return wp.exp(log_phase[count - 1])
 
 
+@wp.func
+def phase_value(kind: int, g: float, angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.float32],
+                cone_phase: float, cos_theta: float) -> float:
+    """p(cos θ) [1/sr] of the configured phase function: kind 0 = Henyey–Greenstein(g), 1 = the table."""
+    if kind == 0:
+        return henyey_greenstein(cos_theta, g)
+    return tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta)
+
+
 @wp.kernel
 def evaluate_phase(cos_theta: wp.array[wp.float32], kind: int, g: float,
                    angles_rad: wp.array[wp.float32], log_phase: wp.array[wp.float32], cone_phase: float,
                    out: wp.array[wp.float32]):
     """out[i] = p(cos θ_i): kind 0 = Henyey–Greenstein(g), 1 = the table."""
     i = wp.tid()
-    if kind == 0:
-        out[i] = henyey_greenstein(cos_theta[i], g)
-    else:
-        out[i] = tabulated_phase(angles_rad, log_phase, cone_phase, cos_theta[i])
+    out[i] = phase_value(kind, g, angles_rad, log_phase, cone_phase, cos_theta[i])

@@ -114,10 +114,9 @@ class TileBins:
         self.count.zero_()
         boxes = [self.use_boxes, self.box_axis, self.box_lo, self.box_hi]
         wp.launch(
-            beam_kernels.count_tiles,
+            beam_kernels.bin_tiles,
             dim=n,
-            inputs=[self.grid, self.spans, *boxes],
-            outputs=[self.count],
+            inputs=[self.grid, self.spans, *boxes, 0, self.start, self.count, self.items],
             device=dev,
         )
         wp.utils.array_scan(self.count, self.start, inclusive=False)
@@ -127,10 +126,9 @@ class TileBins:
             self.items = wp.zeros(int(total * 1.25) + 1, dtype=wp.int32, device=dev)
         self.fill.zero_()
         wp.launch(
-            beam_kernels.scatter_tiles,
+            beam_kernels.bin_tiles,
             dim=n,
-            inputs=[self.grid, self.spans, *boxes, self.start, self.fill],
-            outputs=[self.items],
+            inputs=[self.grid, self.spans, *boxes, 1, self.start, self.fill, self.items],
             device=dev,
         )
 
@@ -286,6 +284,8 @@ class BeamCaustics:
                 f"{1 << self.levels} (it is {n}); lower caustics.beam_levels"
             )
         if self.levels:
+            self.refine_ior = float(group_ior[0])
+            """Index the refinement criteria refract with (the first group's)."""
             self.vertex_direction = wp.empty((n, n), dtype=wp.vec3, device=device)
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
@@ -360,7 +360,7 @@ class BeamCaustics:
             inputs=[
                 surface.positions,
                 surface.normals,
-                float(self.ior.numpy()[0]),
+                self.refine_ior,
                 self.sun_dir,
                 self.extent_m,
                 float(self.plane_z),

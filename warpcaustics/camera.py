@@ -192,21 +192,7 @@ class UnderwaterCamera:
         wp.launch(
             camera_kernels.blur3, dim=(k, h, w), inputs=[self.shafts_raw], outputs=[self.shafts], device=dev
         )
-        wp.launch(
-            camera_kernels.shade,
-            dim=(k, h, w),
-            inputs=[
-                self.receiver,
-                self.depth,
-                self.caustic,
-                self.shafts,
-                self.receivers.albedo_wp,
-                photons.attenuation_per_m,
-            ],
-            outputs=[self.radiance],
-            device=dev,
-        )
-        return self.radiance
+        return self._shade(photons.attenuation_per_m)
 
     def render_beams(self, beams, shafts: bool) -> wp.array3d:
         """Light the receivers the camera sees by ``beams``' last frame (point-in-beam on the
@@ -262,19 +248,18 @@ class UnderwaterCamera:
                 outputs=[self.shafts, self._pairs],
                 device=dev,
             )
+        return self._shade(beams.attenuation_per_m)
+
+    def _shade(self, attenuation_per_m: wp.array) -> wp.array3d:
+        """Radiance at the camera from the caustic map and the shafts of this frame."""
+        k = self.caustic.shape[0]
         wp.launch(
             camera_kernels.shade,
-            dim=(k, h, w),
-            inputs=[
-                self.receiver,
-                self.depth,
-                self.caustic,
-                self.shafts,
-                self.receivers.albedo_wp,
-                beams.attenuation_per_m,
-            ],
+            dim=(k, self.cfg.height, self.cfg.width),
+            inputs=[self.receiver, self.depth, self.caustic, self.shafts, self.receivers.albedo_wp,
+                    attenuation_per_m],
             outputs=[self.radiance],
-            device=dev,
+            device=self.device,
         )
         return self.radiance
 
