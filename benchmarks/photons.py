@@ -13,12 +13,9 @@ single-threaded, and so is Warp's ``cpu`` device. ``python -m benchmarks.photons
 
 from __future__ import annotations
 
-import argparse
-import platform
 import sys
 import time
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -379,21 +376,9 @@ def run(quick: bool, device: str) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m benchmarks.photons", description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true", help="small sizes, fewer repeats")
-    p.add_argument("--device", default="cpu", help="Warp device for the Warp side (default cpu)")
-    p.add_argument("--out", type=Path, default=None, help="JSON file (default benchmarks/results/...)")
-    args = p.parse_args(argv)
-    from benchmarks.run import _cpu_name, save_record
+    from benchmarks.run import module_main
 
-    record = run(args.quick, args.device)
-    record.update(command="python -m benchmarks.photons" + (" --quick" if args.quick else "")
-                  + f" --device {args.device}", date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                  machine={"platform": platform.platform(), "processor": _cpu_name(),
-                           "python": platform.python_version()},
-                  versions={d: metadata.version(d) for d in ("warp-lang", "numpy")})
-    save_record(record, args.out, "photons", args.quick, args.device)
-    return 0
+    return module_main(argv, "photons", run, __doc__)
 
 
 if __name__ == "__main__":

@@ -195,6 +195,25 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def module_main(argv: list[str] | None, name: str, run, doc: str) -> int:
+    """The command line of one benchmark module (``python -m benchmarks.<name>``): ``--quick``,
+    ``--device``, ``--out``; runs ``run(quick, device)`` and saves its record with the command,
+    date, machine and versions."""
+    p = argparse.ArgumentParser(prog=f"python -m benchmarks.{name}", description=doc.splitlines()[0])
+    p.add_argument("--quick", action="store_true", help="small sizes, fewer repeats")
+    p.add_argument("--device", default="cpu", help="Warp device for the Warp side (default cpu)")
+    p.add_argument("--out", type=Path, default=None, help="JSON file (default benchmarks/results/...)")
+    args = p.parse_args(argv)
+    record = run(args.quick, args.device)
+    record.update(command=f"python -m benchmarks.{name}" + (" --quick" if args.quick else "")
+                  + f" --device {args.device}", date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                  machine={"platform": platform.platform(), "processor": _cpu_name(),
+                           "python": platform.python_version()},
+                  versions={d: metadata.version(d) for d in ("warp-lang", "numpy")})
+    save_record(record, args.out, name, args.quick, args.device)
+    return 0
+
+
 def save_record(record: dict, out: Path | None, name: str, quick: bool, device: str) -> Path:
     """Write a benchmark's JSON record to ``out`` or benchmarks/results/<name>[_quick]_<device>.json."""
     tag = f"{name}{'_quick' if quick else ''}_{device.replace(':', '')}"
