@@ -336,6 +336,10 @@ def _beams() -> None:
         l1 = np.abs(bm.floor_irradiance - ph.floor_irradiance).sum() / ph.floor_irradiance.sum()
         print(f"vs exact photons at {s * s} per cell: relative L1 {l1:.2%}; beams floor / transmitted - 1 = "
               f"{(bm.floor_flux_w_nm / bm.transmitted_flux_w_nm - 1).max():.1e}")
+    for el in (20.0, 5.0):
+        low = wc.render(wc.load_scene(ocean, {**rip, **BEAMS, "sun.elevation_deg": el}), device="cpu")
+        print(f"sun {el:g}° high: beams floor / transmitted - 1 = "
+              f"{(low.floor_flux_w_nm / low.transmitted_flux_w_nm - 1).max():.1e}")
 
     print("\n## Scan-plane chord of a straight prism vs the exact float64 ray-prism chord")
     rng = np.random.default_rng(5)
