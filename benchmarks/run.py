@@ -27,7 +27,9 @@ BINS_FULL = (256, 512, [3, 8, 16, 32])
 BINS_QUICK = (128, 256, [3, 8])
 # Step benchmarks: (module, label, sizes N full, sizes N quick)
 STEPS = [("ocean_step", "FFT ocean step, choppy (4 complex 2-D FFTs)", [64, 128, 256, 512, 1024], [64, 128]),
-         ("pool_step", "shallow-water pool substep", [64, 128, 256, 512, 1024], [64, 128])]
+         ("pool_step", "shallow-water pool substep", [64, 128, 256, 512, 1024], [64, 128]),
+         ("procedural_step", "procedural octave waves (GPU Gems ch. 2), heights + analytic normals",
+          [64, 128, 256, 512, 1024], [64, 128])]
 
 
 def _in_child(func_name: str, *args, module: str = "frame"):

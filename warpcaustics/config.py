@@ -36,6 +36,7 @@ class WaterModel(str, enum.Enum):
     FFT = "fft"
     POOL = "pool"
     WAVEPOOL = "wavepool"
+    PROCEDURAL = "procedural"
 
 
 class WaterSpectrum(str, enum.Enum):
@@ -129,7 +130,6 @@ class DeviceChoice(str, enum.Enum):
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
     "caustics.method": ("sunmap", "eikonal", "wave3d"),
-    "water.model": ("procedural",),
 }
 
 
@@ -166,9 +166,11 @@ class BodyConfig:
 @dataclass(frozen=True)
 class WaterConfig:
     model: WaterModel = WaterModel.FFT
-    """Surface model: ``flat``, ``heightfield`` (from ``water.file``) or ``fft`` (Tessendorf)."""
+    """Surface model: ``flat``, ``heightfield`` (from ``water.file``), ``fft`` (Tessendorf), the walled
+    ``pool`` (shallow water) and ``wavepool`` (wave equation), or ``procedural`` (GPU Gems octave
+    waves, an open patch that does not tile)."""
     extent_m: float = field(default=16.0, metadata=_range(0.0, None, lo_open=True))
-    """Side L of the square, periodic water patch centred at the origin [m]."""
+    """Side L of the square water patch centred at the origin [m]."""
     resolution: int | None = field(default=None, metadata=_range(4, 4096))
     """Vertices per side N (default 256; a heightfield takes N from its file) [-]."""
     file: str | None = None
@@ -208,11 +210,34 @@ class WaterConfig:
     """Damping γ of the ``wavepool`` (η_tt = c²∇²η − γη_t): energy decays as e^(−γt) [1/s]."""
     seed: int = field(default=0, metadata=_range(0, 2**63 - 1))
     """Seed of the ocean's random phases and amplitudes."""
+    procedural_amplitude: float = field(default=0.01, metadata=_range(0.0, 1.0))
+    """A of the ``procedural`` waves (GPU Gems ch. 2's VTXSIZE): η = 2Aℓ·r·Σ −f cos(…) [-]."""
+    procedural_frequency: float = field(default=10.0, metadata=_range(0.0, 1.0e4, lo_open=True))
+    """W of the ``procedural`` waves (the chapter's WAVESIZE): phase W·x̂·ŷ/f in units of ℓ [-]."""
+    procedural_factor: float = field(default=1.0, metadata=_range(0.0, 100.0, lo_open=True))
+    """f_0 of the ``procedural`` waves (the chapter's FACTOR): the first octave's weight; each
+    further octave halves it [-]."""
+    procedural_speed_rad_s: float = field(default=2.0, metadata=_range(-1.0e3, 1.0e3))
+    """S of the ``procedural`` waves (the chapter's SPEED): phase rate [rad/s]."""
+    procedural_octaves: int = field(default=4, metadata=_range(1, 16))
+    """Number of octaves of the ``procedural`` waves [-]."""
+    procedural_scale_m: float = field(default=0.0, metadata=_range(0.0, None))
+    """ℓ, one model unit of the chapter's shader in metres [m]; 0 = half of ``extent_m``."""
 
     @property
     def walled(self) -> bool:
-        """The stateful pools have walls; the other models are periodic patches."""
+        """The stateful pools have walls."""
         return self.model in (WaterModel.POOL, WaterModel.WAVEPOOL)
+
+    @property
+    def periodic(self) -> bool:
+        """A tileable patch (flat, heightfield, fft); the pools and the procedural waves are not."""
+        return not self.walled and self.model is not WaterModel.PROCEDURAL
+
+    @property
+    def stateful(self) -> bool:
+        """Frame k steps on from frame k−1 (the pools); the other models are functions of time."""
+        return self.walled
 
 
 @dataclass(frozen=True)
@@ -592,13 +617,14 @@ def _check_vector(key: str, value: tuple[float, ...], lengths: tuple[int, ...]) 
 def _check_periodic_floor(cfg: Config) -> None:
     """Under a periodic sea the floor must tile the patch too: the photons of the neighbouring
     tiles are folded into the patch, which is only right if the floor repeats with it."""
-    if cfg.water.walled:
+    if not cfg.water.periodic:
         return
     floor = cfg.floor
     if floor.shape is FloorShape.SLOPE:
         raise ConfigError(f"floor.shape = 'slope' does not repeat, but water.model = "
-                          f"{cfg.water.model.value!r} is a periodic patch: use a walled pool "
-                          "(water.model = \"pool\" or \"wavepool\") or a floor that tiles (ripples, file)")
+                          f"{cfg.water.model.value!r} is a periodic patch: use a water model that does not "
+                          "tile (water.model = \"pool\", \"wavepool\" or \"procedural\") or a floor that "
+                          "tiles (ripples, file)")
     if floor.shape is FloorShape.RIPPLES:
         a = math.radians(floor.ripple_direction_deg)
         m = math.cos(a) * cfg.water.extent_m / floor.ripple_wavelength_m
@@ -621,9 +647,9 @@ def _check_beam_levels(cfg: Config) -> None:
     levels = cfg.caustics.beam_levels
     if not levels:
         return
-    if cfg.water.walled:
+    if not cfg.water.periodic:
         raise ConfigError(f"caustics.beam_levels = {levels} needs a periodic sea (water.model fft, flat "
-                          f"or heightfield), not the walled {cfg.water.model.value!r}; set "
+                          f"or heightfield), not the non-periodic {cfg.water.model.value!r}; set "
                           "caustics.beam_levels = 0")
     n = cfg.water.resolution
     if n is not None and n % (1 << levels):

@@ -17,7 +17,7 @@ from warpcaustics.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.config import CausticsMethod
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.phase import PhaseFunction
-from warpcaustics.receivers import Receivers
+from warpcaustics.receivers import WALL_FACES, Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
 from warpcaustics.water import make_water, water_bytes
@@ -145,12 +145,12 @@ def scene_bytes(scene: Scene) -> int:
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
     if cfg.caustics.method.uses_receivers:
-        periodic = not cfg.water.walled
+        periodic = cfg.water.periodic
         faces = receiver_face_estimate(scene, periodic)
         cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
         stage = 0
         if cfg.caustics.method in (CausticsMethod.BEAMS, CausticsMethod.BOTH):
-            walls = 0 if periodic else 4 * 2 * 32 * 8
+            walls = WALL_FACES if cfg.water.walled else 0
             sampled = sum(len(m.triangles) for m in scene.receiver_meshes) + walls
             stage += beams.beams_bytes(cfg, n, k, groups, periodic, faces, sampled)
         if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
@@ -160,14 +160,16 @@ def scene_bytes(scene: Scene) -> int:
 
 
 def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
-    """The camera must be in the water: inside a walled pool's walls and above the floor."""
+    """The camera must be in the water: over a non-periodic patch (inside a pool's walls) and above
+    the floor."""
     from warpcaustics.errors import ConfigError
     from warpcaustics.receivers import floor_relief_height
 
     x, y, z = cfg.camera.position_m
     half = 0.5 * cfg.water.extent_m
     if not periodic and max(abs(x), abs(y)) >= half:
-        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is outside the pool's walls "
+        where = "the pool's walls" if cfg.water.walled else f"the {cfg.water.model.value!r} water patch"
+        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is outside {where} "
                           f"(|x|, |y| < {half:g} m); move the camera into the water")
     floor_z = float(floor_relief_height(cfg.floor, floor_relief, cfg.water.extent_m, np.array(x),
                                         np.array(y)))
@@ -183,7 +185,8 @@ def receiver_face_estimate(scene: Scene, periodic: bool) -> int:
     cfg = scene.config
     cells = floor_mesh_cells(cfg)
     floor = 2 * int(cells * (1.5 if periodic else 1.0)) ** 2
-    return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + (0 if periodic else 4 * 2 * 32 * 8)
+    walls = WALL_FACES if cfg.water.walled else 0
+    return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + walls
 
 
 class Renderer:

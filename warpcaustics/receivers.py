@@ -33,6 +33,9 @@ WALL_ALBEDO = (0.8,)
 WALL_CELLS = 32
 """Wall quads per side along the wall (and 8 up it)."""
 
+WALL_FACES = 4 * 2 * WALL_CELLS * 8
+"""Triangles of the four walls."""
+
 
 def floor_relief_height(
     floor: FloorConfig, relief: np.ndarray | None, extent_m: float, x: np.ndarray, y: np.ndarray
@@ -302,7 +305,7 @@ class Receivers:
         parts = [floor]
         ids = [np.full(len(floor.triangles), FLOOR_ID)]
         names = ["floor"]
-        if not periodic:
+        if cfg.water.walled:
             bottom = float(floor.points[:, 2].min()) - 0.01 * cfg.water.extent_m
             walls = wall_mesh(cfg.water.extent_m, bottom, water_top_z)
             parts.append(walls)

@@ -139,7 +139,7 @@ def load_sweep(path: str | Path) -> Sweep:
             tasks.append(Task(task_id({"overrides": overrides}, times), overrides, times, 0, str(exc)))
             continue
         resolved = config_to_dict(scene.config)
-        stateful = scene.config.water.walled  # the pools: frame k steps on from frame k-1
+        stateful = scene.config.water.stateful  # the pools: frame k steps on from frame k-1
         groups = [times] if stateful else [(t,) for t in times]
         for i, group in enumerate(groups):
             tasks.append(

@@ -1,9 +1,11 @@
 """Water surfaces: every model gives device arrays of vertex positions and unit normals.
 
 Vertices sit at cell centres ``(i + 0.5)·L/N − L/2`` of a periodic N×N grid, row index along +y.
-Models: ``flat`` and ``heightfield`` (a periodic height field, normals by central differences) and
+Models: ``flat`` and ``heightfield`` (a periodic height field, normals by central differences),
 ``fft`` (Tessendorf's ocean, Phillips or JONSWAP spectrum, optional choppy displacement; heights,
-slopes and displacements by inverse FFT in Warp).
+slopes and displacements by inverse FFT in Warp) and ``procedural`` (GPU Gems ch. 2 octave waves
+with their analytic gradient, an open patch that does not tile). The walled pools live in
+``pool.py`` and ``wavepool.py``.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from warpcaustics.config import Config, WaterModel, WaterSpectrum
 from warpcaustics.heights import DEFAULT_RESOLUTION
 from warpcaustics.kernels import heightfield as hf_kernels
 from warpcaustics.kernels import ocean as ocean_kernels
+from warpcaustics.kernels import procedural as procedural_kernels
 
 GRAVITY_M_S2 = 9.81
 
@@ -34,7 +37,7 @@ class Surface:
     jacobian: wp.array2d | None = None
     """(N, N) Jacobian of the choppy horizontal map (≤ 0 where the surface folds), if any."""
     periodic: bool = True
-    """True for a tileable patch (footprints wrap); False for a walled pool."""
+    """True for a tileable patch (footprints wrap); False for a pool or the procedural waves."""
 
     @property
     def resolution(self) -> int:
@@ -61,6 +64,51 @@ class HeightfieldWater:
                   inputs=[self.heights, self.extent_m], outputs=[positions, normals],
                   device=self.device)
         return Surface(positions, normals, self.extent_m)
+
+
+class ProceduralWater:
+    """GPU Gems ch. 2 octave waves (``kernels/procedural.py``): stateless, open, not tileable.
+
+    The patch is the whole sea: light that leaves it is lost, as under a walled pool but with no
+    walls to catch it.
+    """
+
+    periodic = False
+    """The waves do not repeat: footprints do not wrap."""
+
+    def __init__(self, n: int, extent_m: float, device: str, *, amplitude: float = 0.01,
+                 frequency: float = 10.0, factor: float = 1.0, speed_rad_s: float = 2.0, octaves: int = 4,
+                 scale_m: float = 0.0):
+        self.device = device
+        self.extent_m = float(extent_m)
+        self.n = int(n)
+        self.waves = procedural_kernels.OctaveWaves()
+        self.waves.amplitude = float(amplitude)
+        self.waves.frequency = float(frequency)
+        self.waves.factor = float(factor)
+        self.waves.speed_rad_s = float(speed_rad_s)
+        self.waves.octaves = int(octaves)
+        self.waves.scale_m = float(scale_m) if scale_m > 0.0 else 0.5 * self.extent_m
+
+    @classmethod
+    def from_config(cls, cfg: Config, device: str) -> ProceduralWater:
+        w = cfg.water
+        return cls(w.resolution or DEFAULT_RESOLUTION, w.extent_m, device,
+                   amplitude=w.procedural_amplitude, frequency=w.procedural_frequency,
+                   factor=w.procedural_factor, speed_rad_s=w.procedural_speed_rad_s,
+                   octaves=w.procedural_octaves, scale_m=w.procedural_scale_m)
+
+    @property
+    def resolution(self) -> int:
+        return self.n
+
+    def at(self, time_s: float) -> Surface:
+        positions = wp.empty((self.n, self.n), dtype=wp.vec3, device=self.device)
+        normals = wp.empty((self.n, self.n), dtype=wp.vec3, device=self.device)
+        wp.launch(procedural_kernels.octave_surface, dim=(self.n, self.n),
+                  inputs=[self.waves, float(time_s), self.extent_m], outputs=[positions, normals],
+                  device=self.device)
+        return Surface(positions, normals, self.extent_m, periodic=False)
 
 
 def wavenumbers(n: int, extent_m: float) -> np.ndarray:
@@ -296,5 +344,7 @@ def make_water(cfg: Config, device: str, heights: np.ndarray | None, floor_relie
         return WaveEquationPool.from_config(cfg, device)
     if w.model is WaterModel.HEIGHTFIELD:
         return HeightfieldWater(heights, w.extent_m, device)
+    if w.model is WaterModel.PROCEDURAL:
+        return ProceduralWater.from_config(cfg, device)
     n = w.resolution or DEFAULT_RESOLUTION
     return HeightfieldWater(np.zeros((n, n), np.float32), w.extent_m, device)
