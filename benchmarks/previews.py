@@ -8,7 +8,9 @@
 - ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots and ocean_floor by
   photons (left) and by beams (right, ``caustics.method = "both"``);
 - ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
-  an Ernst-style bounding prism projected on the screen.
+  an Ernst-style bounding prism projected on the screen;
+- ``docs/images/methods_ocean.png``: one frame of configs/ocean.toml (128², 256² map) by every
+  floor method, as ``warpcaustics compare`` draws it.
 """
 
 from __future__ import annotations
@@ -59,7 +61,21 @@ def main() -> int:
         write_png(images / f"{name}.png", _camera_preview(renderer.render(time_s)))
         print(f"wrote {images / f'{name}.png'}")
     _beam_pictures(images)
+    _method_pictures(images)
     return 0
+
+
+def _method_pictures(images: Path) -> None:
+    import tempfile
+
+    from warpcaustics.compare import compare_methods, write_comparison
+
+    overrides = {"water.resolution": 128, "caustics.map_resolution": 256}
+    comparison = compare_methods(ROOT / "configs" / "ocean.toml", overrides, 0.0, "cpu")
+    with tempfile.TemporaryDirectory() as tmp:
+        png = write_comparison(Path(tmp), comparison, 0.0)["png"]
+        (images / "methods_ocean.png").write_bytes(png.read_bytes())
+    print(f"wrote {images / 'methods_ocean.png'}")
 
 
 def _beam_pictures(images: Path) -> None:

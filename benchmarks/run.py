@@ -171,6 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     # The beam rasteriser vs its numpy twins, in one child process (benchmarks/beams.py).
     beams = _in_child("run", args.quick, args.device, module="beams")
 
+    # Sun-map caustics vs the flux-ratio map of the same frame (benchmarks/sunmap.py).
+    sunmap = _in_child("run", args.quick, args.device, module="sunmap")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -191,6 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         "bins": bins_rows,
         "photons": photons,
         "beams": beams,
+        "sunmap": sunmap,
         "sweep": sweeps,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)

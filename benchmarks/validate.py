@@ -182,7 +182,27 @@ def main() -> int:
 
     _photons()
     _beams()
+    _approximate_methods()
     return 0
+
+
+APPROXIMATE = ("sunmap",)
+"""The approximate floor methods (issue 8), compared with the flux-ratio map."""
+
+
+def _approximate_methods() -> None:
+    """The approximate methods against the flux-ratio map: docs/validation.md's method table."""
+    from warpcaustics.compare import compare_methods
+
+    print("\n## Approximate methods vs the flux-ratio map (band-summed maps normalised by their means)")
+    scenes = {"configs/ocean.toml": {}, "configs/procedural.toml": {},
+              "configs/lens.toml": {"caustics.map_resolution": 128}}
+    for config, overrides in scenes.items():
+        rows = compare_methods(ROOT / config, overrides, 0.0, "cpu", APPROXIMATE)["rows"]
+        reference = rows[0]["contrast"]
+        for r in rows[1:]:
+            print(f"{config:26s} {r['method']:8s} correlation {r['correlation']:6.3f}  relative L1 "
+                  f"{r['relative_l1']:.3f}  contrast {r['contrast']:.3f} (flux ratio {reference:.3f})")
 
 
 def _photons() -> None:

@@ -1,5 +1,5 @@
-"""Command line: ``warpcaustics render | study | sweep | report | info``. User errors print one line
-and exit with 2."""
+"""Command line: ``warpcaustics render | study | sweep | preview | compare | report | info``. User
+errors print one line and exit with 2."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from warpcaustics import __version__
+from warpcaustics.compare import FLOOR_METHODS
 from warpcaustics.errors import WarpcausticsError
 
 EXIT_USER_ERROR = 2
@@ -67,6 +68,21 @@ def _parser() -> argparse.ArgumentParser:
     pv.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help="simulation time [s]")
     pv.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
     pv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
+                    help="override a config key (repeatable)")
+
+    cp = sub.add_parser("compare", help="one frame by every floor-caustics method, side by side",
+                        description="Render one frame of CONFIG with each floor-caustics method (flux "
+                                    "ratio, sun map, beams, photons) and compare each floor map with the "
+                                    "flux-ratio map: DIR/compare.csv, compare.json, compare.png and each "
+                                    "method's frame in DIR/<method>/.")
+    cp.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
+    cp.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
+    cp.add_argument("--methods", default=",".join(FLOOR_METHODS), metavar="LIST",
+                    help=f"comma-separated methods (default {','.join(FLOOR_METHODS)}; fluxratio, the "
+                         "reference, is always included)")
+    cp.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help="simulation time [s]")
+    cp.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    cp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
                     help="override a config key (repeatable)")
 
     rp = sub.add_parser("report", help="print a sweep's summary table and plot it",
@@ -158,6 +174,28 @@ def _preview(args: argparse.Namespace) -> int:
     return 0
 
 
+def _compare(args: argparse.Namespace) -> int:
+    from warpcaustics.compare import compare_methods, write_comparison
+    from warpcaustics.config import parse_override
+
+    if args.time != args.time or abs(args.time) == float("inf"):
+        raise WarpcausticsError(f"--time = {args.time} must be a finite number of seconds")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+    methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
+    overrides = dict(parse_override(text) for text in args.overrides)
+    comparison = compare_methods(args.config, overrides, args.time, args.device, methods)
+    paths = write_comparison(out, comparison, args.time)
+    print(f"{'method':10s} {'correlation':>11s} {'rel. L1':>8s} {'contrast':>8s} {'seconds':>8s}"
+          "   (normalised maps vs fluxratio)")
+    for r in comparison["rows"]:
+        print(f"{r['method']:10s} {r['correlation']:11.3f} {r['relative_l1']:8.3f} {r['contrast']:8.3f} "
+              f"{r['render_s']:8.2f}")
+    print(f"wrote {paths['csv']}, {paths['json']}, {paths['png']}")
+    return 0
+
+
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
     from warpcaustics.output import versions
@@ -193,6 +231,8 @@ def main(argv: list[str] | None = None) -> int:
                               args.address)
         if args.command == "preview":
             return _preview(args)
+        if args.command == "compare":
+            return _compare(args)
         if args.command == "report":
             from warpcaustics.sweep import report_main
 

@@ -97,6 +97,7 @@ class CausticsMethod(str, enum.Enum):
     PHOTONS = "photons"
     BEAMS = "beams"
     BOTH = "both"
+    SUNMAP = "sunmap"
 
     @property
     def uses_receivers(self) -> bool:
@@ -129,7 +130,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("sunmap", "eikonal", "wave3d"),
+    "caustics.method": ("eikonal", "wave3d"),
 }
 
 
@@ -346,7 +347,9 @@ class CausticsConfig:
     ``photons`` (photon splatting onto every receiver, Shah et al. 2007) or ``beams`` (warped beam
     volumes through a tile-binned rasteriser onto every receiver, with volume caustics in the
     camera; Ernst et al. 2005, Liktor & Dachsbacher 2011) or ``both`` (beams and photons on the same
-    frame, both saved with the difference of their floor maps)."""
+    frame, both saved with the difference of their floor maps) or ``sunmap`` (GPU Gems ch. 2:
+    backward rays from the floor looked up in a soft sun map, scaled to the flux-ratio map's mean,
+    which is saved beside it)."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
     intersection: Intersection = Intersection.EXACT
@@ -372,6 +375,11 @@ class CausticsConfig:
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""
+    sunmap_disk_deg: float = field(default=0.53, metadata=_range(0.0, 90.0))
+    """Angular diameter of the sun's disk in the ``sunmap`` (full brightness inside) [deg]."""
+    sunmap_halo_deg: float = field(default=5.3, metadata=_range(0.0, 180.0, lo_open=True))
+    """Angular diameter of the halo where the ``sunmap`` brightness falls to 0 (GPU Gems ch. 2: an
+    arc about 10 times the disk's) [deg]."""
 
 
 @dataclass(frozen=True)
@@ -642,6 +650,13 @@ def _check_periodic_floor(cfg: Config) -> None:
                 f"floor.ripple_direction_deg = {direction:.12g}")
 
 
+def _check_sunmap(cfg: Config) -> None:
+    c = cfg.caustics
+    if c.sunmap_halo_deg <= c.sunmap_disk_deg:
+        raise ConfigError(f"caustics.sunmap_halo_deg = {c.sunmap_halo_deg:g} must exceed "
+                          f"caustics.sunmap_disk_deg = {c.sunmap_disk_deg:g} (the halo surrounds the disk)")
+
+
 def _check_beam_levels(cfg: Config) -> None:
     """Adaptive beams refine quads of 2^levels cells of a periodic sea."""
     levels = cfg.caustics.beam_levels
@@ -663,6 +678,7 @@ def _check_beam_levels(cfg: Config) -> None:
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
+    _check_sunmap(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []
     if cfg.floor.shape is not FloorShape.FLAT:

@@ -112,26 +112,28 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
             "warpcaustics.quantity": "spectral radiance at the camera"}, RADIANCE_UNITS)
     if result.scene.config.output.vtk:
         paths.update(write_vtk(result, out_dir, frame=frame))
-    if result.comparison is not None:  # "both": the photons' frame and the beams − photons floor map
+    if result.comparison is not None:  # "both" or "sunmap": the other method's frame and the difference
         other = result.comparison
-        stem = f"frame_{frame:04d}_photons"
-        paths["photons_exr"], paths["photons_png"] = out_dir / f"{stem}.exr", out_dir / f"{stem}.png"
-        header = {"warpcaustics.quantity": "floor spectral irradiance (photons)",
+        name = other.method
+        stem = f"frame_{frame:04d}_{name}"
+        paths[f"{name}_exr"], paths[f"{name}_png"] = out_dir / f"{stem}.exr", out_dir / f"{stem}.png"
+        header = {"warpcaustics.quantity": f"floor spectral irradiance ({name})",
                   "warpcaustics.extent_m": f"{result.extent_m:g}"}
-        _write_spectral_image(other, other.floor_irradiance[:, ::-1, :], paths["photons_exr"],
-                              paths["photons_png"], header, EMISSIVE_UNITS)
+        _write_spectral_image(other, other.floor_irradiance[:, ::-1, :], paths[f"{name}_exr"],
+                              paths[f"{name}_png"], header, EMISSIVE_UNITS)
         if other.camera_radiance is not None:
-            stem = f"camera_{frame:04d}_photons"
-            paths["camera_photons_exr"] = out_dir / f"{stem}.exr"
-            paths["camera_photons_png"] = out_dir / f"{stem}.png"
-            header = {"warpcaustics.quantity": "spectral radiance at the camera (photons)"}
-            _write_spectral_image(other, other.camera_radiance, paths["camera_photons_exr"],
-                                  paths["camera_photons_png"], header, RADIANCE_UNITS)
-        paths["difference_exr"] = out_dir / f"frame_{frame:04d}_beams_minus_photons.exr"
+            stem = f"camera_{frame:04d}_{name}"
+            paths[f"camera_{name}_exr"] = out_dir / f"{stem}.exr"
+            paths[f"camera_{name}_png"] = out_dir / f"{stem}.png"
+            header = {"warpcaustics.quantity": f"spectral radiance at the camera ({name})"}
+            _write_spectral_image(other, other.camera_radiance, paths[f"camera_{name}_exr"],
+                                  paths[f"camera_{name}_png"], header, RADIANCE_UNITS)
+        paths["difference_exr"] = out_dir / f"frame_{frame:04d}_{result.method}_minus_{name}.exr"
         difference = (result.floor_irradiance - other.floor_irradiance)[:, ::-1, :]
+        quantity = (f"floor spectral irradiance, {result.method} minus {name} (R, G, B are zero: a signed "
+                    "difference has no colour)")
         write_exr(paths["difference_exr"], np.zeros(difference.shape[1:] + (3,), np.float32), difference,
-                  result.wavelengths_nm, {"warpcaustics.quantity": "floor spectral irradiance, beams minus "
-                                          "photons (R, G, B are zero: a signed difference has no colour)",
+                  result.wavelengths_nm, {"warpcaustics.quantity": quantity,
                                           "warpcaustics.time_s": f"{result.time_s:g}"})
     return paths
 
@@ -221,17 +223,41 @@ def _write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, heade
 
 
 def comparison_entry(frame: int, r) -> dict:
-    """``both``: the photons' files, flux and stats beside the beams', and how far the maps differ."""
+    """``both`` (photons beside beams) or ``sunmap`` (the flux-ratio map beside it): the other
+    method's files, flux and stats, and how far the maps differ."""
     other = r.comparison
-    a = r.floor_irradiance.astype(np.float64)
-    b = other.floor_irradiance.astype(np.float64)
-    files = [f"frame_{frame:04d}_photons.exr", f"frame_{frame:04d}_photons.png",
-             f"frame_{frame:04d}_beams_minus_photons.exr"]
+    name = other.method
+    files = [f"frame_{frame:04d}_{name}.exr", f"frame_{frame:04d}_{name}.png",
+             f"frame_{frame:04d}_{r.method}_minus_{name}.exr"]
     if other.camera_radiance is not None:
-        files += [f"camera_{frame:04d}_photons.exr", f"camera_{frame:04d}_photons.png"]
-    return {"method": "photons", "files": files, "floor_flux_w_nm": other.floor_flux_w_nm,
-            "transmitted_flux_w_nm": other.transmitted_flux_w_nm, "photons": other.photon_stats,
-            "floor_relative_l1_beams_vs_photons": float(np.abs(a - b).sum() / max(np.abs(b).sum(), 1e-300))}
+        files += [f"camera_{frame:04d}_{name}.exr", f"camera_{frame:04d}_{name}.png"]
+    l1 = relative_l1(r.floor_irradiance, other.floor_irradiance)
+    entry = {"method": name, "files": files, "floor_flux_w_nm": other.floor_flux_w_nm,
+             "transmitted_flux_w_nm": other.transmitted_flux_w_nm,
+             f"floor_relative_l1_{r.method}_vs_{name}": l1}
+    if other.photon_stats is not None:
+        entry["photons"] = other.photon_stats
+    if name == "fluxratio":  # the approximate method against the reference, maps normalised
+        entry[f"floor_correlation_{r.method}_vs_{name}"] = map_correlation(r.floor_irradiance,
+                                                                           other.floor_irradiance)
+    return entry
+
+
+def relative_l1(a: np.ndarray, reference: np.ndarray) -> float:
+    """Σ|a − ref| / Σ|ref| over all bands and texels (float64)."""
+    a = np.asarray(a, np.float64)
+    ref = np.asarray(reference, np.float64)
+    return float(np.abs(a - ref).sum() / max(np.abs(ref).sum(), 1e-300))
+
+
+def map_correlation(a: np.ndarray, reference: np.ndarray) -> float:
+    """Pearson correlation of the band-summed maps (1: the same pattern up to scale); 0 when either
+    map is uniform."""
+    x = np.asarray(a, np.float64).sum(axis=0).ravel()
+    y = np.asarray(reference, np.float64).sum(axis=0).ravel()
+    x, y = x - x.mean(), y - y.mean()
+    norm = np.sqrt((x * x).sum() * (y * y).sum())
+    return float((x * y).sum() / norm) if norm > 0 else 0.0
 
 
 def frame_entry(frame: int, r) -> dict:

@@ -20,6 +20,7 @@ from warpcaustics.phase import PhaseFunction
 from warpcaustics.receivers import WALL_FACES, Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
+from warpcaustics.sunmap import SunMapCaustics, scale_to_flux_ratio
 from warpcaustics.water import make_water, water_bytes
 
 
@@ -75,9 +76,14 @@ class RenderResult:
     """``photons``: photons emitted, carrying flux, and landed on a receiver."""
     beam_stats: dict[str, int] | None = None
     """``beams``: beams built, carrying flux, dropped, and tile-list entries."""
+    method: str = "fluxratio"
+    """The caustics method that made :attr:`floor_irradiance` (``beams`` for ``both``)."""
     comparison: RenderResult | None = None
-    """``both``: the photon method's result of the same frame (this result is the beams'); saved
-    beside it with the difference of the floor maps."""
+    """``both``: the photon method's result of the same frame (this result is the beams');
+    ``sunmap``: the flux-ratio map of the same frame. Saved beside it with the difference of the
+    floor maps."""
+    sunmap_brightness: np.ndarray | None = None
+    """``sunmap``: (M, M) grey sun-map brightness 0…1 before scaling to the flux-ratio mean."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -156,7 +162,9 @@ def scene_bytes(scene: Scene) -> int:
         if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
             stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
         return water_bytes(cfg, n) + stage + cam
-    return water_bytes(cfg, n) + caustics.floor_bytes(n, cfg.caustics.map_resolution, k, groups)
+    m = cfg.caustics.map_resolution
+    sun_map = m * m * 4 if cfg.caustics.method is CausticsMethod.SUNMAP else 0
+    return water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sun_map
 
 
 def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
@@ -245,6 +253,11 @@ class Renderer:
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
                                                     self.attenuation_per_m, self.device,
                                                     periodic=self.water.periodic)
+                self.sunmap = None
+                if cfg.caustics.method is CausticsMethod.SUNMAP:
+                    # grey: one index for the backward rays, the mean over the bins
+                    self.sunmap = SunMapCaustics(cfg, scene.sun_direction, float(np.mean(self.ior)),
+                                                 self.device, periodic=self.water.periodic)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
@@ -294,6 +307,12 @@ class Renderer:
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
                 transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+            if self.sunmap is not None:
+                with watch.stage("sunmap"):
+                    brightness = self.sunmap.run(surface, self.water, time_s).numpy().copy()
+                extra = {"sunmap_brightness": brightness}
+                flux_ratio_floor = floor_np
+                floor_np = scale_to_flux_ratio(brightness, flux_ratio_floor)
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
@@ -303,11 +322,16 @@ class Renderer:
             bin_widths_nm=self.bins.widths_nm, attenuation_per_m=self.attenuation_per_m, ior=self.ior,
             sun_irradiance=self.sun_irradiance, surface_positions=positions, surface_normals=normals,
             bins=self.bins, fold_fraction=folds, timings_s=watch.timings)
+        method = cfg.caustics.method
         if self.photons is not None and self.beams is not None:  # "both": photons as the comparison
             other_floor, other_transmitted, other_extra = outputs[1]
             comparison = RenderResult(floor_irradiance=other_floor, transmitted_flux_w_nm=other_transmitted,
-                                      **common, **other_extra)
-        return RenderResult(floor_irradiance=floor_np, transmitted_flux_w_nm=transmitted,
+                                      method="photons", **common, **other_extra)
+        if method is CausticsMethod.SUNMAP:  # the flux-ratio map it was scaled to, as the comparison
+            comparison = RenderResult(floor_irradiance=flux_ratio_floor, transmitted_flux_w_nm=transmitted,
+                                      method="fluxratio", **common)
+        name = "beams" if method is CausticsMethod.BOTH else method.value
+        return RenderResult(floor_irradiance=floor_np, transmitted_flux_w_nm=transmitted, method=name,
                             comparison=comparison, **common, **extra)
 
     def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:

@@ -274,6 +274,8 @@ def summary_row(task: Task, result, k: int) -> dict:
     (standard deviation / mean of the band-summed floor irradiance), photon counts, timings."""
     import numpy as np
 
+    from warpcaustics.output import relative_l1
+
     floor = result.floor_irradiance.astype(np.float64)
     total = (floor * result.bin_widths_nm[:, None, None]).sum(axis=0)
     row = {"id": task.id, "frame": task.frame_start + k, "time_s": result.time_s}
@@ -287,9 +289,9 @@ def summary_row(task: Task, result, k: int) -> dict:
         row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
     if result.beam_stats:
         row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
-    if result.comparison is not None:  # "both": how far the photons' floor map is from the beams'
-        other = result.comparison.floor_irradiance.astype(np.float64)
-        row["beams_vs_photons_l1"] = float(np.abs(floor - other).sum() / max(np.abs(other).sum(), 1e-300))
+    if result.comparison is not None:  # "both" or "sunmap": how far the other method's floor map is
+        other = result.comparison
+        row[f"{result.method}_vs_{other.method}_l1"] = relative_l1(floor, other.floor_irradiance)
     row["render_s"] = float(sum(result.timings_s.values()))
     return row
 

@@ -1,0 +1,102 @@
+"""Sun-map caustics (GPU Gems ch. 2) per frame vs the flux-ratio floor map, same scene, same run.
+
+For the default ocean (``configs/ocean.toml``, the surface grid path) and the procedural waves
+(``configs/procedural.toml``, the analytic path) at the same water N and map M: the median wall
+time of the sun-map stage (one backward ray per texel) and of the flux-ratio map (refraction of
+every vertex, then the footprint deposits), each after one warm-up frame, device synchronised.
+``python -m benchmarks.sunmap --help``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+FULL = [(256, 512), (512, 1024)]
+QUICK = [(128, 256)]
+SCENES = ("configs/ocean.toml", "configs/procedural.toml")
+
+
+def _median_time(func, repeats: int, device: str) -> float:
+    import warp as wp
+
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        func()
+        wp.synchronize_device(device)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
+    """Times of the two floor maps of one frame (the water surface is computed once, outside)."""
+    import warpcaustics as wc
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.refraction import refract_to_floor, sun_visibility
+
+    scene = wc.load_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
+                                   "caustics.map_resolution": m})
+    renderer = Renderer(scene, device)
+    result = renderer.render(0.5)  # warm-up: JIT compile, first launches
+    surface = renderer.water.at(0.5)
+    highest = float(surface.positions.numpy()[..., 2].max())
+    visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
+    depth = scene.config.floor.depth_m
+
+    def flux_ratio():
+        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction, -depth,
+                                     device, out=renderer.refracted)
+        renderer.floor.run(surface, refracted, scene.sun_direction)
+
+    def sun_map():
+        renderer.sunmap.run(surface, renderer.water, 0.5)
+
+    fluxratio_s = _median_time(flux_ratio, repeats, device)
+    sunmap_s = _median_time(sun_map, repeats, device)
+    from warpcaustics.output import map_correlation, relative_l1
+
+    return {"config": config, "water_n": n, "map_m": m, "bins": len(result.wavelengths_nm),
+            "fluxratio_s": fluxratio_s, "sunmap_s": sunmap_s,
+            "speedup_sunmap_vs_fluxratio": fluxratio_s / sunmap_s,
+            "relative_l1_sunmap_vs_fluxratio": relative_l1(result.floor_irradiance,
+                                                           result.comparison.floor_irradiance),
+            "correlation_sunmap_vs_fluxratio": map_correlation(result.floor_irradiance,
+                                                               result.comparison.floor_irradiance)}
+
+
+def run(quick: bool, device: str) -> dict:
+    import warp as wp
+
+    from benchmarks.run import _cpu_name
+
+    repeats = 2 if quick else 5
+    wp_name = str(wp.get_device(device).name)
+    print(f"sunmap       warp {wp.__version__} [{device}: {wp_name}] | cpu {_cpu_name()}", flush=True)
+    rows = []
+    for config in SCENES:
+        for n, m in QUICK if quick else FULL:
+            row = measure(config, n, m, device, repeats)
+            rows.append(row)
+            print(f"sunmap       {config:24s} N={n:5d} M={m:5d} K={row['bins']:3d} | sun map "
+                  f"{row['sunmap_s'] * 1e3:9.2f} ms | flux ratio {row['fluxratio_s'] * 1e3:9.2f} ms | "
+                  f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | L1 vs flux ratio "
+                  f"{row['relative_l1_sunmap_vs_fluxratio']:.2f}, correlation "
+                  f"{row['correlation_sunmap_vs_fluxratio']:.2f}", flush=True)
+    return {"benchmark": "sunmap_vs_fluxratio", "device": device, "device_name": wp_name,
+            "warp_version": wp.__version__, "repeats": repeats,
+            "timing": "median wall time of each floor-map stage on one surface, after a warm-up frame, "
+                      "device synchronised",
+            "results": rows}
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "sunmap", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
