@@ -174,6 +174,9 @@ def main(argv: list[str] | None = None) -> int:
     # Sun-map caustics vs the flux-ratio map of the same frame (benchmarks/sunmap.py).
     sunmap = _in_child("run", args.quick, args.device, module="sunmap")
 
+    # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
+    eikonal = _in_child("run", args.quick, args.device, module="eikonal")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -195,6 +198,7 @@ def main(argv: list[str] | None = None) -> int:
         "photons": photons,
         "beams": beams,
         "sunmap": sunmap,
+        "eikonal": eikonal,
         "sweep": sweeps,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)

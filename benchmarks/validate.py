@@ -186,7 +186,7 @@ def main() -> int:
     return 0
 
 
-APPROXIMATE = ("sunmap",)
+APPROXIMATE = ("sunmap", "eikonal")
 """The approximate floor methods (issue 8), compared with the flux-ratio map."""
 
 
@@ -195,13 +195,17 @@ def _approximate_methods() -> None:
     from warpcaustics.compare import compare_methods
 
     print("\n## Approximate methods vs the flux-ratio map (band-summed maps normalised by their means)")
-    scenes = {"configs/ocean.toml": {}, "configs/procedural.toml": {},
-              "configs/lens.toml": {"caustics.map_resolution": 128}}
-    for config, overrides in scenes.items():
-        rows = compare_methods(ROOT / config, overrides, 0.0, "cpu", APPROXIMATE)["rows"]
+    scenes = {"configs/ocean.toml": ({}, 0.0, APPROXIMATE),
+              "configs/ocean.toml, eikonal 256": ({"caustics.eikonal_resolution": 256}, 0.0, ("eikonal",)),
+              "configs/procedural.toml": ({}, 0.0, APPROXIMATE),
+              "configs/lens.toml": ({"caustics.map_resolution": 128}, 0.0, APPROXIMATE),
+              "configs/mercier_pool.toml": ({}, 0.3, APPROXIMATE)}
+    for label, (overrides, time_s, methods) in scenes.items():
+        config = label.split(",")[0]
+        rows = compare_methods(ROOT / config, overrides, time_s, "cpu", methods)["rows"]
         reference = rows[0]["contrast"]
         for r in rows[1:]:
-            print(f"{config:26s} {r['method']:8s} correlation {r['correlation']:6.3f}  relative L1 "
+            print(f"{label:32s} {r['method']:8s} correlation {r['correlation']:6.3f}  relative L1 "
                   f"{r['relative_l1']:.3f}  contrast {r['contrast']:.3f} (flux ratio {reference:.3f})")
 
 

@@ -35,6 +35,31 @@ def bilinear_cell(n: int, extent_m: float, x: float, y: float):
 
 
 @wp.func
+def grid_bilinear(grid: wp.array2d[wp.vec3], extent_m: float, periodic: int, x: float, y: float) -> wp.vec3:
+    """Bilinear sample of a cell-centre grid at (x, y) [m]: wrapped when periodic, else clamped."""
+    n = grid.shape[0]
+    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    if periodic == 0:
+        u = wp.clamp(u, 0.0, float(n - 1))
+        v = wp.clamp(v, 0.0, float(n - 1))
+    fu = wp.floor(u)
+    fv = wp.floor(v)
+    tu = u - fu
+    tv = v - fv
+    i0 = ((int(fu) % n) + n) % n
+    j0 = ((int(fv) % n) + n) % n
+    i1 = (i0 + 1) % n
+    j1 = (j0 + 1) % n
+    if periodic == 0:
+        i1 = wp.min(i0 + 1, n - 1)
+        j1 = wp.min(j0 + 1, n - 1)
+    return (1.0 - tv) * ((1.0 - tu) * grid[j0, i0] + tu * grid[j0, i1]) + tv * (
+        (1.0 - tu) * grid[j1, i0] + tu * grid[j1, i1]
+    )
+
+
+@wp.func
 def bilerp(a: float, b: float, c: float, d: float, tu: float, tv: float) -> float:
     """(1-tv)((1-tu) a + tu b) + tv((1-tu) c + tu d): a, b on row j0; c, d on row j1."""
     return (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)

@@ -11,7 +11,7 @@ sends every ray exactly to the sun's centre (and the chapter's case is the overh
 
 import warp as wp
 
-from warpcaustics.kernels.geometry import cell_centre, refract
+from warpcaustics.kernels.geometry import cell_centre, grid_bilinear, refract
 from warpcaustics.kernels.procedural import OctaveWaves, octave_wave
 
 wp.set_module_options({"enable_backward": False})
@@ -67,31 +67,6 @@ def leave_water(params: SunMap, normal: wp.vec3) -> float:
 
 
 @wp.func
-def grid_sample(grid: wp.array2d[wp.vec3], extent_m: float, periodic: int, x: float, y: float) -> wp.vec3:
-    """Bilinear sample of a cell-centre grid at (x, y) [m]: wrapped when periodic, else clamped."""
-    n = grid.shape[0]
-    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    if periodic == 0:
-        u = wp.clamp(u, 0.0, float(n - 1))
-        v = wp.clamp(v, 0.0, float(n - 1))
-    fu = wp.floor(u)
-    fv = wp.floor(v)
-    tu = u - fu
-    tv = v - fv
-    i0 = ((int(fu) % n) + n) % n
-    j0 = ((int(fv) % n) + n) % n
-    i1 = (i0 + 1) % n
-    j1 = (j0 + 1) % n
-    if periodic == 0:
-        i1 = wp.min(i0 + 1, n - 1)
-        j1 = wp.min(j0 + 1, n - 1)
-    return (1.0 - tv) * ((1.0 - tu) * grid[j0, i0] + tu * grid[j0, i1]) + tv * (
-        (1.0 - tu) * grid[j1, i0] + tu * grid[j1, i1]
-    )
-
-
-@wp.func
 def inside_patch(params: SunMap, p: wp.vec3) -> bool:
     half = 0.5 * params.extent_m
     return params.periodic != 0 or (wp.abs(p[0]) <= half and wp.abs(p[1]) <= half)
@@ -112,11 +87,11 @@ def sunmap_grid(
     start = wp.vec3(xy[0], xy[1], params.floor_z)
     p = start + params.up * ((0.0 - params.floor_z) / params.up[2])
     for _k in range(RAY_ITERATIONS):
-        z = grid_sample(positions, params.extent_m, params.periodic, p[0], p[1])[2]
+        z = grid_bilinear(positions, params.extent_m, params.periodic, p[0], p[1])[2]
         p = start + params.up * ((z - params.floor_z) / params.up[2])
     value = float(0.0)
     if inside_patch(params, p):
-        n = wp.normalize(grid_sample(normals, params.extent_m, params.periodic, p[0], p[1]))
+        n = wp.normalize(grid_bilinear(normals, params.extent_m, params.periodic, p[0], p[1]))
         value = leave_water(params, n)
     brightness[j, i] = value
 

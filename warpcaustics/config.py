@@ -98,6 +98,7 @@ class CausticsMethod(str, enum.Enum):
     BEAMS = "beams"
     BOTH = "both"
     SUNMAP = "sunmap"
+    EIKONAL = "eikonal"
 
     @property
     def uses_receivers(self) -> bool:
@@ -130,7 +131,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("eikonal", "wave3d"),
+    "caustics.method": ("wave3d",),
 }
 
 
@@ -349,7 +350,9 @@ class CausticsConfig:
     camera; Ernst et al. 2005, Liktor & Dachsbacher 2011) or ``both`` (beams and photons on the same
     frame, both saved with the difference of their floor maps) or ``sunmap`` (GPU Gems ch. 2:
     backward rays from the floor looked up in a soft sun map, scaled to the flux-ratio map's mean,
-    which is saved beside it)."""
+    which is saved beside it) or ``eikonal`` (after Mercier 2013: the refracted front's travel
+    time on a 3-D grid, its Laplacian carried along the rays to the floor; the flux-ratio map is
+    saved beside it)."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
     intersection: Intersection = Intersection.EXACT
@@ -375,6 +378,9 @@ class CausticsConfig:
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""
+    eikonal_resolution: int = field(default=128, metadata=_range(8, 1024))
+    """Nodes N per side of the ``eikonal`` grid over the water extent; the spacing L/N is also the
+    layer spacing in depth [-]."""
     sunmap_disk_deg: float = field(default=0.53, metadata=_range(0.0, 90.0))
     """Angular diameter of the sun's disk in the ``sunmap`` (full brightness inside) [deg]."""
     sunmap_halo_deg: float = field(default=5.3, metadata=_range(0.0, 180.0, lo_open=True))

@@ -15,12 +15,13 @@ from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.config import CausticsMethod
+from warpcaustics.eikonal import EikonalCaustics, eikonal_bytes
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.phase import PhaseFunction
 from warpcaustics.receivers import WALL_FACES, Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
-from warpcaustics.sunmap import SunMapCaustics, scale_to_flux_ratio
+from warpcaustics.sunmap import SunMapCaustics
 from warpcaustics.water import make_water, water_bytes
 
 
@@ -84,6 +85,8 @@ class RenderResult:
     floor maps."""
     sunmap_brightness: np.ndarray | None = None
     """``sunmap``: (M, M) grey sun-map brightness 0…1 before scaling to the flux-ratio mean."""
+    eikonal_stats: dict[str, int] | None = None
+    """``eikonal``: layers of the grid and Jacobi passes of the relaxation."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -163,8 +166,8 @@ def scene_bytes(scene: Scene) -> int:
             stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
         return water_bytes(cfg, n) + stage + cam
     m = cfg.caustics.map_resolution
-    sun_map = m * m * 4 if cfg.caustics.method is CausticsMethod.SUNMAP else 0
-    return water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sun_map
+    extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4}
+    return water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + extra.get(cfg.caustics.method, 0)
 
 
 def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
@@ -253,11 +256,16 @@ class Renderer:
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
                                                     self.attenuation_per_m, self.device,
                                                     periodic=self.water.periodic)
-                self.sunmap = None
+                # The approximate methods (issue 8): grey, one index for their rays (the bins' mean).
+                self.approximate = None
+                mean_ior = float(np.mean(self.ior))
                 if cfg.caustics.method is CausticsMethod.SUNMAP:
-                    # grey: one index for the backward rays, the mean over the bins
-                    self.sunmap = SunMapCaustics(cfg, scene.sun_direction, float(np.mean(self.ior)),
-                                                 self.device, periodic=self.water.periodic)
+                    self.approximate = SunMapCaustics(cfg, scene.sun_direction, mean_ior, self.device,
+                                                      periodic=self.water.periodic)
+                elif cfg.caustics.method is CausticsMethod.EIKONAL:
+                    self.approximate = EikonalCaustics(cfg, scene.sun_direction, mean_ior,
+                                                       self.sun_irradiance, self.attenuation_per_m,
+                                                       self.device, periodic=self.water.periodic)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
@@ -307,12 +315,11 @@ class Renderer:
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
                 transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
-            if self.sunmap is not None:
-                with watch.stage("sunmap"):
-                    brightness = self.sunmap.run(surface, self.water, time_s).numpy().copy()
-                extra = {"sunmap_brightness": brightness}
+            if self.approximate is not None:
                 flux_ratio_floor = floor_np
-                floor_np = scale_to_flux_ratio(brightness, flux_ratio_floor)
+                with watch.stage(cfg.caustics.method.value):
+                    floor_np, extra = self.approximate.floor_map(surface, self.water, time_s, highest,
+                                                                 flux_ratio_floor)
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
@@ -327,7 +334,8 @@ class Renderer:
             other_floor, other_transmitted, other_extra = outputs[1]
             comparison = RenderResult(floor_irradiance=other_floor, transmitted_flux_w_nm=other_transmitted,
                                       method="photons", **common, **other_extra)
-        if method is CausticsMethod.SUNMAP:  # the flux-ratio map it was scaled to, as the comparison
+        if self.photons is None and self.beams is None and self.approximate is not None:
+            # the flux-ratio map of the same frame as the comparison (the sun map's scale)
             comparison = RenderResult(floor_irradiance=flux_ratio_floor, transmitted_flux_w_nm=transmitted,
                                       method="fluxratio", **common)
         name = "beams" if method is CausticsMethod.BOTH else method.value

@@ -64,6 +64,14 @@ class SunMapCaustics:
         return self.brightness
 
 
+    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float,
+                  flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:
+        """(K, M, M) floor map: the sun map scaled per band to ``flux_ratio``'s mean, and the
+        RenderResult fields it adds (the grey brightness)."""
+        brightness = self.run(surface, water, time_s).numpy().copy()
+        return scale_to_flux_ratio(brightness, flux_ratio), {"sunmap_brightness": brightness}
+
+
 def still_water_refraction(sun_dir: np.ndarray, ior: float) -> np.ndarray:
     """Unit direction of the sun's light refracted into still water (float64, pointing down)."""
     s = np.asarray(sun_dir, np.float64)

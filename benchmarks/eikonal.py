@@ -1,0 +1,103 @@
+"""Eikonal caustic texture (after Mercier 2013) at Mercier's Table 1 sizes, and the flux-ratio map
+of the same frame as the baseline measured in the same run.
+
+``configs/mercier_pool.toml`` (a Gaussian bump in the wave pool, 2 m wide and 1.9 m deep, so the
+grid is about N³) at t = 0.3 s, with ``caustics.eikonal_resolution`` = N ∈ {64, 128, 256} (quick:
+64). Timed: the whole eikonal stage of one frame (front initialisation, layer relaxation, the
+Laplacian texture, transport, floor map), median of a few runs after a warm-up frame, device
+synchronised. Mercier's own timings (his Table 1: fast marching on the CPU, 0.3 s, 2.5 s and 26 s
+at 64³, 128³ and 256³; his wave texture 17 s, 21 s and 107 s) are quoted as published, not
+measured here. ``python -m benchmarks.eikonal --help``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+FULL = [64, 128, 256]
+QUICK = [64]
+TIME_S = 0.3
+MERCIER_TABLE1_S = {64: (0.3, 17.0), 128: (2.5, 21.0), 256: (26.0, 107.0)}
+"""Published (Mercier 2013, Table 1): (eikonal by fast marching, wave texture) seconds per size."""
+
+
+def _median(func, repeats: int, device: str) -> float:
+    import warp as wp
+
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        func()
+        wp.synchronize_device(device)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def measure(n: int, device: str, repeats: int) -> dict:
+    import warpcaustics as wc
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.refraction import height_range, refract_to_floor, sun_visibility
+
+    scene = wc.load_scene("configs/mercier_pool.toml", {
+        "caustics.eikonal_resolution": n, "water.resolution": n, "caustics.map_resolution": 2 * n})
+    renderer = Renderer(scene, device)
+    renderer.render(TIME_S)  # warm-up: JIT compile, first launches; the pool is now at TIME_S
+    surface = renderer.water.at(TIME_S)
+    _, highest = height_range(surface, device)
+    eik = renderer.approximate
+    eikonal_s = _median(lambda: eik.run(surface, highest), repeats, device)
+    visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
+    depth = scene.config.floor.depth_m
+
+    def flux_ratio():
+        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction, -depth,
+                                     device, out=renderer.refracted)
+        renderer.floor.run(surface, refracted, scene.sun_direction)
+
+    fluxratio_s = _median(flux_ratio, repeats, device)
+    nodes = n * n * eik.stats.layers
+    published = MERCIER_TABLE1_S.get(n, (None, None))
+    return {"n": n, "layers": eik.stats.layers, "nodes": nodes, "passes": eik.stats.passes,
+            "max_passes_per_layer": eik.stats.max_passes, "eikonal_s": eikonal_s,
+            "ns_per_node_pass": eikonal_s / (n * n * eik.stats.passes) * 1e9,
+            "fluxratio_s": fluxratio_s, "eikonal_over_fluxratio": eikonal_s / fluxratio_s,
+            "mercier_published_eikonal_s": published[0], "mercier_published_wave_s": published[1],
+            "device_bytes": eik.bytes_held()}
+
+
+def run(quick: bool, device: str) -> dict:
+    import warp as wp
+
+    from benchmarks.run import _cpu_name
+
+    repeats = 1 if quick else 3
+    wp_name = str(wp.get_device(device).name)
+    print(f"eikonal      configs/mercier_pool.toml t={TIME_S} s | warp {wp.__version__} "
+          f"[{device}: {wp_name}] | cpu {_cpu_name()}", flush=True)
+    rows = []
+    for n in QUICK if quick else FULL:
+        row = measure(n, device, repeats)
+        rows.append(row)
+        print(f"eikonal      N={n:4d} layers={row['layers']:4d} ({row['nodes'] / 1e6:6.2f} M nodes, "
+              f"{row['passes']:5d} layer passes) | eikonal {row['eikonal_s']:8.3f} s "
+              f"({row['ns_per_node_pass']:5.1f} ns/node/pass) | flux ratio "
+              f"{row['fluxratio_s'] * 1e3:8.1f} ms "
+              f"| Mercier's published marching {row['mercier_published_eikonal_s']} s | "
+              f"{row['device_bytes'] / 2**20:7.1f} MiB", flush=True)
+    return {"benchmark": "eikonal_texture", "device": device, "device_name": wp_name,
+            "warp_version": wp.__version__, "repeats": repeats, "scene": "configs/mercier_pool.toml",
+            "time_s": TIME_S, "published": "Mercier 2013, Table 1 (quoted, not measured here)",
+            "results": rows}
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "eikonal", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,167 @@
+"""Eikonal caustics on the host: ``caustics.method = "eikonal"`` (``kernels/eikonal.py``).
+
+Per frame: the refracted front in the frozen layers under the surface, the layer-by-layer
+Godunov relaxation of |∇φ| = n_w, Mercier's Laplacian texture, the transport of intensity along
+the rays and the floor map. The grid follows the surface's highest crest, so its layer count can
+change from frame to frame (the arrays are reallocated when it does).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config
+from warpcaustics.kernels import eikonal as eikonal_kernels
+from warpcaustics.sunmap import still_water_refraction
+from warpcaustics.water import Surface
+
+MAX_PASSES_PER_LAYER = 512
+"""Jacobi passes allowed for one layer before the relaxation is declared stuck (an error)."""
+
+
+def eikonal_bytes(cfg: Config) -> int:
+    """Device memory of the eikonal grid at its deepest (five N×N×nz float arrays) [bytes]."""
+    n = cfg.caustics.eikonal_resolution
+    h = cfg.water.extent_m / n
+    layers = math.ceil(cfg.floor.depth_m / h) + 3 + max(1, math.ceil(0.1 * n))  # crests: ≤ 10 % of L
+    return 5 * 4 * n * n * layers + 8 * n * n
+
+
+@dataclass
+class EikonalStats:
+    layers: int = 0
+    passes: int = 0
+    """Jacobi passes over all layers of the last frame."""
+    max_passes: int = 0
+    """Most passes one layer needed."""
+
+
+def relax(grid: eikonal_kernels.EikonalGrid, top: wp.array2d, psi: wp.array3d, device: str, *,
+          scratch: wp.array2d | None = None, changed: wp.array | None = None) -> EikonalStats:
+    """Solve |∇φ| = n_w below the frozen layers (``k <= top[j, i]``) of ``psi``, in place: layer
+    by layer from the top, Jacobi passes of the Godunov update until no node moves by more than
+    1e-6 h. Returns the number of passes."""
+    n = grid.n
+    scratch = scratch if scratch is not None else wp.empty((n, n), dtype=wp.float32, device=device)
+    changed = changed if changed is not None else wp.zeros(1, dtype=wp.int32, device=device)
+    tolerance = 1.0e-6 * grid.h
+    stats = EikonalStats(layers=grid.layers)
+    for k in range(1, grid.layers):
+        for passes in range(1, MAX_PASSES_PER_LAYER + 1):  # noqa: B007 - counted after the loop
+            changed.zero_()
+            wp.launch(eikonal_kernels.relax_layer, dim=(n, n), inputs=[grid, k, top, psi, tolerance],
+                      outputs=[scratch, changed], device=device)
+            wp.launch(eikonal_kernels.store_layer, dim=(n, n), inputs=[k, scratch], outputs=[psi],
+                      device=device)
+            if not changed.numpy()[0]:
+                break
+        else:
+            raise RuntimeError(f"eikonal layer {k} did not settle in {MAX_PASSES_PER_LAYER} passes")
+        stats.passes += passes
+        stats.max_passes = max(stats.max_passes, passes)
+    return stats
+
+
+class EikonalCaustics:
+    """Owns the 3-D grid (ψ, Laplacian, intensity, path, horizontal irradiance) of a scene."""
+
+    def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+        self.device = device
+        self.n = cfg.caustics.eikonal_resolution
+        self.extent_m = float(cfg.water.extent_m)
+        self.h = self.extent_m / self.n
+        self.floor_z = -float(cfg.floor.depth_m)
+        self.map_resolution = cfg.caustics.map_resolution
+        self.periodic = periodic
+        s = np.asarray(sun_dir, np.float64)
+        self.sun_dir = s / np.linalg.norm(s)
+        self.ior = float(ior)
+        self.gradient = self.ior * still_water_refraction(self.sun_dir, self.ior)
+        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32,
+                                       device=device)
+        self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
+                                          device=device)
+        k = len(sun_irradiance)
+        m = self.map_resolution
+        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
+        self.top = wp.empty((self.n, self.n), dtype=wp.int32, device=device)
+        self.scratch = wp.empty((self.n, self.n), dtype=wp.float32, device=device)
+        self.changed = wp.zeros(1, dtype=wp.int32, device=device)
+        self.layers = 0
+        self.stats = EikonalStats()
+
+    def _grid(self, highest_m: float) -> eikonal_kernels.EikonalGrid:
+        grid = eikonal_kernels.EikonalGrid()
+        grid.n = self.n
+        grid.h = self.h
+        grid.extent_m = self.extent_m
+        grid.z_top = float(highest_m) + self.h
+        grid.layers = math.ceil((grid.z_top - self.floor_z) / self.h) + 2
+        grid.periodic = int(self.periodic)
+        grid.slowness = self.ior
+        grid.gradient = wp.vec3(*self.gradient.astype(np.float32))
+        grid.sun_dir = wp.vec3(*self.sun_dir.astype(np.float32))
+        grid.eta = 1.0 / self.ior
+        if grid.layers != self.layers:
+            shape = (grid.layers, self.n, self.n)
+            self.psi, self.lap, self.intensity, self.path, self.horizontal = (
+                wp.empty(shape, dtype=wp.float32, device=self.device) for _ in range(5))
+            self.layers = grid.layers
+        return grid
+
+    def run(self, surface: Surface, highest_m: float) -> wp.array3d:
+        """Fill :attr:`irradiance` for ``surface`` (whose highest point is ``highest_m``)."""
+        grid = self._grid(highest_m)
+        dev = self.device
+        n = self.n
+        wp.launch(eikonal_kernels.init_front, dim=(n, n),
+                  inputs=[grid, surface.positions, surface.normals, float(surface.extent_m),
+                          int(surface.periodic)],
+                  outputs=[self.top, self.psi, self.intensity, self.path], device=dev)
+        self.stats = relax(grid, self.top, self.psi, dev, scratch=self.scratch, changed=self.changed)
+        wp.launch(eikonal_kernels.laplacian, dim=(grid.layers, n, n), inputs=[grid, self.top, self.psi],
+                  outputs=[self.lap], device=dev)
+        for k in range(grid.layers):
+            wp.launch(eikonal_kernels.transport_layer, dim=(n, n),
+                      inputs=[grid, k, self.top, self.psi, self.lap],
+                      outputs=[self.intensity, self.path, self.horizontal], device=dev)
+        k_bands, m = self.irradiance.shape[0], self.map_resolution
+        wp.launch(eikonal_kernels.floor_irradiance, dim=(k_bands, m, m),
+                  inputs=[grid, self.horizontal, self.path, self.floor_z, self.sun_irradiance,
+                          self.attenuation_per_m],
+                  outputs=[self.irradiance], device=dev)
+        self.grid = grid
+        return self.irradiance
+
+    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float,
+                  flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:
+        """(K, M, M) floor irradiance by the eikonal grid (absolute: ``flux_ratio`` is not used),
+        and the RenderResult fields it adds (the relaxation's statistics)."""
+        floor = self.run(surface, highest_m).numpy().copy()
+        return floor, {"eikonal_stats": vars(self.stats).copy()}
+
+    def bytes_held(self) -> int:
+        """Device memory of the grid's arrays now [bytes]."""
+        arrays = [self.top, self.scratch, self.irradiance] + (
+            [self.psi, self.lap, self.intensity, self.path, self.horizontal] if self.layers else [])
+        return sum(a.capacity for a in arrays)
+
+    def texture(self) -> np.ndarray:
+        """Mercier's caustic texture of the last frame: −Δφ [1/m] on the (nz, N, N) nodes, layer 0
+        at the top (positive where the front converges)."""
+        return -self.lap.numpy()
+
+    def travel_time(self) -> np.ndarray:
+        """φ [m] (optical path) on the (nz, N, N) nodes of the last frame (float64)."""
+        g = self.grid
+        c = (np.arange(self.n) + 0.5) * self.h - 0.5 * self.extent_m
+        z = g.z_top - np.arange(g.layers) * self.h
+        phi0 = (self.gradient[0] * c[None, None, :] + self.gradient[1] * c[None, :, None]
+                + self.gradient[2] * z[:, None, None])
+        return self.psi.numpy().astype(np.float64) + phi0
