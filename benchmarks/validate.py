@@ -186,7 +186,7 @@ def main() -> int:
     return 0
 
 
-APPROXIMATE = ("sunmap", "eikonal")
+APPROXIMATE = ("sunmap", "eikonal", "wave3d")
 """The approximate floor methods (issue 8), compared with the flux-ratio map."""
 
 

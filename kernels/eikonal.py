@@ -147,11 +147,39 @@ def solve_terms(t0: wp.vec2, t1: wp.vec2, t2: wp.vec2, f: float) -> float:
     return u
 
 
+@wp.func
+def scalar_bilinear(
+    grid2: wp.array2d[wp.float32], extent_m: float, periodic: int, x: float, y: float
+) -> float:
+    """Bilinear sample of a scalar cell-centre grid at (x, y) [m]: wrapped when periodic, else clamped."""
+    n = grid2.shape[0]
+    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
+    if periodic == 0:
+        u = wp.clamp(u, 0.0, float(n - 1))
+        v = wp.clamp(v, 0.0, float(n - 1))
+    fu = wp.floor(u)
+    fv = wp.floor(v)
+    tu = u - fu
+    tv = v - fv
+    i0 = ((int(fu) % n) + n) % n
+    j0 = ((int(fv) % n) + n) % n
+    i1 = (i0 + 1) % n
+    j1 = (j0 + 1) % n
+    if periodic == 0:
+        i1 = wp.min(i0 + 1, n - 1)
+        j1 = wp.min(j0 + 1, n - 1)
+    return (1.0 - tv) * ((1.0 - tu) * grid2[j0, i0] + tu * grid2[j0, i1]) + tv * (
+        (1.0 - tu) * grid2[j1, i0] + tu * grid2[j1, i1]
+    )
+
+
 @wp.kernel
 def init_front(
     grid: EikonalGrid,
     positions: wp.array2d[wp.vec3],
     normals: wp.array2d[wp.vec3],
+    visible: wp.array2d[wp.float32],
     surface_extent_m: float,
     surface_periodic: int,
     top: wp.array2d[wp.int32],
@@ -160,7 +188,8 @@ def init_front(
     path: wp.array3d[wp.float32],
 ):
     """Per column: the surface above it, the frozen layers (z ≥ η − h) with the refracted plane
-    front, their intensity across the ray, I = E_sun-relative T (s·n) / (n_z |t_z|), and path."""
+    front, their intensity across the ray, I = E_sun-relative T (s·n) / (n_z |t_z|) times the sun's
+    visibility there (crests shade the surface behind them at a low sun), and path."""
     j, i = wp.tid()
     xy = cell_centre(i, j, grid.n, grid.extent_m)
     q = grid_bilinear(positions, surface_extent_m, surface_periodic, xy[0], xy[1])
@@ -174,6 +203,7 @@ def init_front(
         if d[2] < -1.0e-3:
             t = wp.normalize(d)
             through = fresnel_transmittance(cos_i, grid.eta) * cos_i / (nrm[2] * wp.abs(t[2]))
+            through *= scalar_bilinear(visible, surface_extent_m, surface_periodic, xy[0], xy[1])
     last = int(wp.floor((grid.z_top - (eta_m - grid.h)) / grid.h))
     last = wp.clamp(last, 0, grid.layers - 1)
     top[j, i] = last
@@ -338,7 +368,9 @@ def floor_irradiance(
     out: wp.array3d[wp.float32],
 ):
     """Floor map (K, M, M): the horizontal irradiance of the two layers around the floor,
-    interpolated in z and bilinearly in x, y, times E_sun(λ) exp(−c(λ) ℓ)."""
+    interpolated in z and bilinearly in x, y, times E_sun(λ) exp(−c(λ) ℓ). On a non-periodic grid
+    a texel is dark where its still-water ray comes from beyond the patch (no water surface there),
+    as in the flux-ratio map: the faces continue the front, so the field itself does not know."""
     b, j, i = wp.tid()
     m = out.shape[1]
     xy = cell_centre(i, j, m, grid.extent_m)
@@ -351,4 +383,17 @@ def floor_irradiance(
     length = (1.0 - w) * layer_sample(grid, path, k0, xy[0], xy[1]) + w * layer_sample(
         grid, path, k0 + 1, xy[0], xy[1]
     )
-    out[b, j, i] = sun_irradiance[b] * e * wp.exp(-attenuation_per_m[b] * length)
+    value = sun_irradiance[b] * e * wp.exp(-attenuation_per_m[b] * length)
+    if grid.periodic == 0 and beyond_patch(grid, xy[0], xy[1], floor_z):
+        value = 0.0
+    out[b, j, i] = value
+
+
+@wp.func
+def beyond_patch(grid: EikonalGrid, x: float, y: float, floor_z: float) -> bool:
+    """Whether still water's refracted ray to the floor point (x, y) enters the water outside the
+    patch (it meets z = 0 at (x, y) − t₀_xy · (−floor_z)/|t₀_z|)."""
+    t = grid.gradient / grid.slowness
+    s = (0.0 - floor_z) / wp.abs(t[2])
+    half = 0.5 * grid.extent_m
+    return wp.abs(x - t[0] * s) > half or wp.abs(y - t[1] * s) > half

@@ -19,7 +19,7 @@ import numpy as np
 
 from warpcaustics.errors import WarpcausticsError
 
-FLOOR_METHODS = ("fluxratio", "sunmap", "eikonal", "beams", "photons")
+FLOOR_METHODS = ("fluxratio", "sunmap", "eikonal", "wave3d", "beams", "photons")
 """The methods that draw a floor map, reference first."""
 
 

@@ -99,6 +99,7 @@ class CausticsMethod(str, enum.Enum):
     BOTH = "both"
     SUNMAP = "sunmap"
     EIKONAL = "eikonal"
+    WAVE3D = "wave3d"
 
     @property
     def uses_receivers(self) -> bool:
@@ -131,7 +132,6 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "caustics.method": ("wave3d",),
 }
 
 
@@ -381,6 +381,17 @@ class CausticsConfig:
     eikonal_resolution: int = field(default=128, metadata=_range(8, 1024))
     """Nodes N per side of the ``eikonal`` grid over the water extent; the spacing L/N is also the
     layer spacing in depth [-]."""
+    wave3d_resolution: int = field(default=64, metadata=_range(8, 1024))
+    """Nodes N per side of the ``wave3d`` grid over the water extent (also its layer spacing) [-]."""
+    wave3d_cells_per_wavelength: float = field(default=8.0, metadata=_range(4.0, 1000.0))
+    """The ``wave3d`` wave's wavelength in the water, in grid spacings: far longer than light's,
+    so diffraction blurs the caustics over about this many spacings [-]."""
+    wave3d_periods: float = field(default=4.0, metadata=_range(0.5, 1000.0))
+    """Periods of the drive over which u² is averaged into the ``wave3d`` intensity [-]."""
+    wave3d_gain: float = field(default=1.0, metadata=_range(0.0, None, lo_open=True))
+    """a of Mercier's post-process a·I^b of the ``wave3d`` intensity (1, 1: the intensity) [-]."""
+    wave3d_exponent: float = field(default=1.0, metadata=_range(0.0, 10.0, lo_open=True))
+    """b of Mercier's post-process a·I^b [-]."""
     sunmap_disk_deg: float = field(default=0.53, metadata=_range(0.0, 90.0))
     """Angular diameter of the sun's disk in the ``sunmap`` (full brightness inside) [deg]."""
     sunmap_halo_deg: float = field(default=5.3, metadata=_range(0.0, 180.0, lo_open=True))
@@ -656,8 +667,23 @@ def _check_periodic_floor(cfg: Config) -> None:
                 f"floor.ripple_direction_deg = {direction:.12g}")
 
 
+GREY_METHODS = (CausticsMethod.SUNMAP, CausticsMethod.EIKONAL, CausticsMethod.WAVE3D)
+"""Methods that trace one refractive index for all bands."""
+
+
 def _check_sunmap(cfg: Config) -> None:
+    """The approximate methods' own settings."""
     c = cfg.caustics
+    if c.method in GREY_METHODS and cfg.optics.dispersion:
+        raise ConfigError(f"optics.dispersion = true needs a method that refracts each band: "
+                          f"caustics.method = {c.method.value!r} traces one index for all bands; set "
+                          "optics.dispersion = false or caustics.method = \"fluxratio\", \"beams\" or "
+                          "\"photons\"")
+    if c.method is CausticsMethod.WAVE3D and c.wave3d_cells_per_wavelength > c.wave3d_resolution / 6:
+        raise ConfigError(f"caustics.wave3d_cells_per_wavelength = {c.wave3d_cells_per_wavelength:g} makes "
+                          f"the wave longer than a sixth of the patch at caustics.wave3d_resolution = "
+                          f"{c.wave3d_resolution} (its direction could not be kept); use at most "
+                          f"{c.wave3d_resolution / 6:g} or raise caustics.wave3d_resolution")
     if c.sunmap_halo_deg <= c.sunmap_disk_deg:
         raise ConfigError(f"caustics.sunmap_halo_deg = {c.sunmap_halo_deg:g} must exceed "
                           f"caustics.sunmap_disk_deg = {c.sunmap_disk_deg:g} (the halo surrounds the disk)")

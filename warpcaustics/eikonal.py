@@ -15,6 +15,7 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.config import Config
+from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels import eikonal as eikonal_kernels
 from warpcaustics.sunmap import still_water_refraction
 from warpcaustics.water import Surface
@@ -60,10 +61,36 @@ def relax(grid: eikonal_kernels.EikonalGrid, top: wp.array2d, psi: wp.array3d, d
             if not changed.numpy()[0]:
                 break
         else:
-            raise RuntimeError(f"eikonal layer {k} did not settle in {MAX_PASSES_PER_LAYER} passes")
+            raise WarpcausticsError(f"the eikonal relaxation of layer {k} did not settle in "
+                                    f"{MAX_PASSES_PER_LAYER} passes; lower caustics.eikonal_resolution")
         stats.passes += passes
         stats.max_passes = max(stats.max_passes, passes)
     return stats
+
+
+def make_grid(n: int, extent_m: float, highest_m: float, floor_z: float, layers_below: int, periodic: bool,
+              ior: float, sun_dir: np.ndarray) -> eikonal_kernels.EikonalGrid:
+    """The grid over the patch: N columns per side, layers h apart from one spacing above the
+    highest crest to ``layers_below`` spacings below the floor."""
+    grid = eikonal_kernels.EikonalGrid()
+    h = extent_m / n
+    grid.n = n
+    grid.h = h
+    grid.extent_m = extent_m
+    grid.z_top = float(highest_m) + h
+    grid.layers = math.ceil((grid.z_top - floor_z) / h) + layers_below
+    grid.periodic = int(periodic)
+    grid.slowness = ior
+    grid.gradient = wp.vec3(*(ior * still_water_refraction(sun_dir, ior)).astype(np.float32))
+    grid.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
+    grid.eta = 1.0 / ior
+    return grid
+
+
+def all_lit(surface: Surface, device: str) -> wp.array2d:
+    """A visibility grid of ones for the surface's vertices."""
+    n = surface.resolution
+    return wp.full((n, n), 1.0, dtype=wp.float32, device=device)
 
 
 class EikonalCaustics:
@@ -97,17 +124,8 @@ class EikonalCaustics:
         self.stats = EikonalStats()
 
     def _grid(self, highest_m: float) -> eikonal_kernels.EikonalGrid:
-        grid = eikonal_kernels.EikonalGrid()
-        grid.n = self.n
-        grid.h = self.h
-        grid.extent_m = self.extent_m
-        grid.z_top = float(highest_m) + self.h
-        grid.layers = math.ceil((grid.z_top - self.floor_z) / self.h) + 2
-        grid.periodic = int(self.periodic)
-        grid.slowness = self.ior
-        grid.gradient = wp.vec3(*self.gradient.astype(np.float32))
-        grid.sun_dir = wp.vec3(*self.sun_dir.astype(np.float32))
-        grid.eta = 1.0 / self.ior
+        grid = make_grid(self.n, self.extent_m, highest_m, self.floor_z, 2, self.periodic, self.ior,
+                         self.sun_dir)
         if grid.layers != self.layers:
             shape = (grid.layers, self.n, self.n)
             self.psi, self.lap, self.intensity, self.path, self.horizontal = (
@@ -115,13 +133,15 @@ class EikonalCaustics:
             self.layers = grid.layers
         return grid
 
-    def run(self, surface: Surface, highest_m: float) -> wp.array3d:
-        """Fill :attr:`irradiance` for ``surface`` (whose highest point is ``highest_m``)."""
+    def run(self, surface: Surface, highest_m: float, visible: wp.array2d | None = None) -> wp.array3d:
+        """Fill :attr:`irradiance` for ``surface`` (whose highest point is ``highest_m``);
+        ``visible`` (N_w, N_w): the sun's visibility at the surface vertices (default all lit)."""
         grid = self._grid(highest_m)
+        visible = visible if visible is not None else all_lit(surface, self.device)
         dev = self.device
         n = self.n
         wp.launch(eikonal_kernels.init_front, dim=(n, n),
-                  inputs=[grid, surface.positions, surface.normals, float(surface.extent_m),
+                  inputs=[grid, surface.positions, surface.normals, visible, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.top, self.psi, self.intensity, self.path], device=dev)
         self.stats = relax(grid, self.top, self.psi, dev, scratch=self.scratch, changed=self.changed)
@@ -139,11 +159,11 @@ class EikonalCaustics:
         self.grid = grid
         return self.irradiance
 
-    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float,
+    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float, visible: wp.array2d,
                   flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:
         """(K, M, M) floor irradiance by the eikonal grid (absolute: ``flux_ratio`` is not used),
         and the RenderResult fields it adds (the relaxation's statistics)."""
-        floor = self.run(surface, highest_m).numpy().copy()
+        floor = self.run(surface, highest_m, visible).numpy().copy()
         return floor, {"eikonal_stats": vars(self.stats).copy()}
 
     def bytes_held(self) -> int:

@@ -275,6 +275,7 @@ def frame_entry(frame: int, r) -> dict:
         **({"photons": r.photon_stats} if r.photon_stats is not None else {}),
         **({"beams": r.beam_stats} if r.beam_stats is not None else {}),
         **({"eikonal": r.eikonal_stats} if r.eikonal_stats is not None else {}),
+        **({"wave3d": r.wave3d_stats} if r.wave3d_stats is not None else {}),
         **({"comparison": comparison_entry(frame, r)} if r.comparison is not None else {}),
     }
     return json.loads(json.dumps(entry, default=_jsonable))

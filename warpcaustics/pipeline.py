@@ -23,6 +23,7 @@ from warpcaustics.refraction import Refracted, height_range, refract_to_floor, s
 from warpcaustics.scene import Scene
 from warpcaustics.sunmap import SunMapCaustics
 from warpcaustics.water import make_water, water_bytes
+from warpcaustics.wave3d import Wave3DCaustics, wave3d_bytes
 
 
 @dataclass
@@ -87,6 +88,8 @@ class RenderResult:
     """``sunmap``: (M, M) grey sun-map brightness 0…1 before scaling to the flux-ratio mean."""
     eikonal_stats: dict[str, int] | None = None
     """``eikonal``: layers of the grid and Jacobi passes of the relaxation."""
+    wave3d_stats: dict[str, int] | None = None
+    """``wave3d``: layers of the grid, steps, averaged steps and node updates."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -166,7 +169,8 @@ def scene_bytes(scene: Scene) -> int:
             stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
         return water_bytes(cfg, n) + stage + cam
     m = cfg.caustics.map_resolution
-    extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4}
+    extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4,
+             CausticsMethod.WAVE3D: wave3d_bytes(cfg) + k * m * m * 4}
     return water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + extra.get(cfg.caustics.method, 0)
 
 
@@ -212,7 +216,8 @@ class Renderer:
         self.scene = scene
         self.device = devices.resolve_device(device, config_value=cfg.device.value)
         self.bytes_needed = scene_bytes(scene)
-        devices.check_fits(self.device, self.bytes_needed, _MEMORY_FIX)
+        self.memory_fix = memory_fix(cfg)
+        devices.check_fits(self.device, self.bytes_needed, self.memory_fix)
         self.bins = spectra.bins_for(cfg.optics)
         self.sun_irradiance = spectra.sun_irradiance(self.bins, cfg.sun, scene.base_dir)
         optics = spectra.water_optics(cfg.optics, self.bins)
@@ -220,7 +225,7 @@ class Renderer:
         self.ior = spectra.refractive_index(cfg.optics, self.bins)
         # One refraction per distinct index: K groups with dispersion, else one shared by all bins.
         self.group_ior = self.ior if cfg.optics.dispersion else self.ior[:1]
-        with _memory_errors(self.device, self.bytes_needed):
+        with _memory_errors(self.device, self.bytes_needed, self.memory_fix):
             self.water = make_water(cfg, self.device, scene.heights, scene.floor_relief)
             n = scene.water_resolution
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
@@ -262,16 +267,18 @@ class Renderer:
                 if cfg.caustics.method is CausticsMethod.SUNMAP:
                     self.approximate = SunMapCaustics(cfg, scene.sun_direction, mean_ior, self.device,
                                                       periodic=self.water.periodic)
-                elif cfg.caustics.method is CausticsMethod.EIKONAL:
-                    self.approximate = EikonalCaustics(cfg, scene.sun_direction, mean_ior,
-                                                       self.sun_irradiance, self.attenuation_per_m,
-                                                       self.device, periodic=self.water.periodic)
+                elif cfg.caustics.method in (CausticsMethod.EIKONAL, CausticsMethod.WAVE3D):
+                    grid_stage = {CausticsMethod.EIKONAL: EikonalCaustics,
+                                  CausticsMethod.WAVE3D: Wave3DCaustics}[cfg.caustics.method]
+                    self.approximate = grid_stage(
+                        cfg, scene.sun_direction, mean_ior, self.sun_irradiance, self.attenuation_per_m,
+                        self.device, periodic=self.water.periodic)
 
     def render(self, time_s: float = 0.0) -> RenderResult:
         """Render the floor caustics at ``time_s`` [s]."""
         if not math.isfinite(time_s):
             raise WarpcausticsError(f"time_s = {time_s} is not a finite number of seconds")
-        with _memory_errors(self.device, self.bytes_needed):
+        with _memory_errors(self.device, self.bytes_needed, self.memory_fix):
             return self._render(float(time_s))
 
     def _render(self, time_s: float) -> RenderResult:
@@ -319,7 +326,7 @@ class Renderer:
                 flux_ratio_floor = floor_np
                 with watch.stage(cfg.caustics.method.value):
                     floor_np, extra = self.approximate.floor_map(surface, self.water, time_s, highest,
-                                                                 flux_ratio_floor)
+                                                                 visible, flux_ratio_floor)
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
@@ -386,15 +393,22 @@ _WALL_TOP_M = 1.0
 _MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
 
 
+def memory_fix(cfg) -> str:
+    """What to lower when a scene does not fit: the grid methods' 3-D grid comes first."""
+    grid_key = {CausticsMethod.EIKONAL: "caustics.eikonal_resolution",
+                CausticsMethod.WAVE3D: "caustics.wave3d_resolution"}.get(cfg.caustics.method)
+    return f"lower {grid_key}, water.resolution or caustics.map_resolution" if grid_key else _MEMORY_FIX
+
+
 @contextmanager
-def _memory_errors(device: str, needed: int):
+def _memory_errors(device: str, needed: int, fix: str = _MEMORY_FIX):
     """Turn Warp's allocation failures into a one-line DeviceError that states the need."""
     try:
         yield
     except RuntimeError as exc:
         text = str(exc).lower()
         if "alloc" in text or "out of memory" in text:
-            raise devices.out_of_memory(device, needed, _MEMORY_FIX) from None
+            raise devices.out_of_memory(device, needed, fix) from None
         raise
 
 

@@ -64,10 +64,11 @@ class SunMapCaustics:
         return self.brightness
 
 
-    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float,
+    def floor_map(self, surface: Surface, water, time_s: float, highest_m: float, visible: wp.array2d,
                   flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:
         """(K, M, M) floor map: the sun map scaled per band to ``flux_ratio``'s mean, and the
-        RenderResult fields it adds (the grey brightness)."""
+        RenderResult fields it adds (the grey brightness). ``visible`` is not used: the chapter's
+        backward rays know no shading by crests."""
         brightness = self.run(surface, water, time_s).numpy().copy()
         return scale_to_flux_ratio(brightness, flux_ratio), {"sunmap_brightness": brightness}
 
