@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.run import median_time
+
 ROOT = Path(__file__).resolve().parents[1]
 
 FULL = {
@@ -50,15 +52,6 @@ QUICK = {
 WAVELENGTHS = "rgb"
 MIN_AREA_FRACTION = 1.0e-6  # as kernels/beams.py
 MAX_CHORD_PIECES = 16
-
-
-def _median_time(func, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        func()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def _timed_runs(func, repeats: int):
@@ -412,7 +405,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
         wp.synchronize_device(device)
 
     warp_run()
-    warp_s = _median_time(warp_run, warp_repeats)
+    warp_s = median_time(warp_run, warp_repeats)
     warp_out = args[3].numpy().astype(np.float64)
     beams = _beam_arrays(stage)
     bins = stage.point_bins
@@ -585,9 +578,9 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
         wp.synchronize_device(device)
 
     warp_run()
-    warp_s = _median_time(warp_run, warp_repeats)
+    warp_s = median_time(warp_run, warp_repeats)
     # The shafts alone: render_beams also gathers the G-buffer points and shades; time them apart.
-    t_surface = _median_time(
+    t_surface = median_time(
         lambda: (camera.render_beams(stage, False), wp.synchronize_device(device)), warp_repeats
     )
     warp_volume_s = max(warp_s - t_surface, 1e-9)
@@ -665,7 +658,7 @@ def _stage_time(n: int, m: int, device: str, repeats: int) -> dict:
         renderer.beams.run(surface, renderer.visible)
         wp.synchronize_device(device)
 
-    s = _median_time(run, repeats)
+    s = median_time(run, repeats)
     beams = renderer.beams.weight.shape[0]
     return {
         "water_n": n,
@@ -693,7 +686,7 @@ def _adaptive_rows(config: str, overrides: dict, levels: int, device: str, repea
         renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / config, {
             **base, "caustics.beam_levels": lv, "caustics.beam_tolerance": tol}), device)
         renderer.render(0.0)  # warm-up
-        s = _median_time(lambda renderer=renderer: renderer.render(0.0), repeats)
+        s = median_time(lambda renderer=renderer: renderer.render(0.0), repeats)
         result = renderer.render(0.0)
         if reference is None:
             reference = result.floor_irradiance.astype(np.float64)

@@ -17,25 +17,13 @@ from __future__ import annotations
 import sys
 import time
 
-import numpy as np
+from benchmarks.run import median_time
 
 FULL = [64, 128, 256]
 QUICK = [64]
 TIME_S = 0.3
 MERCIER_TABLE1_S = {64: (0.3, 17.0), 128: (2.5, 21.0), 256: (26.0, 107.0)}
 """Published (Mercier 2013, Table 1): (eikonal by fast marching, wave texture) seconds per size."""
-
-
-def _median(func, repeats: int, device: str) -> float:
-    import warp as wp
-
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        func()
-        wp.synchronize_device(device)
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def measure(n: int, device: str, repeats: int) -> dict:
@@ -50,7 +38,7 @@ def measure(n: int, device: str, repeats: int) -> dict:
     surface = renderer.water.at(TIME_S)
     _, highest = height_range(surface, device)
     eik = renderer.approximate
-    eikonal_s = _median(lambda: eik.run(surface, highest), repeats, device)
+    eikonal_s = median_time(lambda: eik.run(surface, highest), repeats, device)
     visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
     depth = scene.config.floor.depth_m
 
@@ -59,7 +47,7 @@ def measure(n: int, device: str, repeats: int) -> dict:
                                      device, out=renderer.refracted)
         renderer.floor.run(surface, refracted, scene.sun_direction)
 
-    fluxratio_s = _median(flux_ratio, repeats, device)
+    fluxratio_s = median_time(flux_ratio, repeats, device)
     nodes = n * n * eik.stats.layers
     published = MERCIER_TABLE1_S.get(n, (None, None))
     wave = _wave(n, device)

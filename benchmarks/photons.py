@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.run import median_time
+
 ROOT = Path(__file__).resolve().parents[1]
 
 MIN_DOWNWARD_COS = 1.0e-3
@@ -278,15 +280,6 @@ class PhotonCase:
                     view=view)
 
 
-def _median_time(func, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        func()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
-
-
 def _camera_frames(quick: bool, device: str) -> list[dict]:
     """One camera frame of every config in configs/ with ``camera.enabled = true`` (none: [])."""
     import warpcaustics as wc
@@ -340,10 +333,10 @@ def run(quick: bool, device: str) -> dict:
     for intersection in ("exact", "newton"):
         case = PhotonCase(n, s, m, intersection, device)
         warp_map = case.run_warp()  # warm-up: JIT compile, first launch
-        warp_s = _median_time(case.run_warp, warp_repeats)
+        warp_s = median_time(case.run_warp, warp_repeats)
         inputs = case.numpy_inputs()
         numpy_map = numpy_photons(**inputs)
-        numpy_s = _median_time(lambda inputs=inputs: numpy_photons(**inputs), numpy_repeats)
+        numpy_s = median_time(lambda inputs=inputs: numpy_photons(**inputs), numpy_repeats)
         count = case.photon_count
         stats = vars(case.renderer.photons.stats())
         row = {"photons": count, "photon_stats": stats, "warp_s": warp_s, "numpy_s": numpy_s,

@@ -9,8 +9,9 @@
   photons (left) and by beams (right, ``caustics.method = "both"``);
 - ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
   an Ernst-style bounding prism projected on the screen;
-- ``docs/images/methods_ocean.png``: one frame of configs/ocean.toml (128², 256² map) by every
-  floor method, as ``warpcaustics compare`` draws it.
+- ``docs/images/methods_ocean.png``, ``methods_mercier.png``: one frame of configs/ocean.toml
+  (128², 256² map) and of configs/mercier_pool.toml (at 0.3 s) by every floor method, as
+  ``warpcaustics compare`` draws them.
 """
 
 from __future__ import annotations
@@ -65,17 +66,24 @@ def main() -> int:
     return 0
 
 
+METHOD_SCENES = {
+    "methods_ocean.png": ("ocean.toml", {"water.resolution": 128, "caustics.map_resolution": 256}, 0.0),
+    "methods_mercier.png": ("mercier_pool.toml", {}, 0.3),
+}
+"""``warpcaustics compare`` pictures: (config, overrides, time [s])."""
+
+
 def _method_pictures(images: Path) -> None:
     import tempfile
 
     from warpcaustics.compare import compare_methods, write_comparison
 
-    overrides = {"water.resolution": 128, "caustics.map_resolution": 256}
-    comparison = compare_methods(ROOT / "configs" / "ocean.toml", overrides, 0.0, "cpu")
-    with tempfile.TemporaryDirectory() as tmp:
-        png = write_comparison(Path(tmp), comparison, 0.0)["png"]
-        (images / "methods_ocean.png").write_bytes(png.read_bytes())
-    print(f"wrote {images / 'methods_ocean.png'}")
+    for name, (config, overrides, time_s) in METHOD_SCENES.items():
+        comparison = compare_methods(ROOT / "configs" / config, overrides, time_s, "cpu")
+        with tempfile.TemporaryDirectory() as tmp:
+            png = write_comparison(Path(tmp), comparison, time_s)["png"]
+            (images / name).write_bytes(png.read_bytes())
+        print(f"wrote {images / name}")
 
 
 def _beam_pictures(images: Path) -> None:

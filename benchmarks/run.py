@@ -32,6 +32,21 @@ STEPS = [("ocean_step", "FFT ocean step, choppy (4 complex 2-D FFTs)", [64, 128,
           [64, 128, 256, 512, 1024], [64, 128])]
 
 
+def median_time(func, repeats: int, device: str | None = None) -> float:
+    """Median wall time [s] of ``repeats`` calls of ``func``; with ``device``, each call ends by
+    synchronising it (Warp launches are asynchronous on CUDA)."""
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        func()
+        if device is not None:
+            import warp as wp
+
+            wp.synchronize_device(device)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
 def _in_child(func_name: str, *args, module: str = "frame"):
     """Run benchmarks.<module>.<func_name>(*args) in a fresh spawned process (own peak memory)."""
     ctx = mp.get_context("spawn")

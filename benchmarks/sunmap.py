@@ -10,25 +10,12 @@ every vertex, then the footprint deposits), each after one warm-up frame, device
 from __future__ import annotations
 
 import sys
-import time
 
-import numpy as np
+from benchmarks.run import median_time
 
 FULL = [(256, 512), (512, 1024)]
 QUICK = [(128, 256)]
 SCENES = ("configs/ocean.toml", "configs/procedural.toml")
-
-
-def _median_time(func, repeats: int, device: str) -> float:
-    import warp as wp
-
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        func()
-        wp.synchronize_device(device)
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
@@ -54,8 +41,8 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     def sun_map():
         renderer.sunmap.run(surface, renderer.water, 0.5)
 
-    fluxratio_s = _median_time(flux_ratio, repeats, device)
-    sunmap_s = _median_time(sun_map, repeats, device)
+    fluxratio_s = median_time(flux_ratio, repeats, device)
+    sunmap_s = median_time(sun_map, repeats, device)
     from warpcaustics.output import map_correlation, relative_l1
 
     return {"config": config, "water_n": n, "map_m": m, "bins": len(result.wavelengths_nm),
@@ -64,7 +51,8 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
             "relative_l1_sunmap_vs_fluxratio": relative_l1(result.floor_irradiance,
                                                            result.comparison.floor_irradiance),
             "correlation_sunmap_vs_fluxratio": map_correlation(result.floor_irradiance,
-                                                               result.comparison.floor_irradiance)}
+                                                               result.comparison.floor_irradiance,
+                                                               result.bin_widths_nm)}
 
 
 def run(quick: bool, device: str) -> dict:

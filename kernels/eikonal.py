@@ -26,7 +26,15 @@ d ln I / ds = −Δφ / |∇φ| (semi-Lagrangian, one layer per step), which kee
 
 import warp as wp
 
-from warpcaustics.kernels.geometry import cell_centre, fresnel_transmittance, grid_bilinear, refract
+from warpcaustics.kernels.geometry import (
+    bilerp,
+    cell_centre,
+    fresnel_transmittance,
+    grid_bilinear,
+    grid_cell,
+    refract,
+    scalar_bilinear,
+)
 
 wp.set_module_options({"enable_backward": False})
 
@@ -145,33 +153,6 @@ def solve_terms(t0: wp.vec2, t1: wp.vec2, t2: wp.vec2, f: float) -> float:
         if u > t2[1]:
             u = quadratic(t0, t1, t2, f)
     return u
-
-
-@wp.func
-def scalar_bilinear(
-    grid2: wp.array2d[wp.float32], extent_m: float, periodic: int, x: float, y: float
-) -> float:
-    """Bilinear sample of a scalar cell-centre grid at (x, y) [m]: wrapped when periodic, else clamped."""
-    n = grid2.shape[0]
-    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    if periodic == 0:
-        u = wp.clamp(u, 0.0, float(n - 1))
-        v = wp.clamp(v, 0.0, float(n - 1))
-    fu = wp.floor(u)
-    fv = wp.floor(v)
-    tu = u - fu
-    tv = v - fv
-    i0 = ((int(fu) % n) + n) % n
-    j0 = ((int(fv) % n) + n) % n
-    i1 = (i0 + 1) % n
-    j1 = (j0 + 1) % n
-    if periodic == 0:
-        i1 = wp.min(i0 + 1, n - 1)
-        j1 = wp.min(j0 + 1, n - 1)
-    return (1.0 - tv) * ((1.0 - tu) * grid2[j0, i0] + tu * grid2[j0, i1]) + tv * (
-        (1.0 - tu) * grid2[j1, i0] + tu * grid2[j1, i1]
-    )
 
 
 @wp.kernel
@@ -301,26 +282,18 @@ def ray_gradient(grid: EikonalGrid, psi: wp.array3d[wp.float32], k: int, j: int,
 @wp.func
 def layer_sample(grid: EikonalGrid, a: wp.array3d[wp.float32], k: int, x: float, y: float) -> float:
     """Bilinear value of layer k of a node array at (x, y) [m] (wrapped or clamped)."""
-    n = grid.n
-    u = (x + 0.5 * grid.extent_m) / grid.h - 0.5
-    v = (y + 0.5 * grid.extent_m) / grid.h - 0.5
-    if grid.periodic == 0:
-        u = wp.clamp(u, 0.0, float(n - 1))
-        v = wp.clamp(v, 0.0, float(n - 1))
-    fu = wp.floor(u)
-    fv = wp.floor(v)
-    tu = u - fu
-    tv = v - fv
-    i0 = ((int(fu) % n) + n) % n
-    j0 = ((int(fv) % n) + n) % n
-    i1 = (i0 + 1) % n
-    j1 = (j0 + 1) % n
-    if grid.periodic == 0:
-        i1 = wp.min(i0 + 1, n - 1)
-        j1 = wp.min(j0 + 1, n - 1)
-    return (1.0 - tv) * ((1.0 - tu) * a[k, j0, i0] + tu * a[k, j0, i1]) + tv * (
-        (1.0 - tu) * a[k, j1, i0] + tu * a[k, j1, i1]
-    )
+    i0, j0, i1, j1, tu, tv = grid_cell(grid.n, grid.extent_m, grid.periodic, x, y)
+    return bilerp(a[k, j0, i0], a[k, j0, i1], a[k, j1, i0], a[k, j1, i1], tu, tv)
+
+
+@wp.func
+def floor_sample(grid: EikonalGrid, a: wp.array3d[wp.float32], floor_z: float, x: float, y: float) -> float:
+    """A node array at the floor point (x, y, floor_z): linear between the two layers around it,
+    bilinear within each."""
+    kf = (grid.z_top - floor_z) / grid.h
+    k0 = wp.clamp(int(wp.floor(kf)), 0, grid.layers - 2)
+    w = wp.clamp(kf - float(k0), 0.0, 1.0)
+    return (1.0 - w) * layer_sample(grid, a, k0, x, y) + w * layer_sample(grid, a, k0 + 1, x, y)
 
 
 @wp.kernel
@@ -372,17 +345,9 @@ def floor_irradiance(
     a texel is dark where its still-water ray comes from beyond the patch (no water surface there),
     as in the flux-ratio map: the faces continue the front, so the field itself does not know."""
     b, j, i = wp.tid()
-    m = out.shape[1]
-    xy = cell_centre(i, j, m, grid.extent_m)
-    kf = (grid.z_top - floor_z) / grid.h
-    k0 = wp.clamp(int(wp.floor(kf)), 0, grid.layers - 2)
-    w = wp.clamp(kf - float(k0), 0.0, 1.0)
-    e = (1.0 - w) * layer_sample(grid, horizontal, k0, xy[0], xy[1]) + w * layer_sample(
-        grid, horizontal, k0 + 1, xy[0], xy[1]
-    )
-    length = (1.0 - w) * layer_sample(grid, path, k0, xy[0], xy[1]) + w * layer_sample(
-        grid, path, k0 + 1, xy[0], xy[1]
-    )
+    xy = cell_centre(i, j, out.shape[1], grid.extent_m)
+    e = floor_sample(grid, horizontal, floor_z, xy[0], xy[1])
+    length = floor_sample(grid, path, floor_z, xy[0], xy[1])
     value = sun_irradiance[b] * e * wp.exp(-attenuation_per_m[b] * length)
     if grid.periodic == 0 and beyond_patch(grid, xy[0], xy[1], floor_z):
         value = 0.0

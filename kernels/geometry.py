@@ -35,28 +35,34 @@ def bilinear_cell(n: int, extent_m: float, x: float, y: float):
 
 
 @wp.func
+def grid_cell(n: int, extent_m: float, periodic: int, x: float, y: float):
+    """:func:`bilinear_cell` on a grid that wraps when ``periodic`` and is clamped to its outer
+    cell centres otherwise."""
+    if periodic != 0:
+        return bilinear_cell(n, extent_m, x, y)
+    u = wp.clamp((x + 0.5 * extent_m) * float(n) / extent_m - 0.5, 0.0, float(n - 1))
+    v = wp.clamp((y + 0.5 * extent_m) * float(n) / extent_m - 0.5, 0.0, float(n - 1))
+    i0 = wp.min(int(wp.floor(u)), n - 1)
+    j0 = wp.min(int(wp.floor(v)), n - 1)
+    return i0, j0, wp.min(i0 + 1, n - 1), wp.min(j0 + 1, n - 1), u - float(i0), v - float(j0)
+
+
+@wp.func
 def grid_bilinear(grid: wp.array2d[wp.vec3], extent_m: float, periodic: int, x: float, y: float) -> wp.vec3:
-    """Bilinear sample of a cell-centre grid at (x, y) [m]: wrapped when periodic, else clamped."""
-    n = grid.shape[0]
-    u = (x + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    v = (y + 0.5 * extent_m) * float(n) / extent_m - 0.5
-    if periodic == 0:
-        u = wp.clamp(u, 0.0, float(n - 1))
-        v = wp.clamp(v, 0.0, float(n - 1))
-    fu = wp.floor(u)
-    fv = wp.floor(v)
-    tu = u - fu
-    tv = v - fv
-    i0 = ((int(fu) % n) + n) % n
-    j0 = ((int(fv) % n) + n) % n
-    i1 = (i0 + 1) % n
-    j1 = (j0 + 1) % n
-    if periodic == 0:
-        i1 = wp.min(i0 + 1, n - 1)
-        j1 = wp.min(j0 + 1, n - 1)
+    """Bilinear sample of a cell-centre vec3 grid at (x, y) [m] (:func:`grid_cell`)."""
+    i0, j0, i1, j1, tu, tv = grid_cell(grid.shape[0], extent_m, periodic, x, y)
     return (1.0 - tv) * ((1.0 - tu) * grid[j0, i0] + tu * grid[j0, i1]) + tv * (
         (1.0 - tu) * grid[j1, i0] + tu * grid[j1, i1]
     )
+
+
+@wp.func
+def scalar_bilinear(
+    grid: wp.array2d[wp.float32], extent_m: float, periodic: int, x: float, y: float
+) -> float:
+    """Bilinear sample of a cell-centre scalar grid at (x, y) [m] (:func:`grid_cell`)."""
+    i0, j0, i1, j1, tu, tv = grid_cell(grid.shape[0], extent_m, periodic, x, y)
+    return bilerp(grid[j0, i0], grid[j0, i1], grid[j1, i0], grid[j1, i1], tu, tv)
 
 
 @wp.func

@@ -18,7 +18,9 @@ wp.set_module_options({"enable_backward": False})
 
 RAY_ITERATIONS = 4
 """Fixed-point steps for the ray–surface meeting point: each moves it to the height found at the
-last one (for the chapter's vertical ray the first step is exact)."""
+last one (for the chapter's vertical ray the first step is exact). For an oblique ray over a
+surface whose slope along the ray exceeds the ray's own, the steps need not converge: the point
+found is then near, not on, the surface."""
 
 
 @wp.struct

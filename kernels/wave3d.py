@@ -13,7 +13,7 @@ the wave can have reached are stepped: the stencil's domain of dependence grows 
 
 import warp as wp
 
-from warpcaustics.kernels.eikonal import EikonalGrid, beyond_patch, layer_sample, layer_z
+from warpcaustics.kernels.eikonal import EikonalGrid, beyond_patch, floor_sample, layer_z
 from warpcaustics.kernels.geometry import cell_centre, grid_bilinear
 
 wp.set_module_options({"enable_backward": False})
@@ -179,14 +179,8 @@ def floor_irradiance(
     grid a texel whose still-water ray comes from beyond the patch is dark, as for the other
     methods (the faces let the plane wave through, so the field itself does not know)."""
     b, j, i = wp.tid()
-    m = out.shape[1]
-    xy = cell_centre(i, j, m, grid.extent_m)
-    kf = (grid.z_top - floor_z) / grid.h
-    k0 = wp.clamp(int(wp.floor(kf)), 0, grid.layers - 2)
-    w = wp.clamp(kf - float(k0), 0.0, 1.0)
-    e = (1.0 - w) * layer_sample(grid, energy, k0, xy[0], xy[1]) + w * layer_sample(
-        grid, energy, k0 + 1, xy[0], xy[1]
-    )
+    xy = cell_centre(i, j, out.shape[1], grid.extent_m)
+    e = floor_sample(grid, energy, floor_z, xy[0], xy[1])
     intensity = gain * wp.pow(wp.max(2.0 * e / samples, 0.0), exponent)
     cos_t = wp.abs(grid.gradient[2]) / grid.slowness
     # η at the texel: the nearest column's

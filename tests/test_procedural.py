@@ -98,3 +98,21 @@ def test_procedural_config_errors():
     with pytest.raises(ConfigError, match="caustics.beam_levels"):
         wc.load_scene("configs/procedural.toml", overrides={"caustics.beam_levels": 1,
                                                             "caustics.method": "beams"})
+
+
+def test_open_patch_loses_the_light_bent_past_its_edge():
+    """Still water on the open patch under a 40° sun (water_type none): the floor receives the
+    transmitted flux times the lit fraction (L − dx)(L − dy)/L², dx, dy the refracted ray's
+    horizontal run D·tanθt along x and y — light from beyond the patch does not exist."""
+    import math
+
+    depth, extent, el, az = 1.5, 4.0, 40.0, 25.0
+    scene = wc.load_scene("configs/procedural.toml", {
+        "water.procedural_amplitude": 0.0, "water.resolution": 64, "sun.elevation_deg": el,
+        "sun.azimuth_deg": az, "floor.depth_m": depth, "optics.water_type": "none",
+        "caustics.map_resolution": 64, "optics.wavelengths": {"min_nm": 500.0, "max_nm": 600.0, "bins": 1}})
+    result = wc.render(scene, device="cpu")
+    run = depth * math.tan(math.asin(math.cos(math.radians(el)) / 1.333))
+    dx, dy = run * abs(math.cos(math.radians(az))), run * abs(math.sin(math.radians(az)))
+    lit = (extent - dx) * (extent - dy) / extent**2
+    np.testing.assert_allclose(result.floor_flux_w_nm / result.transmitted_flux_w_nm, lit, rtol=1e-4)

@@ -72,9 +72,9 @@ def _parser() -> argparse.ArgumentParser:
 
     cp = sub.add_parser("compare", help="one frame by every floor-caustics method, side by side",
                         description="Render one frame of CONFIG with each floor-caustics method (flux "
-                                    "ratio, sun map, beams, photons) and compare each floor map with the "
-                                    "flux-ratio map: DIR/compare.csv, compare.json, compare.png and each "
-                                    "method's frame in DIR/<method>/.")
+                                    "ratio, sun map, eikonal, wave3d, beams, photons) and compare each floor "
+                                    "map with the flux-ratio map: DIR/compare.csv, compare.json, compare.png "
+                                    "and each method's frame in DIR/<method>/.")
     cp.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
     cp.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
     cp.add_argument("--methods", default=",".join(FLOOR_METHODS), metavar="LIST",

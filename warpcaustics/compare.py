@@ -52,7 +52,14 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
         raise WarpcausticsError(f"--methods: {', '.join(unknown)} is not a floor-caustics method; choose "
                                 f"from {', '.join(FLOOR_METHODS)}")
     methods = ("fluxratio",) + tuple(m for m in methods if m != "fluxratio")
-    scenes = {name: load_scene(config, {**overrides, "caustics.method": name}) for name in methods}
+    scenes = {}
+    for name in methods:
+        try:
+            scenes[name] = load_scene(config, {**overrides, "caustics.method": name})
+        except WarpcausticsError as exc:
+            raise WarpcausticsError(f"compare renders this scene with caustics.method = {name!r}, which it "
+                                    f"cannot take: {exc} (drop {name!r} from --methods; the flux-ratio "
+                                    "reference needs a flat floor and no camera)") from None
     results = {}
     seconds = {}
     for name, scene in scenes.items():
@@ -69,7 +76,8 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
 
 
 def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Path]:
-    """compare.json, compare.csv, compare.png and ``frame_<method>.exr`` into ``out``."""
+    """compare.json, compare.csv, compare.png and each method's frame (EXR, PNG, run.json) in
+    ``out/<method>/``."""
     from warpcaustics import colour_out
     from warpcaustics.output import save_frame, write_png, write_run_json
 

@@ -351,8 +351,9 @@ class CausticsConfig:
     frame, both saved with the difference of their floor maps) or ``sunmap`` (GPU Gems ch. 2:
     backward rays from the floor looked up in a soft sun map, scaled to the flux-ratio map's mean,
     which is saved beside it) or ``eikonal`` (after Mercier 2013: the refracted front's travel
-    time on a 3-D grid, its Laplacian carried along the rays to the floor; the flux-ratio map is
-    saved beside it)."""
+    time on a 3-D grid, its Laplacian carried along the rays to the floor) or ``wave3d`` (after
+    Mercier 2013 §4: the 3-D wave equation driven by the refracted wave, its time-averaged
+    intensity on the floor); those two also save the flux-ratio map beside theirs."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent [-]."""
     intersection: Intersection = Intersection.EXACT
@@ -384,8 +385,8 @@ class CausticsConfig:
     wave3d_resolution: int = field(default=64, metadata=_range(8, 1024))
     """Nodes N per side of the ``wave3d`` grid over the water extent (also its layer spacing) [-]."""
     wave3d_cells_per_wavelength: float = field(default=8.0, metadata=_range(4.0, 1000.0))
-    """The ``wave3d`` wave's wavelength in the water, in grid spacings: far longer than light's,
-    so diffraction blurs the caustics over about this many spacings [-]."""
+    """The ``wave3d`` wave's wavelength λ in the water, in grid spacings: far longer than light's,
+    so diffraction blurs the caustics over about √(λ·depth); at most a sixth of the patch [-]."""
     wave3d_periods: float = field(default=4.0, metadata=_range(0.5, 1000.0))
     """Periods of the drive over which u² is averaged into the ``wave3d`` intensity [-]."""
     wave3d_gain: float = field(default=1.0, metadata=_range(0.0, None, lo_open=True))

@@ -238,8 +238,8 @@ def comparison_entry(frame: int, r) -> dict:
     if other.photon_stats is not None:
         entry["photons"] = other.photon_stats
     if name == "fluxratio":  # the approximate method against the reference, maps normalised
-        entry[f"floor_correlation_{r.method}_vs_{name}"] = map_correlation(r.floor_irradiance,
-                                                                           other.floor_irradiance)
+        entry[f"floor_correlation_{r.method}_vs_{name}"] = map_correlation(
+            r.floor_irradiance, other.floor_irradiance, r.bin_widths_nm)
     return entry
 
 
@@ -250,11 +250,11 @@ def relative_l1(a: np.ndarray, reference: np.ndarray) -> float:
     return float(np.abs(a - ref).sum() / max(np.abs(ref).sum(), 1e-300))
 
 
-def map_correlation(a: np.ndarray, reference: np.ndarray) -> float:
-    """Pearson correlation of the band-summed maps (1: the same pattern up to scale); 0 when either
-    map is uniform."""
-    x = np.asarray(a, np.float64).sum(axis=0).ravel()
-    y = np.asarray(reference, np.float64).sum(axis=0).ravel()
+def map_correlation(a: np.ndarray, reference: np.ndarray, bin_widths_nm: np.ndarray) -> float:
+    """Pearson correlation of the maps integrated over the bands, Σ E_k Δλ_k (1: the same pattern
+    up to scale); 0 when either map is uniform."""
+    x = np.einsum("kij,k->ij", np.asarray(a, np.float64), bin_widths_nm).ravel()
+    y = np.einsum("kij,k->ij", np.asarray(reference, np.float64), bin_widths_nm).ravel()
     x, y = x - x.mean(), y - y.mean()
     norm = np.sqrt((x * x).sum() * (y * y).sum())
     return float((x * y).sum() / norm) if norm > 0 else 0.0
