@@ -82,8 +82,8 @@ class RenderResult:
     """The caustics method that made :attr:`floor_irradiance` (``beams`` for ``both``)."""
     comparison: RenderResult | None = None
     """``both``: the photon method's result of the same frame (this result is the beams');
-    ``sunmap``: the flux-ratio map of the same frame. Saved beside it with the difference of the
-    floor maps."""
+    ``sunmap``, ``eikonal``, ``wave3d``: the flux-ratio map of the same frame. Saved beside it with
+    the difference of the floor maps."""
     sunmap_brightness: np.ndarray | None = None
     """``sunmap``: (M, M) grey sun-map brightness 0…1 before scaling to the flux-ratio mean."""
     eikonal_stats: dict[str, int] | None = None
@@ -231,6 +231,7 @@ class Renderer:
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.photons = None
             self.beams = None
+            self.approximate = None
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
@@ -262,7 +263,6 @@ class Renderer:
                                                     self.attenuation_per_m, self.device,
                                                     periodic=self.water.periodic)
                 # The approximate methods (issue 8): grey, one index for their rays (the bins' mean).
-                self.approximate = None
                 mean_ior = float(np.mean(self.ior))
                 if cfg.caustics.method is CausticsMethod.SUNMAP:
                     self.approximate = SunMapCaustics(cfg, scene.sun_direction, mean_ior, self.device,
