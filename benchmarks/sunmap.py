@@ -39,7 +39,7 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
         renderer.floor.run(surface, refracted, scene.sun_direction)
 
     def sun_map():
-        renderer.sunmap.run(surface, renderer.water, 0.5)
+        renderer.approximate.run(surface, renderer.water, 0.5)
 
     fluxratio_s = median_time(flux_ratio, repeats, device)
     sunmap_s = median_time(sun_map, repeats, device)
