@@ -461,6 +461,34 @@ class OutputConfig:
     """Also write VTK files for ParaView / pyvista: ``surface_NNNN.vts`` (water surface, normals),
     ``floor_NNNN.vti`` (floor irradiance per band) and, with photons, ``receivers_NNNN.vtp``
     (receiver meshes with their irradiance per band)."""
+    npz: bool = False
+    """Also write ``frame_NNNN.npz``: the floor map (K, M, M), wavelengths, bin edges, x, y, time
+    and the PAR map, as plain numpy arrays."""
+    netcdf: bool = False
+    """Also write ``frame_NNNN.nc`` through xarray (``pip install 'warpcaustics[science]'``):
+    floor irradiance on coordinates time, wavelength, y, x with units as attributes, and PAR."""
+
+
+@dataclass(frozen=True)
+class ProbeConfig:
+    x_m: float = 0.0
+    """Where the probe sits on the floor, x [m]."""
+    y_m: float = 0.0
+    """Where it sits, y [m]."""
+
+
+@dataclass(frozen=True)
+class StatsConfig:
+    collector_mm: float = field(default=0.0, metadata=_range(0.0, 1.0e5))
+    """Diameter of the circular collector the statistics average over (a sensor's window) [mm];
+    0 = the texels themselves."""
+    flash_threshold: float = field(default=1.5, metadata=_range(1.0, 100.0, lo_open=True))
+    """A flash is irradiance above this many times the mean [-]."""
+    wavelength_nm: float | None = field(default=None, metadata=_range(100.0, 5000.0))
+    """Also report the statistics of the band holding this wavelength (e.g. 510 nm) [nm]."""
+    probes: tuple[ProbeConfig, ...] = (ProbeConfig(),)
+    """Floor points whose irradiance over an animation is reported (``[[stats.probes]]`` tables
+    with x_m, y_m); the centre by default."""
 
 
 @dataclass(frozen=True)
@@ -481,6 +509,8 @@ class Config:
     """A pinhole camera under the water (``photons`` only)."""
     output: OutputConfig = field(default_factory=OutputConfig)
     """What is written."""
+    stats: StatsConfig = field(default_factory=StatsConfig)
+    """Irradiance statistics reported in run.json."""
     device: DeviceChoice = DeviceChoice.AUTO
     """``auto`` (CUDA when available, else CPU), ``cpu`` or ``cuda``."""
 
@@ -672,6 +702,23 @@ GREY_METHODS = (CausticsMethod.SUNMAP, CausticsMethod.EIKONAL, CausticsMethod.WA
 """Methods that trace one refractive index for all bands."""
 
 
+def _check_stats(cfg: Config) -> None:
+    half = 0.5 * cfg.water.extent_m
+    for i, p in enumerate(cfg.stats.probes):
+        if abs(p.x_m) > half or abs(p.y_m) > half:
+            raise ConfigError(f"stats.probes[{i}] = ({p.x_m:g}, {p.y_m:g}) m is off the floor map "
+                              f"(|x|, |y| <= {half:g} m); move it inside water.extent_m")
+    if cfg.stats.collector_mm * 1e-3 > cfg.water.extent_m:
+        raise ConfigError(f"stats.collector_mm = {cfg.stats.collector_mm:g} is wider than the "
+                          f"{cfg.water.extent_m:g} m floor map; use a smaller collector")
+    if cfg.output.netcdf:
+        try:
+            import xarray  # noqa: F401
+        except ImportError:
+            raise ConfigError("output.netcdf = true needs xarray: pip install 'warpcaustics[science]' "
+                              "(or set output.netcdf = false)") from None
+
+
 def _check_sunmap(cfg: Config) -> None:
     """The approximate methods' own settings."""
     c = cfg.caustics
@@ -712,6 +759,7 @@ def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
     _check_sunmap(cfg)
+    _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []
     if cfg.floor.shape is not FloorShape.FLAT:

@@ -112,6 +112,10 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
             "warpcaustics.quantity": "spectral radiance at the camera"}, RADIANCE_UNITS)
     if result.scene.config.output.vtk:
         paths.update(write_vtk(result, out_dir, frame=frame))
+    if result.scene.config.output.npz:
+        paths["npz"] = write_npz(result, out_dir / f"frame_{frame:04d}.npz")
+    if result.scene.config.output.netcdf:
+        paths["netcdf"] = write_netcdf(result, out_dir / f"frame_{frame:04d}.nc")
     if result.comparison is not None:  # "both" or "sunmap": the other method's frame and the difference
         other = result.comparison
         name = other.method
@@ -136,6 +140,57 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
                   result.wavelengths_nm, {"warpcaustics.quantity": quantity,
                                           "warpcaustics.time_s": f"{result.time_s:g}"})
     return paths
+
+
+def science_arrays(result) -> dict[str, np.ndarray]:
+    """The floor map and its coordinates as plain arrays (for .npz and NetCDF): row index along +y
+    (not flipped as in the images)."""
+    from warpcaustics.stats import par_map
+
+    m = result.floor_irradiance.shape[-1]
+    coords = (np.arange(m) + 0.5) * result.extent_m / m - 0.5 * result.extent_m
+    edges = result.bins.edges_nm if result.bins is not None else np.array([])
+    return {"floor_irradiance": result.floor_irradiance.astype(np.float32),
+            "wavelength_nm": np.asarray(result.wavelengths_nm, np.float64),
+            "bin_edges_nm": np.asarray(edges, np.float64), "x_m": coords, "y_m": coords,
+            "time_s": np.array([result.time_s]),
+            "par_umol_m2_s": par_map(result.floor_irradiance, edges).astype(np.float32)}
+
+
+def write_npz(result, path: Path) -> Path:
+    """``frame_NNNN.npz``: :func:`science_arrays` (floor_irradiance in W m⁻² nm⁻¹, PAR in
+    µmol photons m⁻² s⁻¹, coordinates in nm, m and s)."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **science_arrays(result))
+    return path
+
+
+def write_netcdf(result, path: Path) -> Path:
+    """``frame_NNNN.nc`` through xarray: ``floor_irradiance`` (time, wavelength, y, x) and ``par``
+    (time, y, x), units and descriptions as attributes (NetCDF3 via scipy when netCDF4 is not
+    installed)."""
+    try:
+        import xarray as xr
+    except ImportError:
+        from warpcaustics.errors import WarpcausticsError
+
+        raise WarpcausticsError("output.netcdf = true needs xarray: pip install 'warpcaustics[science]' "
+                                "(or set output.netcdf = false)") from None
+    a = science_arrays(result)
+    ds = xr.Dataset(
+        {"floor_irradiance": (("time", "wavelength", "y", "x"), a["floor_irradiance"][None],
+                              {"units": "W m-2 nm-1", "long_name": "floor spectral irradiance"}),
+         "par": (("time", "y", "x"), a["par_umol_m2_s"][None],
+                 {"units": "umol m-2 s-1",
+                  "long_name": "photosynthetically available radiation (400-700 nm)"})},
+        coords={"time": ("time", a["time_s"], {"units": "s"}),
+                "wavelength": ("wavelength", a["wavelength_nm"], {"units": "nm"}),
+                "y": ("y", a["y_m"], {"units": "m"}), "x": ("x", a["x_m"], {"units": "m"})},
+        attrs={"source": "warpcaustics", "config": str(result.scene.source or ""),
+               "bin_edges_nm": a["bin_edges_nm"]})
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp)
+    return path
 
 
 def band_name(wavelength_nm: float) -> str:
@@ -277,8 +332,31 @@ def frame_entry(frame: int, r) -> dict:
         **({"eikonal": r.eikonal_stats} if r.eikonal_stats is not None else {}),
         **({"wave3d": r.wave3d_stats} if r.wave3d_stats is not None else {}),
         **({"comparison": comparison_entry(frame, r)} if r.comparison is not None else {}),
+        "statistics": frame_statistics_entry(r),
     }
     return json.loads(json.dumps(entry, default=_jsonable))
+
+
+def frame_statistics_entry(r) -> dict:
+    """run.json's irradiance statistics of a frame, with the probe values an animation's time
+    statistics are built from."""
+    from warpcaustics.stats import frame_statistics, probe_values
+
+    cfg = r.scene.config.stats
+    return {**frame_statistics(r, cfg), "probe_irradiance_w_m2": probe_values(r, cfg).tolist()}
+
+
+def time_statistics(frames: list[dict], stats_cfg) -> dict | None:
+    """Statistics of the probes' E(t) over an animation (three frames or more, equally spaced)."""
+    from warpcaustics.stats import series_statistics
+
+    if len(frames) < 3:
+        return None
+    times = np.array([f["time_s"] for f in frames])
+    series = np.array([f["statistics"]["probe_irradiance_w_m2"] for f in frames])
+    dt = float(np.mean(np.diff(times)))
+    return {"probes_m": [[p.x_m, p.y_m] for p in stats_cfg.probes], "dt_s": dt,
+            **series_statistics(series, dt, stats_cfg.flash_threshold)}
 
 
 def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = None) -> Path:
@@ -290,6 +368,8 @@ def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = 
     """
     first = results[0]
     path = out_dir / "run.json"
+    frames = frames if frames is not None else [frame_entry(i, r) for i, r in enumerate(results)]
+    series = time_statistics(frames, first.scene.config.stats)
     write_json(path, {
         "source": first.scene.source,
         "config": config_to_dict(first.scene.config),
@@ -300,6 +380,7 @@ def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = 
         "attenuation_per_m": first.attenuation_per_m,
         "ior": first.ior,
         "sun_irradiance_w_m2_nm": first.sun_irradiance,
-        "frames": frames if frames is not None else [frame_entry(i, r) for i, r in enumerate(results)],
+        "frames": frames,
+        **({"time_statistics": series} if series is not None else {}),
     })
     return path

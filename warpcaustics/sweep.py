@@ -285,6 +285,13 @@ def summary_row(task: Task, result, k: int) -> dict:
         row[f"max_{wl:g}nm"] = float(band.max())
     row["floor_w_m2"] = float(total.mean())
     row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
+    from warpcaustics.stats import frame_statistics
+
+    statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
+    row["cv"] = statistics["irradiance_w_m2"]["cv"]
+    row["flash_fraction"] = statistics["irradiance_w_m2"]["flash_fraction"]
+    if "par_umol_m2_s" in statistics:
+        row["par_umol_m2_s"] = statistics["par_umol_m2_s"]["mean"]
     if result.photon_stats:
         row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
     if result.beam_stats:

@@ -1,0 +1,138 @@
+"""Irradiance statistics, PAR, collector averaging and the science outputs, on fields with known answers."""
+
+import json
+import math
+
+import jerlov
+import numpy as np
+import pytest
+from scipy import special
+
+import warpcaustics as wc
+from warpcaustics import stats
+from warpcaustics.errors import ConfigError
+
+
+def _spectrum(wl):
+    """A smooth made-up spectral irradiance [W m⁻² nm⁻¹] (a test input, not data)."""
+    return 1.2 + 0.4 * np.sin(wl / 37.0) + 0.002 * (wl - 550.0)
+
+
+@pytest.mark.parametrize(("bins", "rtol"), [(300, 1e-5), (16, 2e-3)])
+def test_par_matches_jerlov(bins, rtol):
+    """PAR of a floor map equals jerlov's photon integral of the same spectrum (its own constants
+    and quadrature): to 1e-5 with 1 nm bins, to 2e-3 with 16 bins of bin averages."""
+    fine = np.arange(400.0, 700.001, 0.05)
+    reference = jerlov.par_profile(_spectrum(fine), fine, 0.0, kd=np.zeros_like(fine), unit="energy").par
+    edges = np.linspace(400.0, 700.0, bins + 1)
+    averages = np.array([_spectrum(np.linspace(a, b, 401)).mean() for a, b in zip(edges[:-1], edges[1:])])
+    floor = np.broadcast_to(averages[:, None, None], (bins, 4, 4))
+    np.testing.assert_allclose(stats.par_map(floor, edges), float(np.ravel(reference)[0]), rtol=rtol)
+
+
+def test_par_counts_only_400_to_700_nm():
+    """Bins outside 400–700 nm add nothing; a bin straddling 700 nm counts its part inside."""
+    edges = np.array([350.0, 400.0, 650.0, 750.0])
+    w = stats.par_weights(edges)
+    assert w[0] == 0.0
+    np.testing.assert_allclose(w[2] / w[1], (700.0**2 - 650.0**2) / (650.0**2 - 400.0**2))
+
+
+def _sine_field(m, periods, amplitude):
+    x = (np.arange(m) + 0.5) / m
+    return np.tile(1.0 + amplitude * np.sin(2 * np.pi * periods * x), (m, 1))
+
+
+def test_cv_flashes_and_pdf_of_a_sine():
+    """E = 1 + a sin(kx) over whole periods: CV = a/√2, the fraction above 1.5 Ē is
+    (π − 2 asin(0.5/a))/2π, and the density of E/Ē integrates to 1 with mean 1."""
+    a = 0.8
+    out = stats.field_statistics(_sine_field(1024, 8, a), 1.5)
+    assert out["mean"] == pytest.approx(1.0, abs=1e-12)
+    assert out["cv"] == pytest.approx(a / math.sqrt(2.0), rel=1e-6)
+    # texels sample each period 128 times: each of its two crossings moves the count by < 1 texel
+    expected_fraction = (math.pi - 2 * math.asin(0.5 / a)) / (2 * math.pi)
+    assert out["flash_fraction"] == pytest.approx(expected_fraction, abs=1.0 / 128)
+    pdf = np.asarray(out["pdf"])
+    widths = np.diff(stats.PDF_EDGES)
+    centres = 0.5 * (stats.PDF_EDGES[1:] + stats.PDF_EDGES[:-1])
+    assert (pdf * widths).sum() == pytest.approx(1.0)
+    assert (pdf * widths * centres).sum() == pytest.approx(1.0, abs=0.01)  # bin-centre quadrature
+
+
+@pytest.mark.parametrize("diameter_texels", [3.0, 10.0, 21.5])
+def test_collector_damps_a_sine_like_a_disc_should(diameter_texels):
+    """Averaging a sine of wavenumber k over a disc of radius r multiplies its amplitude by
+    2 J₁(kr)/(kr) (the disc's Fourier transform); the periodic convolution does so within 2e-3."""
+    m, periods, a = 256, 6, 0.5
+    texel = 1.0 / m
+    field = _sine_field(m, periods, a)
+    averaged = stats.collector_average(field, texel, diameter_texels * texel, periodic=True)
+    k = 2 * np.pi * periods
+    kr = k * 0.5 * diameter_texels * texel
+    expected = a * 2 * special.j1(kr) / kr
+    measured = (averaged.max() - averaged.min()) / 2
+    assert measured == pytest.approx(expected, abs=2e-3 * a)
+    assert averaged.mean() == pytest.approx(1.0, abs=1e-12)
+
+
+def test_collector_on_an_open_map_keeps_a_uniform_field_uniform():
+    """On a non-periodic map the disc is cut at the edges and renormalised: a constant stays constant."""
+    out = stats.collector_average(np.full((40, 40), 3.0), 0.01, 0.13, periodic=False)
+    np.testing.assert_allclose(out, 3.0, rtol=1e-12)
+
+
+def test_time_series_flashes_and_spectrum():
+    """E(t) = 1 + 0.8 sin(2π·2t) over 10 s at 20 Hz: 2 flashes per second above 1.5 Ē, the spectrum
+    peaks at 2 Hz, CV = 0.8/√2."""
+    t = np.arange(200) / 20.0
+    e = 1.0 + 0.8 * np.sin(2 * np.pi * 2.0 * t + 0.3)
+    out = stats.series_statistics(e[:, None], 0.05, 1.5)
+    assert out["flash_frequency_hz"][0] == pytest.approx(2.0, abs=1.0 / 9.95)
+    assert out["peak_frequency_hz"][0] == pytest.approx(2.0, abs=0.1)
+    assert out["cv"][0] == pytest.approx(0.8 / math.sqrt(2.0), rel=1e-3)
+
+
+def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
+    """A four-frame render: run.json has each frame's statistics (total irradiance, PAR, the 510 nm
+    band) and the probes' time statistics; the .npz and .nc files read back with their coordinates
+    and units, and PAR in them equals the statistics' mean."""
+    import xarray as xr
+
+    from warpcaustics.cli import main
+
+    out = tmp_path / "anim"
+    code = main(["render", "configs/ocean.toml", "--out", str(out), "--frames", "4", "--fps", "10",
+                 "--quiet",
+                 "--set", "water.resolution=32", "--set", "caustics.map_resolution=32",
+                 "--set", "stats.wavelength_nm=510", "--set", "stats.collector_mm=300",
+                 "--set", "output.npz=true", "--set", "output.netcdf=true"])
+    assert code == 0
+    run = json.loads((out / "run.json").read_text())
+    first = run["frames"][0]["statistics"]
+    assert {"irradiance_w_m2", "par_umol_m2_s", "band_503.125nm_w_m2_nm"} <= set(first)
+    assert 0.0 < first["irradiance_w_m2"]["cv"] < 2.0
+    series = run["time_statistics"]
+    assert series["dt_s"] == pytest.approx(0.1) and len(series["cv"]) == 1
+    npz = np.load(out / "frame_0002.npz")
+    assert npz["floor_irradiance"].shape == (16, 32, 32)
+    np.testing.assert_allclose(npz["x_m"][[0, -1]], [-7.75, 7.75])
+    ds = xr.open_dataset(out / "frame_0002.nc")
+    assert ds["floor_irradiance"].dims == ("time", "wavelength", "y", "x")
+    assert ds["floor_irradiance"].attrs["units"] == "W m-2 nm-1"
+    assert ds["par"].attrs["units"] == "umol m-2 s-1"
+    np.testing.assert_allclose(ds["wavelength"].values, npz["wavelength_nm"])
+    assert float(ds["time"].values[0]) == pytest.approx(0.2)
+    # PAR with the collector's mean equals the map's mean (the collector keeps the mean)
+    par_mean = run["frames"][2]["statistics"]["par_umol_m2_s"]["mean"]
+    assert float(ds["par"].mean()) == pytest.approx(par_mean, rel=1e-5)
+    ds.close()
+
+
+def test_stats_config_errors(monkeypatch):
+    """A probe off the map, and NetCDF without xarray, fail at load with one line naming the key."""
+    with pytest.raises(ConfigError, match=r"stats.probes\[0\]"):
+        wc.load_scene("configs/ocean.toml", {"stats.probes": [{"x_m": 20.0, "y_m": 0.0}]})
+    monkeypatch.setitem(__import__("sys").modules, "xarray", None)
+    with pytest.raises(ConfigError, match="output.netcdf"):
+        wc.load_scene("configs/ocean.toml", {"output.netcdf": True})

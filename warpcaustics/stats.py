@@ -1,0 +1,191 @@
+"""Irradiance statistics of floor maps, as the wave-focusing literature reports them (host, numpy).
+
+Per frame: the mean, the coefficient of variation CV = std/mean, the probability density of E/Ē
+and the fraction of the floor above ``flash_threshold``·Ē, for the band-integrated irradiance
+[W m⁻²], for PAR [µmol photons m⁻² s⁻¹] and for the band at ``stats.wavelength_nm``, optionally
+after averaging over a circular collector of diameter ``stats.collector_mm`` (a sensor sees the
+mean over its window, not a point). Over an animation: the series E(t) at probe points, their CV,
+the frequency of flashes (upward crossings of ``flash_threshold``·Ē per second) and their
+spectrum. Gernez & Antoine (2009) report CV and flash statistics for an 8 mm collector.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import constants
+
+from warpcaustics.config import StatsConfig
+
+PAR_BAND_NM = (400.0, 700.0)
+"""Photosynthetically available radiation: the photon flux from 400 to 700 nm."""
+
+PDF_EDGES = np.linspace(0.0, 5.0, 51)
+"""Bins of E/Ē for the probability density (E above 5Ē is counted in the last bin)."""
+
+
+def par_weights(edges_nm: np.ndarray, band_nm: tuple[float, float] = PAR_BAND_NM) -> np.ndarray:
+    """(K,) weights w_k with PAR = Σ_k E_k w_k [µmol m⁻² s⁻¹] for bin averages E_k [W m⁻² nm⁻¹]:
+    w_k = ∫ λ/(h c N_A) dλ over the part of bin k inside the band (λ in m; CODATA constants from
+    scipy.constants), ×1e6 for µmol, taking E constant across each bin."""
+    lo = np.clip(edges_nm[:-1], *band_nm)
+    hi = np.clip(edges_nm[1:], *band_nm)
+    integral_nm2 = 0.5 * (hi**2 - lo**2)  # ∫ λ dλ over the overlap [nm²]
+    return integral_nm2 * 1e-9 / (constants.h * constants.c * constants.Avogadro) * 1e6
+
+
+def band_integrated(floor: np.ndarray, widths_nm: np.ndarray) -> np.ndarray:
+    """(M, M) irradiance summed over the bands, Σ E_k Δλ_k [W m⁻²] (float64)."""
+    return np.einsum("kij,k->ij", np.asarray(floor, np.float64), np.asarray(widths_nm, np.float64))
+
+
+def par_map(floor: np.ndarray, edges_nm: np.ndarray) -> np.ndarray:
+    """(M, M) PAR [µmol photons m⁻² s⁻¹] of a (K, M, M) floor map with bin edges ``edges_nm``."""
+    return np.einsum("kij,k->ij", np.asarray(floor, np.float64), par_weights(np.asarray(edges_nm)))
+
+
+def collector_kernel(texel_m: float, diameter_m: float, supersample: int = 8) -> np.ndarray:
+    """A disc of diameter ``diameter_m`` on texels of side ``texel_m``: each weight is the disc's
+    share of its texel (``supersample``² points per texel), normalised to sum 1."""
+    r = 0.5 * diameter_m / texel_m  # in texels
+    half = int(math.ceil(r - 0.5)) if r > 0.5 else 0
+    offsets = (np.arange(supersample) + 0.5) / supersample - 0.5
+    centres = np.arange(-half, half + 1)
+    sx = (centres[:, None] + offsets[None, :]).ravel()
+    inside = (sx[:, None] ** 2 + sx[None, :] ** 2) <= r * r
+    n = 2 * half + 1
+    weights = inside.reshape(n, supersample, n, supersample).mean(axis=(1, 3))
+    if weights.sum() == 0.0:  # a disc smaller than a sample spacing: the texel itself
+        weights[half, half] = 1.0
+    return weights / weights.sum()
+
+
+def collector_average(field: np.ndarray, texel_m: float, diameter_m: float, *, periodic: bool) -> np.ndarray:
+    """The mean of ``field`` (M, M) over a disc of ``diameter_m`` centred on each texel: a circular
+    convolution on a periodic map; on a non-periodic one the disc is cut at the edges and its
+    weights renormalised."""
+    if diameter_m <= 0.0:
+        return np.asarray(field, np.float64)
+    kernel = collector_kernel(texel_m, diameter_m)
+    m = field.shape[0]
+    k = kernel.shape[0]
+    if k > m:
+        raise ValueError(f"a {diameter_m * 1e3:g} mm collector is wider than the {m * texel_m:g} m map")
+    half = k // 2
+    padded = np.zeros((m, m))
+    padded[:k, :k] = kernel
+    padded = np.roll(padded, (-half, -half), axis=(0, 1))
+    kf = np.fft.rfft2(padded)
+    f = np.asarray(field, np.float64)
+    if periodic:
+        return np.fft.irfft2(np.fft.rfft2(f) * kf, s=f.shape)
+    # zero-pad to avoid wrap-around; divide by the kernel's weight inside the map
+    size = m + k
+    pk = np.zeros((size, size))
+    pk[:k, :k] = kernel
+    pk = np.roll(pk, (-half, -half), axis=(0, 1))
+    pkf = np.fft.rfft2(pk)
+    pf = np.zeros((size, size))
+    pf[:m, :m] = f
+    ones = np.zeros((size, size))
+    ones[:m, :m] = 1.0
+    total = np.fft.irfft2(np.fft.rfft2(pf) * pkf, s=pf.shape)[:m, :m]
+    norm = np.fft.irfft2(np.fft.rfft2(ones) * pkf, s=pf.shape)[:m, :m]
+    return total / norm
+
+
+def field_statistics(field: np.ndarray, flash_threshold: float) -> dict:
+    """Mean, CV, the fraction of texels above ``flash_threshold``·mean and the probability density
+    of E/Ē on :data:`PDF_EDGES` (integrates to 1)."""
+    f = np.asarray(field, np.float64)
+    mean = float(f.mean())
+    if mean <= 0.0:
+        return {"mean": mean, "cv": 0.0, "flash_fraction": 0.0, "pdf": [0.0] * (len(PDF_EDGES) - 1)}
+    ratio = np.minimum(f / mean, PDF_EDGES[-1] - 1e-12)
+    pdf, _ = np.histogram(ratio, bins=PDF_EDGES, density=True)
+    return {
+        "mean": mean,
+        "cv": float(f.std() / mean),
+        "flash_fraction": float(np.mean(f > flash_threshold * mean)),
+        "pdf": pdf.tolist(),
+    }
+
+
+def frame_statistics(result, cfg: StatsConfig) -> dict:
+    """The statistics of one frame's floor map: total irradiance [W m⁻²], PAR [µmol m⁻² s⁻¹] and,
+    if ``cfg.wavelength_nm`` is set, the band holding it [W m⁻² nm⁻¹], after the collector."""
+    fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
+    edges = result.bins.edges_nm if result.bins is not None else None
+    if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0]:
+        fields["par_umol_m2_s"] = par_map(result.floor_irradiance, edges)
+    band = band_index(result.wavelengths_nm, edges, cfg.wavelength_nm)
+    if band is not None:
+        fields[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = np.asarray(
+            result.floor_irradiance[band], np.float64
+        )
+    texel = result.extent_m / result.floor_irradiance.shape[-1]
+    periodic = result.scene.config.water.periodic
+    out = {
+        "collector_mm": cfg.collector_mm,
+        "flash_threshold": cfg.flash_threshold,
+        "pdf_edges": PDF_EDGES.tolist(),
+    }
+    for name, f in fields.items():
+        out[name] = field_statistics(
+            collector_average(f, texel, cfg.collector_mm * 1e-3, periodic=periodic), cfg.flash_threshold
+        )
+    return out
+
+
+def band_index(
+    centres_nm: np.ndarray, edges_nm: np.ndarray | None, wavelength_nm: float | None
+) -> int | None:
+    """The bin holding ``wavelength_nm`` (None: not asked, or outside the bins)."""
+    if wavelength_nm is None or edges_nm is None:
+        return None
+    k = int(np.searchsorted(edges_nm, wavelength_nm, side="right")) - 1
+    return k if 0 <= k < len(centres_nm) else None
+
+
+def probe_values(result, cfg: StatsConfig) -> np.ndarray:
+    """(P,) the collector-averaged, band-integrated irradiance [W m⁻²] at the probe points
+    (nearest texel)."""
+    total = band_integrated(result.floor_irradiance, result.bin_widths_nm)
+    m = total.shape[0]
+    texel = result.extent_m / m
+    averaged = collector_average(
+        total, texel, cfg.collector_mm * 1e-3, periodic=result.scene.config.water.periodic
+    )
+    values = []
+    for probe in cfg.probes:
+        i = min(max(int((probe.x_m + 0.5 * result.extent_m) / texel), 0), m - 1)
+        j = min(max(int((probe.y_m + 0.5 * result.extent_m) / texel), 0), m - 1)
+        values.append(averaged[j, i])
+    return np.array(values)
+
+
+def series_statistics(series: np.ndarray, dt_s: float, flash_threshold: float) -> dict:
+    """Statistics of time series E(t) (T, P) sampled every ``dt_s``: per probe the mean, CV, the
+    flash frequency (upward crossings of ``flash_threshold``·mean per second) and the one-sided
+    power spectrum of E/Ē − 1 (periodogram, Hann window) with its frequencies and the strongest."""
+    e = np.asarray(series, np.float64)
+    t = e.shape[0]
+    mean = e.mean(axis=0)
+    safe = np.where(mean > 0, mean, 1.0)
+    above = e > flash_threshold * safe
+    crossings = np.sum(~above[:-1] & above[1:], axis=0)
+    duration = (t - 1) * dt_s
+    freqs = np.fft.rfftfreq(t, dt_s)
+    window = np.hanning(t)[:, None]
+    spectrum = np.abs(np.fft.rfft((e / safe - 1.0) * window, axis=0)) ** 2 / (window**2).sum() * dt_s
+    spectrum[1:-1] *= 2.0  # one-sided
+    peak = freqs[1:][np.argmax(spectrum[1:], axis=0)] if t > 2 else np.zeros(e.shape[1])
+    return {
+        "mean": mean.tolist(),
+        "cv": (e.std(axis=0) / safe).tolist(),
+        "flash_frequency_hz": (crossings / duration if duration > 0 else np.zeros_like(mean)).tolist(),
+        "frequencies_hz": freqs.tolist(),
+        "power_spectrum": spectrum.T.tolist(),
+        "peak_frequency_hz": np.asarray(peak).tolist(),
+    }
