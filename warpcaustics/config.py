@@ -9,6 +9,7 @@ the nearest valid key.
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import difflib
 import enum
 import math
@@ -284,6 +285,14 @@ class SunConfig:
     file: str | None = None
     """CSV of the ``file`` spectrum: a header line, then wavelength [nm], spectral irradiance
     (any scale); relative paths start at the config file's folder."""
+    datetime: str | None = None
+    """Date and time with UTC offset (ISO 8601, e.g. ``2009-07-14T11:30:00+02:00``): with
+    ``latitude_deg`` and ``longitude_deg`` it sets elevation and azimuth (pvlib's SPA; the
+    ``science`` extra). Give either this or ``elevation_deg``/``azimuth_deg``."""
+    latitude_deg: float | None = field(default=None, metadata=_range(-90.0, 90.0))
+    """Latitude of the site, north positive [deg]."""
+    longitude_deg: float | None = field(default=None, metadata=_range(-180.0, 180.0))
+    """Longitude of the site, east positive [deg]."""
     irradiance_w_m2: float = field(default=0.0, metadata=_range(0.0, 1.0e5))
     """Sun irradiance on a plane perpendicular to the beam, integrated over the render's
     wavelengths [W/m²]; 0 = that of ASTM G173 direct + circumsolar over the same range."""
@@ -839,9 +848,53 @@ def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Co
         elif isinstance(wavelengths, str):
             raise ConfigError(f"optics.wavelengths = {wavelengths!r} is not allowed; allowed: a table "
                               f"{{min_nm, max_nm, bins}}, a list of centres [nm] or \"rgb\"")
+    _resolve_sun_position(table, set(overrides or {}))
     cfg = _build(Config, table, "")
     _check_consistency(cfg)
     return cfg
+
+
+def _resolve_sun_position(table: dict, overridden: set[str]) -> None:
+    """``sun.datetime`` with latitude and longitude: write the sun's elevation and azimuth into the
+    table (so the resolved config, run.json and sweep ids carry them). A place given by overrides
+    replaces an elevation and azimuth from the file; given in the same layer, they conflict."""
+    sun = table.get("sun")
+    if not isinstance(sun, dict):
+        return
+    place = [k for k in ("datetime", "latitude_deg", "longitude_deg") if sun.get(k) is not None]
+    if not place:
+        return
+    if len(place) < 3:
+        missing = [f"sun.{k}" for k in ("datetime", "latitude_deg", "longitude_deg") if k not in place]
+        raise ConfigError(f"sun.{place[0]} needs {' and '.join(missing)} too (the sun's position comes "
+                          "from a date, a time and a place)")
+    explicit = [k for k in ("elevation_deg", "azimuth_deg") if k in sun]
+    place_overridden = any(f"sun.{k}" in overridden for k in place)
+    if explicit and place_overridden and not any(f"sun.{k}" in overridden for k in explicit):
+        for k in explicit:  # the overrides' place wins over the file's angles
+            del sun[k]
+        explicit = []
+    if explicit:
+        raise ConfigError(f"sun.{explicit[0]} and sun.datetime both set the sun's position; give one "
+                          "of them")
+    from warpcaustics.solar import parse_datetime, sun_position
+
+    for key in ("latitude_deg", "longitude_deg"):
+        if isinstance(sun[key], bool) or not isinstance(sun[key], (int, float)):
+            raise ConfigError(f"sun.{key} = {_describe(sun[key])} has the wrong type; expected a number")
+    if isinstance(sun["datetime"], (datetime.datetime, datetime.date)):
+        sun["datetime"] = sun["datetime"].isoformat()  # a TOML date-time literal (quoted or not)
+    if not isinstance(sun["datetime"], str):
+        raise ConfigError(f"sun.datetime = {_describe(sun['datetime'])} must be a string, e.g. "
+                          "\"2009-07-14T11:30:00+02:00\"")
+    elevation, azimuth = sun_position(parse_datetime(sun["datetime"]), float(sun["latitude_deg"]),
+                                      float(sun["longitude_deg"]))
+    if elevation <= 0.0:
+        raise ConfigError(f"sun.datetime = {sun['datetime']!r}: the sun is {-elevation:.1f}° below the "
+                          f"horizon at latitude {sun['latitude_deg']}°, longitude {sun['longitude_deg']}°; "
+                          "pick a daytime")
+    sun["elevation_deg"] = elevation
+    sun["azimuth_deg"] = azimuth
 
 
 def read_toml(path: str | Path) -> dict:
