@@ -218,6 +218,22 @@ def deposit_by_samples(
                              texel_of(p[0], m, periodic), texel_of(p[1], m, periodic), weight)
 
 
+@wp.struct
+class FloorMap:
+    origin: wp.vec2
+    """Corner (x, y) [m] of texel (0, 0) of the map."""
+    centre: wp.vec2
+    """Centre of the map [m]."""
+    scale: float
+    """Texels per metre, M / W."""
+    wrap: int
+    """1: the map is the whole periodic patch and its texel indices wrap; 0: texels outside the map
+    are dropped (a walled pool, an open patch, or a window of a periodic sea)."""
+    max_clipped: int
+    """Footprints covering more texels of the map are deposited by area samples: MAX_CLIPPED_TEXELS
+    for whole maps; a window's texels are few and fine, so all of them are clipped exactly."""
+
+
 @wp.kernel
 def deposit_footprints(
     hit_xy: wp.array3d[wp.vec2],
@@ -225,15 +241,17 @@ def deposit_footprints(
     wavelengths_per_group: int,
     extent_m: float,
     periodic: int,
+    floor_map: FloorMap,
     floor_texels: wp.array3d[wp.float32],
     coarse_count: wp.array[wp.int32],
 ):
     """Spread triangle (iy, ix, half)'s flux over its floor footprint for index group g.
 
     ``floor_texels`` is (M, M, K) [W m^-2 nm^-1] (wavelengths contiguous: one cache line per
-    texel); texel (ty, tx) spans ``[tx, tx+1] * L/M - L/2`` in x. Weight of a texel = overlap area
-    / footprint area. Footprints whose bounding box exceeds ``MAX_CLIPPED_TEXELS`` are deposited by
-    area samples instead and counted in ``coarse_count``.
+    texel); texel (ty, tx) spans ``origin + [tx, tx+1] / scale`` in x. Weight of a texel = overlap
+    area / footprint area. On a window of a periodic sea each footprint is taken at its periodic
+    image nearest the window. Footprints whose bounding box within the map exceeds
+    ``MAX_CLIPPED_TEXELS`` are deposited by area samples instead and counted in ``coarse_count``.
     """
     g, iy, ix, half = wp.tid()
     n = hit_xy.shape[1]
@@ -247,15 +265,20 @@ def deposit_footprints(
     x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
     x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
-    scale = float(m) / extent_m
+    scale = floor_map.scale
+    wrap = floor_map.wrap
     # Footprint in texel units: corner 0 wrapped into [0, M) (a whole-period shift leaves the
     # periodic deposit unchanged and keeps indices small), edges taken in metres first so their
     # precision does not depend on where the footprint lies.
     a = hit_xy[g, y0, x0] + s0
     e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
     e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
-    q0 = (a + wp.vec2(0.5 * extent_m)) * scale
-    if periodic != 0:
+    if periodic != 0 and wrap == 0:
+        # a window of a periodic sea: the footprint's periodic image nearest the window
+        a = a - extent_m * wp.vec2(wp.round((a[0] - floor_map.centre[0]) / extent_m),
+                                   wp.round((a[1] - floor_map.centre[1]) / extent_m))
+    q0 = (a - floor_map.origin) * scale
+    if wrap != 0:
         q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
     q1 = q0 + e1
     q2 = q0 + e2
@@ -264,11 +287,19 @@ def deposit_footprints(
     v_lo = wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1])))
     u_hi = wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0])))
     v_hi = wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1])))
-    if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(MAX_CLIPPED_TEXELS):
+    single_texel = u_lo == u_hi and v_lo == v_hi
+    if wrap == 0:  # only the texels inside the map are visited
+        u_lo = wp.max(u_lo, 0.0)
+        v_lo = wp.max(v_lo, 0.0)
+        u_hi = wp.min(u_hi, float(m - 1))
+        v_hi = wp.min(v_hi, float(m - 1))
+        if u_lo > u_hi or v_lo > v_hi:
+            return  # the footprint misses the map
+    if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(floor_map.max_clipped):
         # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
         wp.atomic_add(coarse_count, 0, 1)
         deposit_by_samples(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
-                           q0, e1, e2, m, periodic, inv_texel_area)
+                           q0, e1, e2, m, wrap, inv_texel_area)
         return
     i_lo = int(u_lo)
     j_lo = int(v_lo)
@@ -280,10 +311,10 @@ def deposit_footprints(
     q1 = q1 - corner
     q2 = q2 - corner
     area = 0.5 * wp.abs(e1[0] * e2[1] - e2[0] * e1[1])
-    if (i_lo == i_hi and j_lo == j_hi) or area < DEGENERATE_AREA_TEXELS:
+    if area < DEGENERATE_AREA_TEXELS or single_texel:
         c = (q0 + q1 + q2) / 3.0
-        tx = texel(i_lo + int(wp.floor(c[0])), m, periodic)
-        ty = texel(j_lo + int(wp.floor(c[1])), m, periodic)
+        tx = texel(i_lo + int(wp.floor(c[0])), m, wrap)
+        ty = texel(j_lo + int(wp.floor(c[1])), m, wrap)
         add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
                      tx, ty, inv_texel_area)
         return
@@ -305,12 +336,12 @@ def deposit_footprints(
         for v in range(1, cn):
             y_min = wp.min(y_min, cy[v])
             y_max = wp.max(y_max, cy[v])
-        for cj in range(int(wp.floor(y_min)), wp.min(int(wp.floor(y_max)), j_hi - j_lo) + 1):
+        for cj in range(wp.max(int(wp.floor(y_min)), 0), wp.min(int(wp.floor(y_max)), j_hi - j_lo) + 1):
             rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
             if rn >= 3:
                 w = polygon_area(rx, ry, rn) / area * inv_texel_area
                 add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
-                             half, texel(i_lo + ci, m, periodic), texel(j_lo + cj, m, periodic), w)
+                             half, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
 
 
 @wp.kernel

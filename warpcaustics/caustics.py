@@ -21,7 +21,10 @@ class FloorCaustics:
     """Owns the floor stage's device buffers, reused from frame to frame."""
 
     def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True):
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True,
+                 window: tuple[float, tuple[float, float]] | None = None, extent_m: float | None = None):
+        """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch
+        (``extent_m``, which is then needed only to place the window)."""
         k = len(sun_irradiance)
         m = map_resolution
         self.device = device
@@ -37,6 +40,20 @@ class FloorCaustics:
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
         self.coarse_count = wp.zeros(1, dtype=wp.int32, device=device)
         """Footprints of the last run deposited by area samples (too large to clip texel by texel)."""
+        self.window = window
+        self.periodic = periodic
+
+    def floor_map(self, extent_m: float) -> floor_kernels.FloorMap:
+        """Where the M×M map lies: the whole patch of side ``extent_m``, or the window."""
+        m = self.texels.shape[0]
+        side, centre = (extent_m, (0.0, 0.0)) if self.window is None else self.window
+        fm = floor_kernels.FloorMap()
+        fm.centre = wp.vec2(*centre)
+        fm.origin = wp.vec2(centre[0] - 0.5 * side, centre[1] - 0.5 * side)
+        fm.scale = m / side
+        fm.wrap = int(self.periodic and self.window is None)
+        fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS if self.window is None else m * m
+        return fm
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray) -> wp.array3d:
         """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
@@ -59,7 +76,7 @@ class FloorCaustics:
         self.coarse_count.zero_()
         wp.launch(floor_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
                   inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
-                          int(surface.periodic)],
+                          int(surface.periodic), self.floor_map(float(surface.extent_m))],
                   outputs=[self.texels, self.coarse_count], device=self.device)
         wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
                   outputs=[self.irradiance], device=self.device)

@@ -364,7 +364,12 @@ class CausticsConfig:
     Mercier 2013 §4: the 3-D wave equation driven by the refracted wave, its time-averaged
     intensity on the floor); those two also save the flux-ratio map beside theirs."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
-    """Texels M per side of the floor irradiance map over the water extent [-]."""
+    """Texels M per side of the floor irradiance map over the water extent (or the window) [-]."""
+    map_extent_m: float = field(default=0.0, metadata=_range(0.0, None))
+    """Side of a square floor-map window [m] (``fluxratio``): millimetre texels over a small part
+    of a large sea; 0 = the whole water extent."""
+    map_center_m: tuple[float, ...] = (0.0, 0.0)
+    """Centre (x, y) of the floor-map window [m]."""
     intersection: Intersection = Intersection.EXACT
     """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
     ``newton`` (Shah's iteration on a receiver-position buffer rendered from the sun)."""
@@ -495,9 +500,9 @@ class StatsConfig:
     """A flash is irradiance above this many times the mean [-]."""
     wavelength_nm: float | None = field(default=None, metadata=_range(100.0, 5000.0))
     """Also report the statistics of the band holding this wavelength (e.g. 510 nm) [nm]."""
-    probes: tuple[ProbeConfig, ...] = (ProbeConfig(),)
+    probes: tuple[ProbeConfig, ...] = ()
     """Floor points whose irradiance over an animation is reported (``[[stats.probes]]`` tables
-    with x_m, y_m); the centre by default."""
+    with x_m, y_m); none given: the floor map's centre."""
 
 
 @dataclass(frozen=True)
@@ -711,15 +716,40 @@ GREY_METHODS = (CausticsMethod.SUNMAP, CausticsMethod.EIKONAL, CausticsMethod.WA
 """Methods that trace one refractive index for all bands."""
 
 
-def _check_stats(cfg: Config) -> None:
+def _check_map_window(cfg: Config) -> None:
+    c = cfg.caustics
+    _check_vector("caustics.map_center_m", c.map_center_m, (2,))
+    if not c.map_extent_m:
+        if any(c.map_center_m):
+            raise ConfigError(f"caustics.map_center_m = {list(c.map_center_m)} places a window, but "
+                              "caustics.map_extent_m is 0 (the whole patch); set caustics.map_extent_m")
+        return
+    if c.method is not CausticsMethod.FLUXRATIO:
+        raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} (a floor-map window) works with "
+                          f"caustics.method = \"fluxratio\" only (the method is {c.method.value!r}); set "
+                          "caustics.map_extent_m = 0")
     half = 0.5 * cfg.water.extent_m
+    if c.map_extent_m > cfg.water.extent_m:
+        raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} exceeds water.extent_m = "
+                          f"{cfg.water.extent_m:g}; a window is part of the patch")
+    x, y = c.map_center_m
+    if not cfg.water.periodic and max(abs(x), abs(y)) + 0.5 * c.map_extent_m > half:
+        raise ConfigError(f"the floor-map window (caustics.map_center_m = {list(c.map_center_m)}, "
+                          f"caustics.map_extent_m = {c.map_extent_m:g}) reaches past the "
+                          f"{cfg.water.model.value!r} patch (|x|, |y| <= {half:g} m); move or shrink it")
+
+
+def _check_stats(cfg: Config) -> None:
+    side = cfg.caustics.map_extent_m or cfg.water.extent_m
+    cx, cy = cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)
+    half = 0.5 * side
     for i, p in enumerate(cfg.stats.probes):
-        if abs(p.x_m) > half or abs(p.y_m) > half:
+        if abs(p.x_m - cx) > half or abs(p.y_m - cy) > half:
             raise ConfigError(f"stats.probes[{i}] = ({p.x_m:g}, {p.y_m:g}) m is off the floor map "
-                              f"(|x|, |y| <= {half:g} m); move it inside water.extent_m")
-    if cfg.stats.collector_mm * 1e-3 > cfg.water.extent_m:
+                              f"({side:g} m wide around ({cx:g}, {cy:g}) m); move it onto the map")
+    if cfg.stats.collector_mm * 1e-3 > side:
         raise ConfigError(f"stats.collector_mm = {cfg.stats.collector_mm:g} is wider than the "
-                          f"{cfg.water.extent_m:g} m floor map; use a smaller collector")
+                          f"{side:g} m floor map; use a smaller collector")
     if cfg.output.netcdf:
         try:
             import xarray  # noqa: F401
@@ -768,6 +798,7 @@ def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
     _check_sunmap(cfg)
+    _check_map_window(cfg)
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []

@@ -103,7 +103,8 @@ def save_frame(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     paths = {"exr": out_dir / f"{stem}.exr", "png": out_dir / f"{stem}.png"}
     _write_spectral_image(result, image, paths["exr"], paths["png"], {
         "warpcaustics.quantity": "floor spectral irradiance",
-        "warpcaustics.extent_m": f"{result.extent_m:g}"}, EMISSIVE_UNITS)
+        "warpcaustics.extent_m": f"{result.map_extent_m:g}",
+        "warpcaustics.center_m": "{:g},{:g}".format(*result.map_center_m)}, EMISSIVE_UNITS)
     if result.camera_radiance is not None:
         stem = f"camera_{frame:04d}"
         paths["camera_exr"] = out_dir / f"{stem}.exr"
@@ -147,12 +148,11 @@ def science_arrays(result) -> dict[str, np.ndarray]:
     (not flipped as in the images)."""
     from warpcaustics.stats import par_map
 
-    m = result.floor_irradiance.shape[-1]
-    coords = (np.arange(m) + 0.5) * result.extent_m / m - 0.5 * result.extent_m
+    x, y = result.map_coordinates()
     edges = result.bins.edges_nm if result.bins is not None else np.array([])
     return {"floor_irradiance": result.floor_irradiance.astype(np.float32),
             "wavelength_nm": np.asarray(result.wavelengths_nm, np.float64),
-            "bin_edges_nm": np.asarray(edges, np.float64), "x_m": coords, "y_m": coords,
+            "bin_edges_nm": np.asarray(edges, np.float64), "x_m": x, "y_m": y,
             "time_s": np.array([result.time_s]),
             "par_umol_m2_s": par_map(result.floor_irradiance, edges).astype(np.float32)}
 
@@ -233,9 +233,10 @@ def write_vtk(result, out_dir: Path, *, frame: int = 0) -> dict[str, Path]:
     _save_mesh(grid, paths["surface_vtk"])
 
     m = result.floor_irradiance.shape[-1]
-    extent = result.extent_m
+    extent = result.map_extent_m
+    cx, cy = result.map_center_m
     image = pv.ImageData(dimensions=(m + 1, m + 1, 1), spacing=(extent / m, extent / m, 1.0),
-                         origin=(-extent / 2, -extent / 2, -result.scene.config.floor.depth_m))
+                         origin=(cx - extent / 2, cy - extent / 2, -result.scene.config.floor.depth_m))
     for wl, band in zip(result.wavelengths_nm, result.floor_irradiance):
         image.cell_data[band_name(wl)] = band.ravel()  # row index along +y: x varies fastest
     paths["floor_vtk"] = out_dir / f"floor_{stem}.vti"
@@ -346,16 +347,18 @@ def frame_statistics_entry(r) -> dict:
     return {**frame_statistics(r, cfg), "probe_irradiance_w_m2": probe_values(r, cfg).tolist()}
 
 
-def time_statistics(frames: list[dict], stats_cfg) -> dict | None:
-    """Statistics of the probes' E(t) over an animation (three frames or more, equally spaced)."""
-    from warpcaustics.stats import series_statistics
+def time_statistics(frames: list[dict], first) -> dict | None:
+    """Statistics of the probes' E(t) over an animation (three frames or more, equally spaced);
+    ``first`` is the first frame's RenderResult (for the config and the map)."""
+    from warpcaustics.stats import probe_points, series_statistics
 
     if len(frames) < 3:
         return None
+    stats_cfg = first.scene.config.stats
     times = np.array([f["time_s"] for f in frames])
     series = np.array([f["statistics"]["probe_irradiance_w_m2"] for f in frames])
     dt = float(np.mean(np.diff(times)))
-    return {"probes_m": [[p.x_m, p.y_m] for p in stats_cfg.probes], "dt_s": dt,
+    return {"probes_m": [list(p) for p in probe_points(stats_cfg, first.map_center_m)], "dt_s": dt,
             **series_statistics(series, dt, stats_cfg.flash_threshold)}
 
 
@@ -369,7 +372,7 @@ def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = 
     first = results[0]
     path = out_dir / "run.json"
     frames = frames if frames is not None else [frame_entry(i, r) for i, r in enumerate(results)]
-    series = time_statistics(frames, first.scene.config.stats)
+    series = time_statistics(frames, first)
     write_json(path, {
         "source": first.scene.source,
         "config": config_to_dict(first.scene.config),

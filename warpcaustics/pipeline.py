@@ -108,8 +108,32 @@ class RenderResult:
         return self.scene.config.water.extent_m
 
     @property
+    def map_extent_m(self) -> float:
+        """Side of the floor map [m]: the water extent, or ``caustics.map_extent_m``'s window."""
+        return self.scene.config.caustics.map_extent_m or self.extent_m
+
+    @property
+    def map_center_m(self) -> tuple[float, float]:
+        """Centre of the floor map [m]."""
+        c = self.scene.config.caustics
+        return (float(c.map_center_m[0]), float(c.map_center_m[1])) if c.map_extent_m else (0.0, 0.0)
+
+    @property
+    def map_periodic(self) -> bool:
+        """Whether the floor map tiles (the whole patch of a periodic sea)."""
+        return self.scene.config.water.periodic and not self.scene.config.caustics.map_extent_m
+
+    def map_coordinates(self) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) [m] of the texel centres of the floor map (row index along +y)."""
+        m = self.floor_irradiance.shape[-1]
+        side = self.map_extent_m
+        offsets = (np.arange(m) + 0.5) * side / m - 0.5 * side
+        cx, cy = self.map_center_m
+        return cx + offsets, cy + offsets
+
+    @property
     def texel_area_m2(self) -> float:
-        return (self.extent_m / self.floor_irradiance.shape[-1]) ** 2
+        return (self.map_extent_m / self.floor_irradiance.shape[-1]) ** 2
 
     @property
     def floor_flux_w_nm(self) -> np.ndarray:
@@ -259,9 +283,11 @@ class Renderer:
             else:
                 self.floor_top_z = -cfg.floor.depth_m
                 self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
+                window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
+                          if cfg.caustics.map_extent_m else None)
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
                                                     self.attenuation_per_m, self.device,
-                                                    periodic=self.water.periodic)
+                                                    periodic=self.water.periodic, window=window)
                 # The approximate methods (issue 8): grey, one index for their rays (the bins' mean).
                 mean_ior = float(np.mean(self.ior))
                 if cfg.caustics.method is CausticsMethod.SUNMAP:

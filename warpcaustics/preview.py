@@ -23,13 +23,14 @@ def preview_png(result, path: Path, *, width: int = 960, height: int = 640) -> P
         import pyvista as pv
 
     widths = result.bin_widths_nm
-    extent = result.extent_m
+    extent = result.map_extent_m
+    cx, cy = result.map_center_m
     depth = result.scene.config.floor.depth_m
     m = result.floor_irradiance.shape[-1]
     floor = pv.ImageData(
         dimensions=(m + 1, m + 1, 1),
         spacing=(extent / m, extent / m, 1.0),
-        origin=(-extent / 2, -extent / 2, -depth),
+        origin=(cx - extent / 2, cy - extent / 2, -depth),
     )
     floor.cell_data["irradiance"] = np.einsum("kij,k->ij", result.floor_irradiance, widths).ravel()
     pos = result.surface_positions.astype(np.float64)

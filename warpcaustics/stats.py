@@ -124,8 +124,8 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         fields[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = np.asarray(
             result.floor_irradiance[band], np.float64
         )
-    texel = result.extent_m / result.floor_irradiance.shape[-1]
-    periodic = result.scene.config.water.periodic
+    texel = result.map_extent_m / result.floor_irradiance.shape[-1]
+    periodic = result.map_periodic
     out = {
         "collector_mm": cfg.collector_mm,
         "flash_threshold": cfg.flash_threshold,
@@ -153,16 +153,22 @@ def probe_values(result, cfg: StatsConfig) -> np.ndarray:
     (nearest texel)."""
     total = band_integrated(result.floor_irradiance, result.bin_widths_nm)
     m = total.shape[0]
-    texel = result.extent_m / m
+    texel = result.map_extent_m / m
     averaged = collector_average(
-        total, texel, cfg.collector_mm * 1e-3, periodic=result.scene.config.water.periodic
+        total, texel, cfg.collector_mm * 1e-3, periodic=result.map_periodic
     )
     values = []
-    for probe in cfg.probes:
-        i = min(max(int((probe.x_m + 0.5 * result.extent_m) / texel), 0), m - 1)
-        j = min(max(int((probe.y_m + 0.5 * result.extent_m) / texel), 0), m - 1)
+    cx, cy = result.map_center_m
+    for x, y in probe_points(cfg, result.map_center_m):
+        i = min(max(int((x - cx + 0.5 * result.map_extent_m) / texel), 0), m - 1)
+        j = min(max(int((y - cy + 0.5 * result.map_extent_m) / texel), 0), m - 1)
         values.append(averaged[j, i])
     return np.array(values)
+
+
+def probe_points(cfg: StatsConfig, map_center_m: tuple[float, float]) -> list[tuple[float, float]]:
+    """(x, y) [m] of the probes: ``stats.probes``, or the floor map's centre."""
+    return [(p.x_m, p.y_m) for p in cfg.probes] or [tuple(map_center_m)]
 
 
 def series_statistics(series: np.ndarray, dt_s: float, flash_threshold: float) -> dict:
