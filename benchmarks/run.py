@@ -192,6 +192,9 @@ def main(argv: list[str] | None = None) -> int:
     # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
     eikonal = _in_child("run", args.quick, args.device, module="eikonal")
 
+    # The sun's disk against a point sun (benchmarks/sun_disk.py).
+    sun_disk = _in_child("run", args.quick, args.device, module="sun_disk")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -214,6 +217,7 @@ def main(argv: list[str] | None = None) -> int:
         "beams": beams,
         "sunmap": sunmap,
         "eikonal": eikonal,
+        "sun_disk": sun_disk,
         "sweep": sweeps,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)

@@ -55,10 +55,12 @@ class FloorCaustics:
         fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS if self.window is None else m * m
         return fm
 
-    def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray) -> wp.array3d:
+    def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray, *,
+            clear: bool = True) -> wp.array3d:
         """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
         so per band ``sum(irradiance) * texel_area == sum(flux)`` to rounding; in a walled pool
-        the flux that would land beyond the walls is not followed."""
+        the flux that would land beyond the walls is not followed. ``clear = False`` adds to the
+        last run's map (the directions of a sun disk, each with its share in ``sun_irradiance``)."""
         quads = self.flux.shape[0]
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
@@ -72,8 +74,9 @@ class FloorCaustics:
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux], device=self.device)
-        self.texels.zero_()
-        self.coarse_count.zero_()
+        if clear:
+            self.texels.zero_()
+            self.coarse_count.zero_()
         wp.launch(floor_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
                   inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
                           int(surface.periodic), self.floor_map(float(surface.extent_m))],

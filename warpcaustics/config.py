@@ -277,6 +277,12 @@ class SunConfig:
     """Angle of the sun above the horizon [deg]."""
     azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction towards the sun, from +x towards +y [deg]."""
+    angular_diameter_deg: float = field(default=0.0, metadata=_range(0.0, 5.0))
+    """Angular diameter of the sun's disk [deg]: 0 = a point; 0.53 = the real sun, integrated over
+    ``disk_samples`` directions (``fluxratio`` so far)."""
+    disk_samples: int = field(default=16, metadata=_range(2, 1024))
+    """Directions over the sun's disk (equal solid angles: a sunflower pattern and its mirror
+    image; an odd number is rounded down to even) [-]."""
     spectrum: SunSpectrum = SunSpectrum.ASTM_G173
     """Shape of the sun's spectrum: ``astm_g173`` (direct + circumsolar, absolute), ``d65``,
     ``blackbody`` (at ``temperature_k``) or ``file`` (``sun.file``)."""
@@ -739,6 +745,13 @@ def _check_map_window(cfg: Config) -> None:
                           f"{cfg.water.model.value!r} patch (|x|, |y| <= {half:g} m); move or shrink it")
 
 
+def _check_sun_disk(cfg: Config) -> None:
+    if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method is not CausticsMethod.FLUXRATIO:
+        raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g} (a sun disk) is "
+                          f"integrated by caustics.method = \"fluxratio\" only so far (the method is "
+                          f"{cfg.caustics.method.value!r}); set sun.angular_diameter_deg = 0")
+
+
 def _check_stats(cfg: Config) -> None:
     side = cfg.caustics.map_extent_m or cfg.water.extent_m
     cx, cy = cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)
@@ -799,6 +812,7 @@ def _check_photon_scene(cfg: Config) -> None:
     _check_beam_levels(cfg)
     _check_sunmap(cfg)
     _check_map_window(cfg)
+    _check_sun_disk(cfg)
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []

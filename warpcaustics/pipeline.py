@@ -169,7 +169,8 @@ class _Stopwatch:
 
             def __exit__(self, *exc):
                 wp.synchronize_device(watch.device)
-                watch.timings[name] = time.perf_counter() - self.t0
+                # a stage run several times in a frame (per sun-disk direction) adds up
+                watch.timings[name] = watch.timings.get(name, 0.0) + time.perf_counter() - self.t0
 
         return _Stage()
 
@@ -285,7 +286,8 @@ class Renderer:
                 self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
-                self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, self.sun_irradiance,
+                disk_share = self.sun_irradiance / len(scene.sun_disk_directions())
+                self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
                                                     self.attenuation_per_m, self.device,
                                                     periodic=self.water.periodic, window=window)
                 # The approximate methods (issue 8): grey, one index for their rays (the bins' mean).
@@ -339,15 +341,20 @@ class Renderer:
             outputs = [self._receiver_stage(st, surface, visible, watch) for st in stages]
             floor_np, transmitted, extra = outputs[0]
         else:
-            with watch.stage("refraction"):
-                refracted = refract_to_floor(surface, visible, self.group_ior, sun_dir,
-                                             -cfg.floor.depth_m, dev, out=self.refracted)
-            with watch.stage("floor_caustics"):
-                floor = self.floor.run(surface, refracted, sun_dir)
+            # A sun disk: one refraction and deposit per direction over it, each with an equal
+            # share of the flux (sun_irradiance was divided by their number); crests shade by the
+            # disk's centre.
+            transmitted = 0.0
+            for i, direction in enumerate(self.scene.sun_disk_directions()):
+                with watch.stage("refraction"):
+                    refracted = refract_to_floor(surface, visible, self.group_ior, direction,
+                                                 -cfg.floor.depth_m, dev, out=self.refracted)
+                with watch.stage("floor_caustics"):
+                    floor = self.floor.run(surface, refracted, direction, clear=i == 0)
+                transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
-                transmitted = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             if self.approximate is not None:
                 flux_ratio_floor = floor_np
                 with watch.stage(cfg.caustics.method.value):

@@ -41,6 +41,29 @@ class Scene:
     def water_resolution(self) -> int:
         return self.config.water.resolution
 
+    def sun_disk_directions(self) -> np.ndarray:
+        """(S, 3) unit directions over the sun's disk, each standing for an equal solid angle: a
+        sunflower pattern (radius ρ√((i + ½)/h), turns of the golden angle) of h = S/2 points and
+        their mirror images through the centre, so the pattern's centroid is the sun's centre and
+        the first-order error of the sampling cancels; the centre alone for a point sun."""
+        sun = self.config.sun
+        s = self.sun_direction
+        if sun.angular_diameter_deg <= 0.0:
+            return s[None]
+        count = max(1, sun.disk_samples // 2)
+        radius = 0.5 * math.radians(sun.angular_diameter_deg)
+        u = np.cross(s, [0.0, 0.0, 1.0] if abs(s[2]) < 0.9 else [1.0, 0.0, 0.0])
+        u /= np.linalg.norm(u)
+        v = np.cross(s, u)
+        i = np.arange(count) + 0.5
+        r = radius * np.sqrt(i / count)
+        phi = i * math.pi * (3.0 - math.sqrt(5.0))
+        around = np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * v
+        around = np.concatenate([around, -around])
+        r = np.concatenate([r, r])
+        d = np.cos(r)[:, None] * s + np.sin(r)[:, None] * around
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+
     @property
     def sun_direction(self) -> np.ndarray:
         """Unit vector towards the sun (z up; azimuth from +x towards +y)."""
