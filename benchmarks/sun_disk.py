@@ -1,7 +1,9 @@
-"""The sun's disk vs a point sun: one frame of the default ocean by the flux-ratio map, same run.
+"""The sun's disk and the sky vs a point sun: one frame of the default ocean by the flux-ratio
+map, same run.
 
 The disk costs one refraction and one deposit per direction over it, so the frame's caustic
-stages should take about ``sun.disk_samples`` times the point sun's. Median of a few frames after
+stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky over as many
+directions adds as many passes, each with its own crest-shading march. Median of a few frames after
 a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
 """
 
@@ -20,15 +22,14 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
     from warpcaustics.pipeline import Renderer
 
     rows = {}
-    for name, diameter in (("point", 0.0), ("disk", 0.53)):
+    cases = (
+        ("point", {}),
+        ("disk", {"sun.angular_diameter_deg": 0.53, "sun.disk_samples": samples}),
+        ("sky", {"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "sky.directions": samples}),
+    )
+    for name, extra in cases:
         scene = wc.load_scene(
-            "configs/ocean.toml",
-            {
-                "water.resolution": n,
-                "caustics.map_resolution": m,
-                "sun.angular_diameter_deg": diameter,
-                "sun.disk_samples": samples,
-            },
+            "configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m, **extra}
         )
         renderer = Renderer(scene, device)
         renderer.render(0.0)  # warm-up
@@ -36,10 +37,12 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
     return {
         "water_n": n,
         "map_m": m,
-        "disk_samples": samples,
+        "directions": samples,
         "point_frame_s": rows["point"],
         "disk_frame_s": rows["disk"],
         "disk_over_point": rows["disk"] / rows["point"],
+        "sky_frame_s": rows["sky"],
+        "sky_over_point": rows["sky"] / rows["point"],
     }
 
 
@@ -55,11 +58,12 @@ def run(quick: bool, device: str) -> dict:
         print(
             f"sun disk     ocean N={n} M={m} | {samples:3d} directions | point "
             f"{row['point_frame_s'] * 1e3:8.1f} ms | disk {row['disk_frame_s'] * 1e3:8.1f} ms | "
-            f"disk / point {row['disk_over_point']:5.1f}x",
+            f"disk / point {row['disk_over_point']:5.1f}x | sky {row['sky_frame_s'] * 1e3:8.1f} ms | "
+            f"sky / point {row['sky_over_point']:5.1f}x",
             flush=True,
         )
     return {
-        "benchmark": "sun_disk_vs_point",
+        "benchmark": "sun_disk_and_sky_vs_point",
         "device": device,
         "device_name": str(wp.get_device(device).name),
         "warp_version": wp.__version__,

@@ -56,11 +56,12 @@ class FloorCaustics:
         return fm
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray, *,
-            clear: bool = True) -> wp.array3d:
+            clear: bool = True, irradiance: wp.array | None = None) -> wp.array3d:
         """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
         so per band ``sum(irradiance) * texel_area == sum(flux)`` to rounding; in a walled pool
         the flux that would land beyond the walls is not followed. ``clear = False`` adds to the
-        last run's map (the directions of a sun disk, each with its share in ``sun_irradiance``)."""
+        last run's map (the directions of a sun disk, each with its share in ``sun_irradiance``);
+        ``irradiance`` (K,) replaces ``sun_irradiance`` for this run (a direction of the sky)."""
         quads = self.flux.shape[0]
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
@@ -70,7 +71,8 @@ class FloorCaustics:
         per_group = k // groups
         wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
-                          wp.vec3(*np.asarray(sun_dir, np.float32)), self.sun_irradiance,
+                          wp.vec3(*np.asarray(sun_dir, np.float32)),
+                          self.sun_irradiance if irradiance is None else irradiance,
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux], device=self.device)

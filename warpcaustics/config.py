@@ -71,6 +71,11 @@ class SunSpectrum(str, enum.Enum):
     FILE = "file"
 
 
+class SkyModel(str, enum.Enum):
+    NONE = "none"
+    UNIFORM = "uniform"
+
+
 class PhaseFunctionKind(str, enum.Enum):
     HENYEY_GREENSTEIN = "henyey_greenstein"
     PETZOLD = "petzold"
@@ -133,6 +138,7 @@ class DeviceChoice(str, enum.Enum):
 
 # Values other issues will add: named so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
+    "sky.model": ("cie_clear",),
 }
 
 
@@ -490,6 +496,18 @@ class OutputConfig:
 
 
 @dataclass(frozen=True)
+class SkyConfig:
+    model: SkyModel = SkyModel.NONE
+    """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky;
+    ``fluxratio`` so far). ``cie_clear`` is planned."""
+    diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
+    """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
+    (``sun.*``) is the rest [-]."""
+    directions: int = field(default=64, metadata=_range(1, 4096))
+    """Directions the sky is integrated over (cosine-weighted, stratified) [-]."""
+
+
+@dataclass(frozen=True)
 class ProbeConfig:
     x_m: float = 0.0
     """Where the probe sits on the floor, x [m]."""
@@ -531,6 +549,8 @@ class Config:
     """What is written."""
     stats: StatsConfig = field(default_factory=StatsConfig)
     """Irradiance statistics reported in run.json."""
+    sky: SkyConfig = field(default_factory=SkyConfig)
+    """Skylight."""
     device: DeviceChoice = DeviceChoice.AUTO
     """``auto`` (CUDA when available, else CPU), ``cpu`` or ``cuda``."""
 
@@ -745,6 +765,22 @@ def _check_map_window(cfg: Config) -> None:
                           f"{cfg.water.model.value!r} patch (|x|, |y| <= {half:g} m); move or shrink it")
 
 
+def _check_sky(cfg: Config) -> None:
+    sky = cfg.sky
+    if sky.model is SkyModel.NONE:
+        if sky.diffuse_fraction:
+            raise ConfigError(f"sky.diffuse_fraction = {sky.diffuse_fraction:g} needs a sky; set "
+                              "sky.model = \"uniform\" (or sky.diffuse_fraction = 0)")
+        return
+    if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
+        raise ConfigError(f"sky.model = {sky.model.value!r} is integrated by caustics.method = "
+                          f"\"fluxratio\" only so far (the method is {cfg.caustics.method.value!r}); set "
+                          "sky.model = \"none\"")
+    if sky.diffuse_fraction <= 0.0:
+        raise ConfigError(f"sky.model = {sky.model.value!r} with sky.diffuse_fraction = 0 has no light; set "
+                          "sky.diffuse_fraction (e.g. 0.15) or sky.model = \"none\"")
+
+
 def _check_sun_disk(cfg: Config) -> None:
     if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method is not CausticsMethod.FLUXRATIO:
         raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g} (a sun disk) is "
@@ -813,6 +849,7 @@ def _check_photon_scene(cfg: Config) -> None:
     _check_sunmap(cfg)
     _check_map_window(cfg)
     _check_sun_disk(cfg)
+    _check_sky(cfg)
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []

@@ -325,6 +325,8 @@ def frame_entry(frame: int, r) -> dict:
             [f"camera_{frame:04d}.exr", f"camera_{frame:04d}.png"] if r.camera_radiance is not None else []),
         "timings_s": r.timings_s,
         "floor_mean_irradiance_w_m2_nm": r.floor_irradiance.mean(axis=(1, 2), dtype=np.float64),
+        **({"sky_floor_mean_irradiance_w_m2_nm": r.sky_floor_irradiance.mean(axis=(1, 2), dtype=np.float64)}
+           if r.sky_floor_irradiance is not None else {}),
         "floor_flux_w_nm": r.floor_flux_w_nm,
         "transmitted_flux_w_nm": r.transmitted_flux_w_nm,
         "fold_fraction": r.fold_fraction,

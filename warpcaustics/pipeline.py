@@ -14,7 +14,7 @@ import warp as wp
 from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
-from warpcaustics.config import CausticsMethod
+from warpcaustics.config import CausticsMethod, SkyModel
 from warpcaustics.eikonal import EikonalCaustics, eikonal_bytes
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.phase import PhaseFunction
@@ -90,6 +90,9 @@ class RenderResult:
     """``eikonal``: layers of the grid and Jacobi passes of the relaxation."""
     wave3d_stats: dict[str, int] | None = None
     """``wave3d``: layers of the grid, steps, averaged steps and node updates."""
+    sky_floor_irradiance: np.ndarray | None = None
+    """With a sky (``sky.model``): (K, M, M) the sky's part of :attr:`floor_irradiance`
+    [W m⁻² nm⁻¹]; the direct sun's is the rest."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
@@ -257,6 +260,7 @@ class Renderer:
             self.photons = None
             self.beams = None
             self.approximate = None
+            self.sky_directions = None
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
@@ -286,6 +290,13 @@ class Renderer:
                 self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
+                if cfg.sky.model is not SkyModel.NONE:
+                    self.sky_directions, shares = scene.sky_directions()
+                    sky = scene.sky_irradiance(self.sun_irradiance)
+                    self.sky_irradiance_per_dir = [
+                        wp.array((sky * w).astype(np.float32), dtype=wp.float32, device=self.device)
+                        for w in shares]
+                    self.sky_visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
                 disk_share = self.sun_irradiance / len(scene.sun_disk_directions())
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
                                                     self.attenuation_per_m, self.device,
@@ -355,6 +366,11 @@ class Renderer:
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
+            if self.sky_directions is not None:
+                sky_np, sky_transmitted = self._sky(surface, highest, watch)
+                extra["sky_floor_irradiance"] = sky_np
+                floor_np = floor_np + sky_np
+                transmitted = transmitted + sky_transmitted
             if self.approximate is not None:
                 flux_ratio_floor = floor_np
                 with watch.stage(cfg.caustics.method.value):
@@ -381,6 +397,21 @@ class Renderer:
         name = "beams" if method is CausticsMethod.BOTH else method.value
         return RenderResult(floor_irradiance=floor_np, transmitted_flux_w_nm=transmitted, method=name,
                             comparison=comparison, **common, **extra)
+
+    def _sky(self, surface, highest: float, watch) -> tuple[np.ndarray, np.ndarray]:
+        """The sky's floor map and transmitted flux: one shaded refraction and deposit per sky
+        direction, each with its share of the sky's irradiance."""
+        cfg = self.scene.config
+        dev = self.device
+        transmitted = 0.0
+        for i, (direction, irradiance) in enumerate(zip(self.sky_directions, self.sky_irradiance_per_dir)):
+            with watch.stage("sky"):
+                visible = sun_visibility(surface, direction, highest, dev, out=self.sky_visible)
+                refracted = refract_to_floor(surface, visible, self.group_ior, direction,
+                                             -cfg.floor.depth_m, dev, out=self.refracted)
+                floor = self.floor.run(surface, refracted, direction, clear=i == 0, irradiance=irradiance)
+                transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+        return floor.numpy().copy(), transmitted
 
     def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:
         """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the

@@ -64,6 +64,27 @@ class Scene:
         d = np.cos(r)[:, None] * s + np.sin(r)[:, None] * around
         return d / np.linalg.norm(d, axis=1, keepdims=True)
 
+    def sky_directions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(K, 3) unit directions towards the sky and (K,) the share of the sky's horizontal
+        irradiance each carries on a plane perpendicular to it, 1/(K cosθ): cosine-weighted
+        stratified samples (sinθ = √((j + ½)/K), turns of the golden angle), so for a uniform sky
+        each direction brings 1/K of the horizontal irradiance."""
+        count = self.config.sky.directions
+        j = np.arange(count) + 0.5
+        sin_t = np.sqrt(j / count)
+        cos_t = np.sqrt(1.0 - sin_t * sin_t)
+        phi = j * math.pi * (3.0 - math.sqrt(5.0))
+        d = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
+        return d, 1.0 / (count * cos_t)
+
+    def sky_irradiance(self, sun_irradiance: np.ndarray) -> np.ndarray:
+        """(K,) the sky's horizontal spectral irradiance [W m⁻² nm⁻¹]: ``sky.diffuse_fraction`` f of
+        the global, the sun's direct beam E_sun sin(elevation) the rest, so E_sky = f/(1 − f) ×
+        that beam (the sky takes the sun's spectral shape: a simplification)."""
+        f = self.config.sky.diffuse_fraction
+        elevation = math.radians(self.config.sun.elevation_deg)
+        return f / (1.0 - f) * np.asarray(sun_irradiance, np.float64) * math.sin(elevation)
+
     @property
     def sun_direction(self) -> np.ndarray:
         """Unit vector towards the sun (z up; azimuth from +x towards +y)."""
