@@ -93,17 +93,21 @@ def test_window_statistics_use_its_texels():
         device="cpu",
     )
     assert r.texel_area_m2 == pytest.approx(1e-4)
-    from warpcaustics.stats import frame_statistics, probe_values
+    from warpcaustics.stats import band_integrated, collector_average, field_statistics, frame_statistics
 
     st = frame_statistics(r, r.scene.config.stats)
-    assert st["irradiance_w_m2"]["mean"] > 0
-    assert probe_values(r, r.scene.config.stats).shape == (1,)
+    total = band_integrated(r.floor_irradiance, r.bin_widths_nm)
+    # the 30 mm collector over 10 mm texels of an open window (not the patch's 0.25 m texels)
+    expected = field_statistics(collector_average(total, 0.01, 0.03, periodic=False), 1.5)
+    assert st["irradiance_w_m2"]["cv"] == pytest.approx(expected["cv"], rel=1e-9)
+    assert expected["cv"] < field_statistics(total, 1.5)["cv"]  # the collector does smooth
 
 
 @pytest.mark.parametrize(
     ("overrides", "needle"),
     [
         ({"caustics.map_extent_m": 20.0}, "exceeds water.extent_m"),
+        ({"caustics.map_extent_m": 10.0}, "more than half"),
         ({"caustics.map_center_m": [1.0, 1.0]}, "caustics.map_extent_m is 0"),
         ({"caustics.map_extent_m": 1.0, "caustics.method": "beams"}, "fluxratio"),
         ({"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.0]}, "caustics.map_center_m"),
@@ -113,8 +117,9 @@ def test_window_statistics_use_its_texels():
 def test_window_errors_are_one_line(overrides, needle):
     """A window larger than the sea, a centre without a window, a window with another method, a
     malformed centre and a probe off the window are refused naming the key."""
-    with pytest.raises(ConfigError, match=needle):
+    with pytest.raises(ConfigError, match=needle) as err:
         wc.load_scene("configs/ocean.toml", overrides)
+    assert "\n" not in str(err.value)
     with pytest.raises(ConfigError, match="reaches past"):
         wc.load_scene(
             "configs/pool.toml", {"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.8, 0.0]}

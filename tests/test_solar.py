@@ -74,3 +74,20 @@ def test_a_toml_date_time_literal_is_taken_too():
     a = wc.load_scene(None, {**place, "sun.datetime": literal}).config.sun
     b = wc.load_scene(None, {**place, "sun.datetime": "2009-07-14T09:00:00+00:00"}).config.sun
     assert (a.elevation_deg, a.azimuth_deg) == (b.elevation_deg, b.azimuth_deg)
+
+
+def test_resolved_config_reads_back_and_overrides_win_either_way(tmp_path):
+    """run.json's resolved config (the place and the angles it gave) reads back unchanged; over a
+    file that gives a place, overridden angles win (a sweep over elevation), and the "Z" suffix
+    means UTC."""
+    from warpcaustics.config import config_from_dict, config_to_dict
+
+    place = {"sun.datetime": "2009-07-14T09:00:00Z", "sun.latitude_deg": 43.7, "sun.longitude_deg": 7.3}
+    cfg = wc.load_scene(None, place).config
+    assert config_from_dict(config_to_dict(cfg)).sun == cfg.sun
+    toml = tmp_path / "placed.toml"
+    toml.write_text('[sun]\ndatetime = "2009-07-14T09:00:00+00:00"\n'
+                    "latitude_deg = 43.7\nlongitude_deg = 7.3\n")
+    assert wc.load_scene(toml).config.sun.elevation_deg == pytest.approx(cfg.sun.elevation_deg)
+    sun = wc.load_scene(toml, {"sun.elevation_deg": 30.0}).config.sun
+    assert sun.elevation_deg == 30.0 and sun.datetime is None

@@ -105,7 +105,7 @@ def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
     code = main(["render", "configs/ocean.toml", "--out", str(out), "--frames", "4", "--fps", "10",
                  "--quiet",
                  "--set", "water.resolution=32", "--set", "caustics.map_resolution=32",
-                 "--set", "stats.wavelength_nm=510", "--set", "stats.collector_mm=300",
+                 "--set", "stats.wavelength_nm=510", "--set", "stats.collector_mm=3000",
                  "--set", "output.npz=true", "--set", "output.netcdf=true"])
     assert code == 0
     run = json.loads((out / "run.json").read_text())
@@ -123,9 +123,13 @@ def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
     assert ds["par"].attrs["units"] == "umol m-2 s-1"
     np.testing.assert_allclose(ds["wavelength"].values, npz["wavelength_nm"])
     assert float(ds["time"].values[0]) == pytest.approx(0.2)
-    # PAR with the collector's mean equals the map's mean (the collector keeps the mean)
-    par_mean = run["frames"][2]["statistics"]["par_umol_m2_s"]["mean"]
-    assert float(ds["par"].mean()) == pytest.approx(par_mean, rel=1e-5)
+    # run.json's PAR statistics are those of the written PAR map after the 3 m collector (6 texels)
+    par = run["frames"][2]["statistics"]["par_umol_m2_s"]
+    averaged = stats.collector_average(ds["par"].values[0], 0.5, 3.0, periodic=True)
+    expected = stats.field_statistics(averaged, 1.5)
+    assert par["mean"] == pytest.approx(expected["mean"], rel=1e-5)
+    assert par["cv"] == pytest.approx(expected["cv"], rel=1e-4)
+    assert par["cv"] < stats.field_statistics(ds["par"].values[0], 1.5)["cv"]
     ds.close()
 
 
@@ -136,3 +140,26 @@ def test_stats_config_errors(monkeypatch):
     monkeypatch.setitem(__import__("sys").modules, "xarray", None)
     with pytest.raises(ConfigError, match="output.netcdf"):
         wc.load_scene("configs/ocean.toml", {"output.netcdf": True})
+
+
+def test_collector_wider_than_the_map_folds_onto_a_periodic_map():
+    """A collector wider than a periodic map wraps around it (each texel's disc overlaps itself):
+    the mean is kept and the field flattens; on an open map the cut disc is renormalised."""
+    rng = np.random.default_rng(3)
+    field = rng.random((40, 40))
+    wide = stats.collector_average(field, 0.01, 0.395, periodic=True)
+    assert wide.mean() == pytest.approx(field.mean(), rel=1e-12)
+    assert wide.std() < 0.1 * field.std()
+    np.testing.assert_allclose(stats.collector_average(np.ones((40, 40)), 0.01, 0.395, periodic=False), 1.0)
+
+
+def test_periodogram_keeps_the_power_for_odd_and_even_lengths():
+    """The one-sided spectrum integrates to the variance of E/Ē − 1 (Parseval, up to the Hann
+    window's leakage) for records of even and odd length."""
+    for t in (200, 201):
+        time = np.arange(t) / 20.0
+        e = 1.0 + 0.5 * np.sin(2 * np.pi * 7.3 * time + 0.4)
+        out = stats.series_statistics(e[:, None], 0.05, 1.5)
+        df = out["frequencies_hz"][1] - out["frequencies_hz"][0]
+        power = np.sum(out["power_spectrum"][0]) * df
+        assert power == pytest.approx(np.var(e / e.mean() - 1.0), rel=0.05)

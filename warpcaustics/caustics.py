@@ -22,9 +22,8 @@ class FloorCaustics:
 
     def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True,
-                 window: tuple[float, tuple[float, float]] | None = None, extent_m: float | None = None):
-        """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch
-        (``extent_m``, which is then needed only to place the window)."""
+                 window: tuple[float, tuple[float, float]] | None = None):
+        """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch."""
         k = len(sun_irradiance)
         m = map_resolution
         self.device = device
@@ -44,15 +43,21 @@ class FloorCaustics:
         self.periodic = periodic
 
     def floor_map(self, extent_m: float) -> floor_kernels.FloorMap:
-        """Where the M×M map lies: the whole patch of side ``extent_m``, or the window."""
+        """Where the M×M map lies: the whole patch of side ``extent_m``, or the window. On a
+        periodic sea a window as wide as the patch wraps (it is the patch, shifted), and a window's
+        centre is reduced to the period nearest the origin (float32 positions stay small)."""
         m = self.texels.shape[0]
         side, centre = (extent_m, (0.0, 0.0)) if self.window is None else self.window
+        centre = np.asarray(centre, np.float64)
+        if self.periodic:
+            centre = centre - extent_m * np.round(centre / extent_m)
         fm = floor_kernels.FloorMap()
-        fm.centre = wp.vec2(*centre)
-        fm.origin = wp.vec2(centre[0] - 0.5 * side, centre[1] - 0.5 * side)
+        fm.centre = wp.vec2(*centre.astype(np.float32))
+        fm.origin = wp.vec2(*(centre - 0.5 * side).astype(np.float32))
         fm.scale = m / side
-        fm.wrap = int(self.periodic and self.window is None)
-        fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS if self.window is None else m * m
+        whole = self.window is None or side >= extent_m
+        fm.wrap = int(self.periodic and whole)
+        fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS if whole else m * m
         return fm
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray, *,

@@ -759,6 +759,10 @@ def _check_map_window(cfg: Config) -> None:
         raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} exceeds water.extent_m = "
                           f"{cfg.water.extent_m:g}; a window is part of the patch")
     x, y = c.map_center_m
+    if cfg.water.periodic and 0.5 * cfg.water.extent_m < c.map_extent_m < cfg.water.extent_m:
+        raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} is more than half the periodic "
+                          f"{cfg.water.extent_m:g} m patch (a footprint could reach it from two periods); "
+                          f"use at most {0.5 * cfg.water.extent_m:g} or the whole {cfg.water.extent_m:g}")
     if not cfg.water.periodic and max(abs(x), abs(y)) + 0.5 * c.map_extent_m > half:
         raise ConfigError(f"the floor-map window (caustics.map_center_m = {list(c.map_center_m)}, "
                           f"caustics.map_extent_m = {c.map_extent_m:g}) reaches past the "
@@ -796,6 +800,12 @@ def _check_stats(cfg: Config) -> None:
         if abs(p.x_m - cx) > half or abs(p.y_m - cy) > half:
             raise ConfigError(f"stats.probes[{i}] = ({p.x_m:g}, {p.y_m:g}) m is off the floor map "
                               f"({side:g} m wide around ({cx:g}, {cy:g}) m); move it onto the map")
+    wl = cfg.stats.wavelength_nm
+    w = cfg.optics.wavelengths
+    lo, hi = (w.list_nm[0], w.list_nm[-1]) if w.list_nm else (w.min_nm, w.max_nm)
+    if wl is not None and not lo <= wl <= hi:
+        raise ConfigError(f"stats.wavelength_nm = {wl:g} is outside the spectral bins ({lo:g}–{hi:g} nm); "
+                          "pick a wavelength inside optics.wavelengths")
     if cfg.stats.collector_mm * 1e-3 > side:
         raise ConfigError(f"stats.collector_mm = {cfg.stats.collector_mm:g} is wider than the "
                           f"{side:g} m floor map; use a smaller collector")
@@ -952,18 +962,23 @@ def _resolve_sun_position(table: dict, overridden: set[str]) -> None:
                           "from a date, a time and a place)")
     explicit = [k for k in ("elevation_deg", "azimuth_deg") if k in sun]
     place_overridden = any(f"sun.{k}" in overridden for k in place)
-    if explicit and place_overridden and not any(f"sun.{k}" in overridden for k in explicit):
+    angles_overridden = any(f"sun.{k}" in overridden for k in explicit)
+    if explicit and place_overridden and not angles_overridden:
         for k in explicit:  # the overrides' place wins over the file's angles
             del sun[k]
         explicit = []
-    if explicit:
-        raise ConfigError(f"sun.{explicit[0]} and sun.datetime both set the sun's position; give one "
-                          "of them")
+    if explicit and angles_overridden and not place_overridden:
+        for k in ("datetime", "latitude_deg", "longitude_deg"):  # and the overrides' angles over its place
+            sun.pop(k, None)
+        return
     from warpcaustics.solar import parse_datetime, sun_position
 
-    for key in ("latitude_deg", "longitude_deg"):
+    for key, limit in (("latitude_deg", 90.0), ("longitude_deg", 180.0)):
         if isinstance(sun[key], bool) or not isinstance(sun[key], (int, float)):
             raise ConfigError(f"sun.{key} = {_describe(sun[key])} has the wrong type; expected a number")
+        if abs(sun[key]) > limit:
+            raise ConfigError(f"sun.{key} = {sun[key]} is out of range; allowed: -{limit:g} <= value <= "
+                              f"{limit:g}")
     if isinstance(sun["datetime"], (datetime.datetime, datetime.date)):
         sun["datetime"] = sun["datetime"].isoformat()  # a TOML date-time literal (quoted or not)
     if not isinstance(sun["datetime"], str):
@@ -975,6 +990,13 @@ def _resolve_sun_position(table: dict, overridden: set[str]) -> None:
         raise ConfigError(f"sun.datetime = {sun['datetime']!r}: the sun is {-elevation:.1f}° below the "
                           f"horizon at latitude {sun['latitude_deg']}°, longitude {sun['longitude_deg']}°; "
                           "pick a daytime")
+    if explicit:
+        # both in one layer: accepted when they agree (a resolved config, e.g. run.json's, read back)
+        given = {"elevation_deg": elevation, "azimuth_deg": azimuth}
+        if any(isinstance(sun[k], bool) or not isinstance(sun[k], (int, float))
+               or abs((float(sun[k]) - given[k] + 180.0) % 360.0 - 180.0) > 1e-6 for k in explicit):
+            raise ConfigError(f"sun.{explicit[0]} and sun.datetime both set the sun's position; give one "
+                              "of them")
     sun["elevation_deg"] = elevation
     sun["azimuth_deg"] = azimuth
 

@@ -39,7 +39,7 @@ class RenderResult:
     """(K,) bin widths [nm]."""
     floor_irradiance: np.ndarray
     """(K, M, M) spectral irradiance on the floor [W m^-2 nm^-1]; row index along +y, texel
-    centres at ``(i + 0.5) L/M - L/2``."""
+    centres at ``(i + 0.5) L/M - L/2`` (with a floor-map window, :meth:`map_coordinates`)."""
     attenuation_per_m: np.ndarray
     """(K,) beam attenuation c(λ) = a + b used [1/m]."""
     ior: np.ndarray
@@ -123,8 +123,10 @@ class RenderResult:
 
     @property
     def map_periodic(self) -> bool:
-        """Whether the floor map tiles (the whole patch of a periodic sea)."""
-        return self.scene.config.water.periodic and not self.scene.config.caustics.map_extent_m
+        """Whether the floor map tiles (the whole patch of a periodic sea, or a window as wide)."""
+        c = self.scene.config
+        side = c.caustics.map_extent_m
+        return c.water.periodic and (not side or side >= c.water.extent_m)
 
     def map_coordinates(self) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) [m] of the texel centres of the floor map (row index along +y)."""
@@ -199,7 +201,9 @@ def scene_bytes(scene: Scene) -> int:
     m = cfg.caustics.map_resolution
     extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4,
              CausticsMethod.WAVE3D: wave3d_bytes(cfg) + k * m * m * 4}
-    return water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + extra.get(cfg.caustics.method, 0)
+    sky = n * n * 4 if cfg.sky.model is not SkyModel.NONE else 0  # its shading buffer
+    return (water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sky
+            + extra.get(cfg.caustics.method, 0))
 
 
 def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
@@ -362,7 +366,8 @@ class Renderer:
                                                  -cfg.floor.depth_m, dev, out=self.refracted)
                 with watch.stage("floor_caustics"):
                     floor = self.floor.run(surface, refracted, direction, clear=i == 0)
-                transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+                    # one host read-back per direction (a device-side sum would spare it on CUDA)
+                    transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()

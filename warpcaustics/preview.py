@@ -65,9 +65,9 @@ def preview_png(result, path: Path, *, width: int = 960, height: int = 640) -> P
         if walls.n_cells:  # translucent, so that the pool's inside shows through them
             plotter.add_mesh(walls, opacity=0.25, **style)
     plotter.add_mesh(surface, color="lightblue", opacity=0.3, smooth_shading=True)
-    plotter.camera_position = [
-        (0.9 * extent, -1.1 * extent, 1.1 * extent),
-        (0.0, 0.0, -0.6 * depth),
+    plotter.camera_position = [  # looking at the floor map (a window's centre, if any)
+        (cx + 0.9 * extent, cy - 1.1 * extent, 1.1 * extent),
+        (cx, cy, -0.6 * depth),
         (0, 0, 1),
     ]
     tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")

@@ -19,7 +19,8 @@ STANDARD_PRESSURE_HPA = 1013.25
 def parse_datetime(text: str) -> datetime:
     """An ISO 8601 date and time with its UTC offset (e.g. ``2009-07-14T11:30:00+02:00``)."""
     try:
-        when = datetime.fromisoformat(text)
+        # Python 3.10's fromisoformat takes no trailing "Z"
+        when = datetime.fromisoformat(text[:-1] + "+00:00" if text.endswith(("Z", "z")) else text)
     except (TypeError, ValueError):
         raise ConfigError(f"sun.datetime = {text!r} is not an ISO 8601 date and time; write e.g. "
                           "\"2009-07-14T11:30:00+02:00\"") from None

@@ -70,16 +70,14 @@ def collector_average(field: np.ndarray, texel_m: float, diameter_m: float, *, p
     kernel = collector_kernel(texel_m, diameter_m)
     m = field.shape[0]
     k = kernel.shape[0]
-    if k > m:
-        raise ValueError(f"a {diameter_m * 1e3:g} mm collector is wider than the {m * texel_m:g} m map")
     half = k // 2
-    padded = np.zeros((m, m))
-    padded[:k, :k] = kernel
-    padded = np.roll(padded, (-half, -half), axis=(0, 1))
-    kf = np.fft.rfft2(padded)
     f = np.asarray(field, np.float64)
     if periodic:
-        return np.fft.irfft2(np.fft.rfft2(f) * kf, s=f.shape)
+        # the disc folded onto the torus (it may be wider than the map), centred on texel (0, 0)
+        folded = np.zeros((m, m))
+        offsets = (np.arange(k) - half) % m
+        np.add.at(folded, (offsets[:, None], offsets[None, :]), kernel)
+        return np.fft.irfft2(np.fft.rfft2(f) * np.fft.rfft2(folded), s=f.shape)
     # zero-pad to avoid wrap-around; divide by the kernel's weight inside the map
     size = m + k
     pk = np.zeros((size, size))
@@ -117,8 +115,11 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     if ``cfg.wavelength_nm`` is set, the band holding it [W m⁻² nm⁻¹], after the collector."""
     fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
     edges = result.bins.edges_nm if result.bins is not None else None
+    covered = None
     if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0]:
         fields["par_umol_m2_s"] = par_map(result.floor_irradiance, edges)
+        # PAR counts only what the bins hold: say so when they cover less than 400-700 nm
+        covered = [max(float(edges[0]), PAR_BAND_NM[0]), min(float(edges[-1]), PAR_BAND_NM[1])]
     band = band_index(result.wavelengths_nm, edges, cfg.wavelength_nm)
     if band is not None:
         fields[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = np.asarray(
@@ -130,6 +131,7 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "collector_mm": cfg.collector_mm,
         "flash_threshold": cfg.flash_threshold,
         "pdf_edges": PDF_EDGES.tolist(),
+        "par_band_nm": covered,
     }
     for name, f in fields.items():
         out[name] = field_statistics(
@@ -185,7 +187,8 @@ def series_statistics(series: np.ndarray, dt_s: float, flash_threshold: float) -
     freqs = np.fft.rfftfreq(t, dt_s)
     window = np.hanning(t)[:, None]
     spectrum = np.abs(np.fft.rfft((e / safe - 1.0) * window, axis=0)) ** 2 / (window**2).sum() * dt_s
-    spectrum[1:-1] *= 2.0  # one-sided
+    # one-sided: every bin but 0 (and Nyquist, which exists for an even length) counts twice
+    spectrum[1 : (t + 1) // 2] *= 2.0
     peak = freqs[1:][np.argmax(spectrum[1:], axis=0)] if t > 2 else np.zeros(e.shape[1])
     return {
         "mean": mean.tolist(),
