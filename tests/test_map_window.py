@@ -124,3 +124,20 @@ def test_window_errors_are_one_line(overrides, needle):
         wc.load_scene(
             "configs/pool.toml", {"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.8, 0.0]}
         )
+
+
+def test_a_window_as_wide_as_the_patch_wraps_and_keeps_the_flux():
+    """On a periodic sea a window the size of the patch is the patch, shifted: it wraps, keeps
+    every watt (floor = transmitted, water_type none), and equals the whole map rolled."""
+    base = {**BASE, "caustics.map_resolution": 64, "optics.water_type": "none"}
+    full = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
+    shifted = wc.render(
+        wc.load_scene(
+            "configs/ocean.toml", {**base, "caustics.map_extent_m": 16.0, "caustics.map_center_m": [3.0, 0.0]}
+        ),
+        device="cpu",
+    )
+    np.testing.assert_allclose(shifted.floor_flux_w_nm, shifted.transmitted_flux_w_nm, rtol=1e-5)
+    rolled = np.roll(full.floor_irradiance, -12, axis=2)  # 3 m = 12 texels of 0.25 m
+    np.testing.assert_allclose(shifted.floor_irradiance, rolled, atol=1e-4 * rolled.max())
+    assert shifted.map_periodic
