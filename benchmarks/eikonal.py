@@ -29,7 +29,9 @@ MERCIER_TABLE1_S = {64: (0.3, 17.0), 128: (2.5, 21.0), 256: (26.0, 107.0)}
 def measure(n: int, device: str, repeats: int) -> dict:
     import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
-    from warpcaustics.refraction import height_range, refract_to_floor, sun_visibility
+    from warpcaustics.refraction import height_range
+
+    from benchmarks.sunmap import flux_ratio_pass
 
     scene = wc.load_scene("configs/mercier_pool.toml", {
         "caustics.eikonal_resolution": n, "water.resolution": n, "caustics.map_resolution": 2 * n})
@@ -39,15 +41,7 @@ def measure(n: int, device: str, repeats: int) -> dict:
     _, highest = height_range(surface, device)
     eik = renderer.approximate
     eikonal_s = median_time(lambda: eik.run(surface, highest), repeats, device)
-    visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
-    depth = scene.config.floor.depth_m
-
-    def flux_ratio():
-        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction, -depth,
-                                     device, out=renderer.refracted)
-        renderer.floor.run(surface, refracted, scene.sun_direction)
-
-    fluxratio_s = median_time(flux_ratio, repeats, device)
+    fluxratio_s = median_time(flux_ratio_pass(renderer, surface, highest), repeats, device)
     nodes = n * n * eik.stats.layers
     published = MERCIER_TABLE1_S.get(n, (None, None))
     wave = _wave(n, device)

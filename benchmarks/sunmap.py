@@ -22,21 +22,12 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     """Times of the two floor maps of one frame (the water surface is computed once, outside)."""
     import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
-    from warpcaustics.refraction import refract_to_floor, sun_visibility
-
     scene = wc.load_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
                                    "caustics.map_resolution": m})
     renderer = Renderer(scene, device)
     result = renderer.render(0.5)  # warm-up: JIT compile, first launches
     surface = renderer.water.at(0.5)
-    highest = float(surface.positions.numpy()[..., 2].max())
-    visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
-    depth = scene.config.floor.depth_m
-
-    def flux_ratio():
-        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction, -depth,
-                                     device, out=renderer.refracted)
-        renderer.floor.run(surface, refracted, scene.sun_direction)
+    flux_ratio = flux_ratio_pass(renderer, surface, float(surface.positions.numpy()[..., 2].max()))
 
     def sun_map():
         renderer.approximate.run(surface, renderer.water, 0.5)
@@ -53,6 +44,23 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
             "correlation_sunmap_vs_fluxratio": map_correlation(result.floor_irradiance,
                                                                result.comparison.floor_irradiance,
                                                                result.bin_widths_nm)}
+
+
+def flux_ratio_pass(renderer, surface, highest_m: float):
+    """A function that draws the flux-ratio map of ``surface`` with the renderer's buffers (the
+    baseline the approximate methods are timed against)."""
+    from warpcaustics.refraction import refract_to_floor, sun_visibility
+
+    scene = renderer.scene
+    device = renderer.device
+    visible = sun_visibility(surface, scene.sun_direction, highest_m, device, out=renderer.visible)
+
+    def flux_ratio():
+        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction,
+                                     -scene.config.floor.depth_m, device, out=renderer.refracted)
+        renderer.floor.run(surface, refracted, scene.sun_direction)
+
+    return flux_ratio
 
 
 def run(quick: bool, device: str) -> dict:

@@ -81,22 +81,34 @@ def lateral(grid: EikonalGrid, psi: wp.array3d[wp.float32], k: int, j: int, i: i
     """φ − φ0(p) at the lateral node ``offset`` steps from (k, j, i) along ``axis`` (0: x, 1: y):
     ψ there plus G·(node − p). Outside a non-periodic grid the node mirrors ψ across the face
     (half a spacing beyond the outermost nodes)."""
+    m, _outside = lateral_index(grid, j, i, axis, offset)
+    value = psi[k, j, m]
+    if axis == 1:
+        value = psi[k, m, i]
+    return value + grid.gradient[axis] * grid.h * float(offset)
+
+
+@wp.func
+def lateral_index(grid: EikonalGrid, j: int, i: int, axis: int, offset: int):
+    """Index along ``axis`` of the node ``offset`` steps from column (j, i): wrapped on a periodic
+    grid; beyond a face, its mirror image across the face (half a spacing past the outermost
+    nodes), with ``outside`` = 1."""
     n = grid.n
     c = i
     if axis == 1:
         c = j
     m = c + offset
+    outside = int(0)
     if grid.periodic != 0:
         m = ((m % n) + n) % n
     else:
         if m < 0:
             m = -m - 1
+            outside = 1
         if m >= n:
             m = 2 * n - 1 - m
-    value = psi[k, j, m]
-    if axis == 1:
-        value = psi[k, m, i]
-    return value + grid.gradient[axis] * grid.h * float(offset)
+            outside = 1
+    return m, outside
 
 
 @wp.func

@@ -13,7 +13,7 @@ the wave can have reached are stepped: the stencil's domain of dependence grows 
 
 import warp as wp
 
-from warpcaustics.kernels.eikonal import EikonalGrid, beyond_patch, floor_sample, layer_z
+from warpcaustics.kernels.eikonal import EikonalGrid, beyond_patch, floor_sample, lateral_index, layer_z
 from warpcaustics.kernels.geometry import cell_centre, grid_bilinear
 
 wp.set_module_options({"enable_backward": False})
@@ -100,21 +100,15 @@ def value_at(
     """u at a lateral neighbour: wrapped on a periodic grid; beyond a face of a non-periodic one,
     still water's plane wave at that node (the face lets it through unchanged, as the eikonal
     method continues the front)."""
-    n = grid.n
-    c = i
-    if axis == 1:
-        c = j
-    m = c + offset
-    if grid.periodic != 0:
-        m = ((m % n) + n) % n
-    elif m < 0 or m >= n:
+    m, outside = lateral_index(grid, j, i, axis, offset)
+    if outside != 0:
         ii = i
         jj = j
         if axis == 0:
-            ii = m
+            ii = i + offset
         else:
-            jj = m
-        xy = cell_centre(ii, jj, n, grid.extent_m)
+            jj = j + offset
+        xy = cell_centre(ii, jj, grid.n, grid.extent_m)
         p = wp.vec3(xy[0], xy[1], layer_z(grid, k))
         late = wp.clamp((time - wp.max(-p[2], 0.0) / params.group_vz) / params.ramp_time, 0.0, 1.0)
         rise = 0.5 * (1.0 - wp.cos(wp.pi * late))
