@@ -195,6 +195,9 @@ def main(argv: list[str] | None = None) -> int:
     # The sun's disk against a point sun (benchmarks/sun_disk.py).
     sun_disk = _in_child("run", args.quick, args.device, module="sun_disk")
 
+    # The multiple-scattering random walk's photon rate (benchmarks/multiple.py).
+    multiple = _in_child("run", args.quick, args.device, module="multiple")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -218,6 +221,7 @@ def main(argv: list[str] | None = None) -> int:
         "sunmap": sunmap,
         "eikonal": eikonal,
         "sun_disk": sun_disk,
+        "multiple": multiple,
         "sweep": sweeps,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)

@@ -71,6 +71,11 @@ class SunSpectrum(str, enum.Enum):
     FILE = "file"
 
 
+class Scattering(str, enum.Enum):
+    SINGLE = "single"
+    MULTIPLE = "multiple"
+
+
 class SkyModel(str, enum.Enum):
     NONE = "none"
     UNIFORM = "uniform"
@@ -354,6 +359,17 @@ class OpticsConfig:
     """Petzold (1972) station of the ``petzold`` phase function (and of the default g)."""
     dispersion: bool = False
     """Use n(λ) of seawater from Quan & Fry (1995) at each bin centre instead of ``ior``."""
+    scattering: Scattering = Scattering.SINGLE
+    """``single``: light scattered out of the direct beam is lost (c = a + b attenuates it);
+    ``multiple``: a Monte Carlo random walk carries it on (a reference mode: ``fluxratio`` on a
+    periodic sea; the single-scattering map is kept beside it)."""
+    mc_samples: int = field(default=4, metadata=_range(1, 64))
+    """Photons per surface cell side of the ``multiple`` random walk (s² per cell and band) [-]."""
+    mc_max_events: int = field(default=64, metadata=_range(1, 10000))
+    """Scattering events after which a ``multiple`` photon is stopped (its weight counted as
+    truncated) [-]."""
+    mc_seed: int = field(default=0, metadata=_range(0, 2**31 - 1))
+    """Seed of the ``multiple`` random walk."""
     salinity_psu: float = field(default=35.0, metadata=_range(0.0, 45.0))
     """Salinity for n(λ) (Quan & Fry 1995; fitted for 0–35 ‰) [PSU ≈ ‰]."""
     temperature_c: float = field(default=20.0, metadata=_range(-2.0, 35.0))
@@ -785,6 +801,23 @@ def _check_sky(cfg: Config) -> None:
                           "sky.diffuse_fraction (e.g. 0.15) or sky.model = \"none\"")
 
 
+def _check_scattering(cfg: Config) -> None:
+    if cfg.optics.scattering is not Scattering.MULTIPLE:
+        return
+    needs = []
+    if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
+        needs.append(f"caustics.method = \"fluxratio\" (not {cfg.caustics.method.value!r})")
+    if not cfg.water.periodic:
+        needs.append(f"a periodic sea (not water.model = {cfg.water.model.value!r})")
+    if cfg.sun.angular_diameter_deg or cfg.sky.model is not SkyModel.NONE or cfg.caustics.map_extent_m:
+        needs.append("no sun disk, sky or floor-map window")
+    if cfg.optics.dispersion:
+        needs.append("optics.dispersion = false")
+    if needs:
+        raise ConfigError("optics.scattering = \"multiple\" (a reference random walk) needs "
+                          + "; ".join(needs))
+
+
 def _check_sun_disk(cfg: Config) -> None:
     if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method is not CausticsMethod.FLUXRATIO:
         raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g} (a sun disk) is "
@@ -860,6 +893,7 @@ def _check_photon_scene(cfg: Config) -> None:
     _check_map_window(cfg)
     _check_sun_disk(cfg)
     _check_sky(cfg)
+    _check_scattering(cfg)
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []

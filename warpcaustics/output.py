@@ -334,6 +334,8 @@ def frame_entry(frame: int, r) -> dict:
         **({"beams": r.beam_stats} if r.beam_stats is not None else {}),
         **({"eikonal": r.eikonal_stats} if r.eikonal_stats is not None else {}),
         **({"wave3d": r.wave3d_stats} if r.wave3d_stats is not None else {}),
+        **({"multiple_scattering": r.multiple_scattering_stats} if r.multiple_scattering_stats is not None
+           else {}),
         **({"comparison": comparison_entry(frame, r)} if r.comparison is not None else {}),
         "statistics": frame_statistics_entry(r),
     }

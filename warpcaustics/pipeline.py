@@ -14,9 +14,10 @@ import warp as wp
 from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
-from warpcaustics.config import CausticsMethod, SkyModel
+from warpcaustics.config import CausticsMethod, Scattering, SkyModel
 from warpcaustics.eikonal import EikonalCaustics, eikonal_bytes
 from warpcaustics.errors import WarpcausticsError
+from warpcaustics.multiple import MultipleScattering
 from warpcaustics.phase import PhaseFunction
 from warpcaustics.receivers import WALL_FACES, Receivers
 from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
@@ -90,6 +91,9 @@ class RenderResult:
     """``eikonal``: layers of the grid and Jacobi passes of the relaxation."""
     wave3d_stats: dict[str, int] | None = None
     """``wave3d``: layers of the grid, steps, averaged steps and node updates."""
+    multiple_scattering_stats: dict | None = None
+    """``optics.scattering = "multiple"``: photons walked and, per band, where their flux went
+    (transmitted, floor, escaped, absorbed, unscattered, truncated) [W nm⁻¹]."""
     sky_floor_irradiance: np.ndarray | None = None
     """With a sky (``sky.model``): (K, M, M) the sky's part of :attr:`floor_irradiance`
     [W m⁻² nm⁻¹]; the direct sun's is the rest."""
@@ -265,6 +269,7 @@ class Renderer:
             self.beams = None
             self.approximate = None
             self.sky_directions = None
+            self.multiple = None
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
@@ -294,6 +299,10 @@ class Renderer:
                 self.refracted = Refracted.allocate(len(self.group_ior), n, self.device)
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
+                if cfg.optics.scattering is Scattering.MULTIPLE:
+                    self.multiple = MultipleScattering(cfg, scene.sun_direction, float(self.group_ior[0]),
+                                                       self.sun_irradiance, optics.absorption_per_m,
+                                                       optics.scattering_per_m, self.device)
                 if cfg.sky.model is not SkyModel.NONE:
                     self.sky_directions, shares = scene.sky_directions()
                     sky = scene.sky_irradiance(self.sun_irradiance)
@@ -371,6 +380,12 @@ class Renderer:
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
+            if self.multiple is not None:
+                single_floor, single_transmitted = floor_np, transmitted
+                with watch.stage("multiple_scattering"):
+                    floor_np, walk = self.multiple.run(surface, visible)
+                extra = {"multiple_scattering_stats": walk}
+                transmitted = np.asarray(walk["transmitted"])
             if self.sky_directions is not None:
                 sky_np, sky_transmitted = self._sky(surface, highest, watch)
                 extra["sky_floor_irradiance"] = sky_np
@@ -400,6 +415,10 @@ class Renderer:
             comparison = RenderResult(floor_irradiance=flux_ratio_floor, transmitted_flux_w_nm=transmitted,
                                       method="fluxratio", **common)
         name = "beams" if method is CausticsMethod.BOTH else method.value
+        if self.multiple is not None:  # the single-scattering map beside the random walk's
+            comparison = RenderResult(floor_irradiance=single_floor, transmitted_flux_w_nm=single_transmitted,
+                                      method="single", **common)
+            name = "multiple"
         return RenderResult(floor_irradiance=floor_np, transmitted_flux_w_nm=transmitted, method=name,
                             comparison=comparison, **common, **extra)
 

@@ -1,0 +1,86 @@
+"""Multiple-scattering random walk: photons per second, and the flux-ratio map of the same frame.
+
+``configs/ocean.toml`` in coastal water, 3 m deep, rgb bands: the walk's wall time (median after a
+warm-up frame, device synchronised) and its photon rate, beside the single-scattering flux-ratio
+map's time on the same surface. ``python -m benchmarks.multiple --help``.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from benchmarks.run import median_time
+
+FULL = [(128, 4), (256, 4)]
+QUICK = [(64, 4)]
+
+
+def measure(n: int, samples: int, device: str, repeats: int) -> dict:
+    import warpcaustics as wc
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.refraction import height_range
+
+    from benchmarks.sunmap import flux_ratio_pass
+
+    scene = wc.load_scene(
+        "configs/ocean.toml",
+        {
+            "water.resolution": n,
+            "caustics.map_resolution": 2 * n,
+            "optics.wavelengths": "rgb",
+            "optics.water_type": "coastal_ocean",
+            "floor.depth_m": 3.0,
+            "optics.scattering": "multiple",
+            "optics.mc_samples": samples,
+        },
+    )
+    renderer = Renderer(scene, device)
+    result = renderer.render(0.0)  # warm-up
+    surface = renderer.water.at(0.0)
+    _, highest = height_range(surface, device)
+    walk_s = median_time(lambda: renderer.multiple.run(surface, renderer.visible), repeats, device)
+    flux_ratio_s = median_time(flux_ratio_pass(renderer, surface, highest), repeats, device)
+    photons = result.multiple_scattering_stats["photons"]
+    return {
+        "water_n": n,
+        "samples_per_cell_side": samples,
+        "photons": photons,
+        "walk_s": walk_s,
+        "photons_per_s": photons / walk_s,
+        "fluxratio_s": flux_ratio_s,
+        "walk_over_fluxratio": walk_s / flux_ratio_s,
+    }
+
+
+def run(quick: bool, device: str) -> dict:
+    import warp as wp
+
+    repeats = 2 if quick else 3
+    rows = []
+    for n, s in QUICK if quick else FULL:
+        row = measure(n, s, device, repeats)
+        rows.append(row)
+        print(
+            f"multiple     ocean N={n:4d} s={s} | {row['photons'] / 1e6:6.2f} M photons in "
+            f"{row['walk_s']:7.3f} s = {row['photons_per_s'] / 1e6:6.2f} M photons/s | flux ratio "
+            f"{row['fluxratio_s'] * 1e3:7.1f} ms",
+            flush=True,
+        )
+    return {
+        "benchmark": "multiple_scattering_walk",
+        "device": device,
+        "device_name": str(wp.get_device(device).name),
+        "warp_version": wp.__version__,
+        "repeats": repeats,
+        "results": rows,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "multiple", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

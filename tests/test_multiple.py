@@ -1,0 +1,113 @@
+"""Multiple scattering (optics.scattering = "multiple"): a random walk that accounts for every watt."""
+
+import math
+
+import numpy as np
+import pytest
+
+import warpcaustics as wc
+from warpcaustics.errors import ConfigError
+from warpcaustics.multiple import MultipleScattering
+
+BASE = {
+    "water.model": "flat",
+    "water.extent_m": 4.0,
+    "water.resolution": 32,
+    "caustics.map_resolution": 32,
+    "optics.wavelengths": "rgb",
+    "floor.depth_m": 3.0,
+    "optics.water_type": "turbid_harbor",
+    "optics.scattering": "multiple",
+    "optics.mc_samples": 8,
+}
+
+
+def test_walk_without_absorption_conserves_energy():
+    """Scattering but no absorption (b = 0.5, 1, 2 /m): every watt that enters the water reaches the
+    floor, escapes upwards or is stopped after mc_max_events — the tallies close to float32 rounding
+    of the weights (1e-6), nothing is absorbed, and the floor map holds the floor tally."""
+    scene = wc.load_scene(None, BASE)
+    renderer = wc.Renderer(scene, device="cpu")
+    surface = renderer.water.at(0.0)
+    visible = renderer.visible
+    visible.fill_(1.0)
+    walk = MultipleScattering(
+        scene.config,
+        scene.sun_direction,
+        1.333,
+        renderer.sun_irradiance,
+        np.zeros(3),
+        np.array([0.5, 1.0, 2.0]),
+        "cpu",
+    )
+    floor, st = walk.run(surface, visible)
+    t = np.array(st["transmitted"])
+    assert np.all(np.array(st["absorbed"]) == 0.0)
+    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["truncated"])) / t
+    np.testing.assert_allclose(closing, 1.0, atol=1e-6)
+    np.testing.assert_allclose(floor.sum(axis=(1, 2)) * walk.texel_area_m2, st["floor"], rtol=1e-5)
+    assert np.all(np.array(st["escaped"]) > 0.0)  # some light is scattered back up
+
+
+def test_unscattered_part_follows_beer_lambert():
+    """The photons that reach the floor without scattering carry e^{−cD/cosθt} of the transmitted
+    flux, within 4σ of the binomial noise of 3·32²·64 equal-weight photons; the random walk's
+    tallies close (1e-6)."""
+    r = wc.render(wc.load_scene(None, BASE), device="cpu")
+    st = r.multiple_scattering_stats
+    t = np.array(st["transmitted"])
+    fraction = np.array(st["unscattered"]) / t
+    theta_t = math.asin(math.sin(math.radians(30.0)) / 1.333)
+    expected = np.exp(-r.attenuation_per_m * 3.0 / math.cos(theta_t))
+    photons = st["photons"] / 3
+    sigma = np.sqrt(expected * (1 - expected) / photons)
+    assert np.all(np.abs(fraction - expected) < 4 * sigma)
+    closing = (
+        np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"]) + np.array(st["truncated"])
+    ) / t
+    np.testing.assert_allclose(closing, 1.0, atol=1e-6)
+
+
+def contrast_without_noise(scene_overrides: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(CV single, CV multiple, mean multiple / mean single) per band: the random walk run with two
+    seeds, its photon noise (the variance of their difference / 2) taken out of the variance of
+    their mean."""
+    maps = []
+    for seed in (1, 2):
+        r = wc.render(
+            wc.load_scene("configs/ocean.toml", {**scene_overrides, "optics.mc_seed": seed}), device="cpu"
+        )
+        maps.append(r.floor_irradiance.astype(np.float64))
+    single = r.comparison.floor_irradiance.astype(np.float64)
+    mean = 0.5 * (maps[0] + maps[1])
+    noise = 0.5 * (maps[0] - maps[1]).var(axis=(1, 2))  # per map; the mean's is half of it
+    cv_multi = np.sqrt(np.maximum(mean.var(axis=(1, 2)) - 0.5 * noise, 0.0)) / mean.mean(axis=(1, 2))
+    cv_single = single.std(axis=(1, 2)) / single.mean(axis=(1, 2))
+    return cv_single, cv_multi, mean.mean(axis=(1, 2)) / single.mean(axis=(1, 2))
+
+
+def test_multiple_scattering_brightens_and_smooths_the_floor():
+    """Over an ocean in coastal water at 3 m, light scattered out of the beam still reaches the
+    floor: more irradiance than single scattering, and less caustic contrast once the walk's own
+    photon noise is taken out (two seeds)."""
+    cv_single, cv_multi, gain = contrast_without_noise(
+        {
+            "water.resolution": 64,
+            "caustics.map_resolution": 32,
+            "optics.wavelengths": "rgb",
+            "optics.water_type": "coastal_ocean",
+            "floor.depth_m": 3.0,
+            "optics.scattering": "multiple",
+            "optics.mc_samples": 4,
+        }
+    )
+    assert np.all(gain > 1.0)
+    assert np.all(cv_multi < cv_single)
+
+
+def test_multiple_scattering_errors_are_one_line():
+    """The random walk runs on flux-ratio scenes of a periodic sea only: anything else says so."""
+    with pytest.raises(ConfigError, match="optics.scattering"):
+        wc.load_scene(None, {**BASE, "caustics.method": "beams"})
+    with pytest.raises(ConfigError, match="periodic sea"):
+        wc.load_scene("configs/pool.toml", {"optics.scattering": "multiple"})
