@@ -93,13 +93,14 @@ def all_lit(surface: Surface, device: str) -> wp.array2d:
     return wp.full((n, n), 1.0, dtype=wp.float32, device=device)
 
 
-class EikonalCaustics:
-    """Owns the 3-D grid (ψ, Laplacian, intensity, path, horizontal irradiance) of a scene."""
+class GridCaustics:
+    """What the eikonal and wave methods share: their N×N columns over the patch, the sun and the
+    water, the floor map they fill and the frozen layers' depth per column."""
 
-    def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
+    def __init__(self, cfg: Config, n: int, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
         self.device = device
-        self.n = cfg.caustics.eikonal_resolution
+        self.n = n
         self.extent_m = float(cfg.water.extent_m)
         self.h = self.extent_m / self.n
         self.floor_z = -float(cfg.floor.depth_m)
@@ -108,19 +109,27 @@ class EikonalCaustics:
         s = np.asarray(sun_dir, np.float64)
         self.sun_dir = s / np.linalg.norm(s)
         self.ior = float(ior)
-        self.gradient = self.ior * still_water_refraction(self.sun_dir, self.ior)
         self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32,
                                        device=device)
         self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
                                           device=device)
-        k = len(sun_irradiance)
         m = self.map_resolution
-        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        self.irradiance = wp.empty((len(sun_irradiance), m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
         self.top = wp.empty((self.n, self.n), dtype=wp.int32, device=device)
+        self.layers = 0
+
+
+class EikonalCaustics(GridCaustics):
+    """Owns the 3-D grid (ψ, Laplacian, intensity, path, horizontal irradiance) of a scene."""
+
+    def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+        super().__init__(cfg, cfg.caustics.eikonal_resolution, sun_dir, ior, sun_irradiance,
+                         attenuation_per_m, device, periodic=periodic)
+        self.gradient = self.ior * still_water_refraction(self.sun_dir, self.ior)
         self.scratch = wp.empty((self.n, self.n), dtype=wp.float32, device=device)
         self.changed = wp.zeros(1, dtype=wp.int32, device=device)
-        self.layers = 0
         self.stats = EikonalStats()
 
     def _grid(self, highest_m: float) -> eikonal_kernels.EikonalGrid:

@@ -310,7 +310,8 @@ class Renderer:
                         wp.array((sky * w).astype(np.float32), dtype=wp.float32, device=self.device)
                         for w in shares]
                     self.sky_visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
-                disk_share = self.sun_irradiance / len(scene.sun_disk_directions())
+                self.sun_directions = scene.sun_disk_directions()  # the centre alone for a point sun
+                disk_share = self.sun_irradiance / len(self.sun_directions)
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
                                                     self.attenuation_per_m, self.device,
                                                     periodic=self.water.periodic, window=window)
@@ -369,14 +370,10 @@ class Renderer:
             # share of the flux (sun_irradiance was divided by their number); crests shade by the
             # disk's centre.
             transmitted = 0.0
-            for i, direction in enumerate(self.scene.sun_disk_directions()):
-                with watch.stage("refraction"):
-                    refracted = refract_to_floor(surface, visible, self.group_ior, direction,
-                                                 -cfg.floor.depth_m, dev, out=self.refracted)
-                with watch.stage("floor_caustics"):
-                    floor = self.floor.run(surface, refracted, direction, clear=i == 0)
-                    # one host read-back per direction (a device-side sum would spare it on CUDA)
-                    transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+            for i, direction in enumerate(self.sun_directions):
+                floor, flux = self._deposit(surface, visible, direction, watch,
+                                            ("refraction", "floor_caustics"), clear=i == 0)
+                transmitted = transmitted + flux
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
@@ -425,17 +422,28 @@ class Renderer:
     def _sky(self, surface, highest: float, watch) -> tuple[np.ndarray, np.ndarray]:
         """The sky's floor map and transmitted flux: one shaded refraction and deposit per sky
         direction, each with its share of the sky's irradiance."""
-        cfg = self.scene.config
-        dev = self.device
         transmitted = 0.0
         for i, (direction, irradiance) in enumerate(zip(self.sky_directions, self.sky_irradiance_per_dir)):
             with watch.stage("sky"):
-                visible = sun_visibility(surface, direction, highest, dev, out=self.sky_visible)
-                refracted = refract_to_floor(surface, visible, self.group_ior, direction,
-                                             -cfg.floor.depth_m, dev, out=self.refracted)
-                floor = self.floor.run(surface, refracted, direction, clear=i == 0, irradiance=irradiance)
-                transmitted = transmitted + self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+                visible = sun_visibility(surface, direction, highest, self.device, out=self.sky_visible)
+            floor, flux = self._deposit(surface, visible, direction, watch, ("sky", "sky"), clear=i == 0,
+                                        irradiance=irradiance)
+            transmitted = transmitted + flux
         return floor.numpy().copy(), transmitted
+
+    def _deposit(self, surface, visible, direction, watch, stages: tuple[str, str], *, clear: bool,
+                 irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:
+        """One flux-ratio pass for light arriving from ``direction`` (the sun's centre, a point of
+        its disk or of the sky): refraction, then the deposit added to the map unless ``clear``;
+        returns the map and the pass's transmitted flux per band (one host read-back; a device-side
+        sum would spare it on CUDA)."""
+        with watch.stage(stages[0]):
+            refracted = refract_to_floor(surface, visible, self.group_ior, direction,
+                                         -self.scene.config.floor.depth_m, self.device, out=self.refracted)
+        with watch.stage(stages[1]):
+            floor = self.floor.run(surface, refracted, direction, clear=clear, irradiance=irradiance)
+            flux = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
+        return floor, flux
 
     def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:
         """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the

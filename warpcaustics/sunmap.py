@@ -75,11 +75,9 @@ class SunMapCaustics:
 
 def still_water_refraction(sun_dir: np.ndarray, ior: float) -> np.ndarray:
     """Unit direction of the sun's light refracted into still water (float64, pointing down)."""
-    s = np.asarray(sun_dir, np.float64)
-    eta = 1.0 / ior
-    cos_i = s[2]
-    k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
-    t = -eta * s + (eta * cos_i - math.sqrt(k)) * np.array([0.0, 0.0, 1.0])
+    from warpcaustics.reference import refract
+
+    t = refract(-np.asarray(sun_dir, np.float64), np.array([0.0, 0.0, 1.0]), 1.0 / ior)
     return t / np.linalg.norm(t)
 
 

@@ -189,7 +189,7 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
     """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
     if task.stateful:
         return run_pool_task(base, task, out_dir, device)
-    from warpcaustics.output import save_frame, write_run_json
+    from warpcaustics.output import frame_entry, save_frame, write_run_json
     from warpcaustics.pipeline import Renderer
     from warpcaustics.scene import load_scene
 
@@ -204,14 +204,15 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
             result = renderer.render(t)
             save_frame(result, tmp, frame=task.frame_start + k)
             results.append(result)
-        write_run_json(tmp, results)
+        entries = [frame_entry(k, r) for k, r in enumerate(results)]  # as write_run_json numbers them
+        write_run_json(tmp, results, frames=entries)
         if final.exists():
             shutil.rmtree(final)
         os.replace(tmp, final)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return {
-        "rows": [summary_row(task, r, k) for k, r in enumerate(results)],
+        "rows": [summary_row(task, r, k, entries[k]["statistics"]) for k, r in enumerate(results)],
         "seconds": time.perf_counter() - t0,
         "device": results[0].device,
     }
@@ -254,7 +255,7 @@ def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> di
         result = renderer.render(task.times_s[k])
         save_frame(result, partial, frame=task.frame_start + k)
         entries.append(frame_entry(task.frame_start + k, result))
-        rows.append(summary_row(task, result, k))
+        rows.append(summary_row(task, result, k, entries[-1]["statistics"]))
         with atomic_path(partial / CHECKPOINT) as tmp, open(tmp, "wb") as fh:
             np.savez(fh, frames_done=len(entries), **renderer.water.state())
         write_json(meta_path, {"frames_done": len(entries), "entries": entries, "rows": rows})
@@ -269,9 +270,10 @@ def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> di
     return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
 
 
-def summary_row(task: Task, result, k: int) -> dict:
+def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> dict:
     """Summary statistics of one frame: per band mean and max floor irradiance, caustic contrast
-    (standard deviation / mean of the band-summed floor irradiance), photon counts, timings."""
+    (standard deviation / mean of the band-summed floor irradiance), photon counts, timings.
+    ``statistics``: the frame's run.json statistics, when already computed."""
     import numpy as np
 
     from warpcaustics.output import relative_l1
@@ -285,9 +287,10 @@ def summary_row(task: Task, result, k: int) -> dict:
         row[f"max_{wl:g}nm"] = float(band.max())
     row["floor_w_m2"] = float(total.mean())
     row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
-    from warpcaustics.stats import frame_statistics
+    if statistics is None:
+        from warpcaustics.stats import frame_statistics
 
-    statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
+        statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
     row["cv"] = statistics["irradiance_w_m2"]["cv"]
     row["flash_fraction"] = statistics["irradiance_w_m2"]["flash_fraction"]
     if "par_umol_m2_s" in statistics:

@@ -15,9 +15,10 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.config import Config
-from warpcaustics.eikonal import all_lit, make_grid
+from warpcaustics.eikonal import GridCaustics, all_lit, make_grid
 from warpcaustics.kernels import eikonal as eikonal_kernels
 from warpcaustics.kernels import wave3d as wave_kernels
+from warpcaustics.reference import fresnel_transmittance
 from warpcaustics.water import Surface
 
 COURANT = 0.5
@@ -52,35 +53,19 @@ class WaveStats:
     """Node-steps actually computed (only the layers the wave can have reached)."""
 
 
-class Wave3DCaustics:
+class Wave3DCaustics(GridCaustics):
     """Owns the wave grid (frozen front, u at three times, ⟨u²⟩) of a scene."""
 
     def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
         c = cfg.caustics
-        self.device = device
-        self.n = c.wave3d_resolution
-        self.extent_m = float(cfg.water.extent_m)
-        self.h = self.extent_m / self.n
-        self.floor_z = -float(cfg.floor.depth_m)
-        self.periodic = periodic
-        s = np.asarray(sun_dir, np.float64)
-        self.sun_dir = s / np.linalg.norm(s)
-        self.ior = float(ior)
+        super().__init__(cfg, c.wave3d_resolution, sun_dir, ior, sun_irradiance, attenuation_per_m, device,
+                         periodic=periodic)
         self.cells_per_wavelength = float(c.wave3d_cells_per_wavelength)
         self.periods = float(c.wave3d_periods)
         self.gain = float(c.wave3d_gain)
         self.exponent = float(c.wave3d_exponent)
-        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32,
-                                       device=device)
-        self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
-                                          device=device)
-        m = c.map_resolution
-        self.irradiance = wp.empty((len(sun_irradiance), m, m), dtype=wp.float32, device=device)
-        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
-        self.top = wp.empty((self.n, self.n), dtype=wp.int32, device=device)
         self.eta = wp.empty((self.n, self.n), dtype=wp.float32, device=device)
-        self.layers = 0
         self.stats = WaveStats()
 
     def _allocate(self, layers: int) -> None:
@@ -116,14 +101,9 @@ class Wave3DCaustics:
         p.group_vz = self.group_vz
         p.ramp_time = RAMP_PERIODS * 2.0 * math.pi / p.omega
         p.band = BAND
-        s = self.sun_dir
-        cos_i = float(s[2])
-        eta = 1.0 / self.ior
-        cos_t = math.sqrt(max(1.0 - eta * eta * (1.0 - cos_i * cos_i), 0.0))
-        rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-        rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
-        transmitted = 1.0 - 0.5 * (rs * rs + rp * rp)  # exact Fresnel, as kernels/geometry.py
-        p.amplitude_flat = math.sqrt(transmitted * cos_i / cos_t)
+        cos_i = float(self.sun_dir[2])
+        cos_t = abs(float(g[2])) / self.ior  # still water's refracted direction, G = n_w t0
+        p.amplitude_flat = math.sqrt(float(fresnel_transmittance(cos_i, 1.0 / self.ior)) * cos_i / cos_t)
         # the quadratic ramp that reflected least of a plane wave at 90°, 40° and 15° suns (measured)
         p.sigma_max = 10.0 / (BAND * p.dt)
         return p
