@@ -130,3 +130,15 @@ def test_eikonal_config_errors():
         _flat(60.0, **{"caustics.eikonal_resolution": 4})
     with pytest.raises(wc.errors.ConfigError, match="floor.shape"):
         _flat(60.0, **{"floor.shape": "ripples", "floor.ripple_wavelength_m": 0.5})
+
+
+@pytest.mark.parametrize("depth_m", [1.0, 4.0])
+def test_transport_keeps_the_flux_of_the_flux_ratio_map(depth_m):
+    """Carrying the Laplacian along the rays keeps the light: over the rough ocean (no absorption)
+    the eikonal floor receives the flux-ratio map's flux within 0.5 % (measured +0.35 %, +0.29 %),
+    before and past the first caustics."""
+    r = wc.render(wc.load_scene("configs/ocean.toml", {
+        "caustics.method": "eikonal", "water.resolution": 64, "caustics.map_resolution": 64,
+        "caustics.eikonal_resolution": 64, "optics.water_type": "none", "floor.depth_m": depth_m,
+        "optics.wavelengths": "rgb"}), device="cpu")
+    np.testing.assert_allclose(r.floor_flux_w_nm, r.comparison.floor_flux_w_nm, rtol=5e-3)
