@@ -183,8 +183,24 @@ def main() -> int:
     _photons()
     _beams()
     _approximate_methods()
+    _wave_depths()
     _multiple_scattering()
     return 0
+
+
+def _wave_depths() -> None:
+    """The wave texture on still water at depth under a low sun: docs/physics.md's figures."""
+    import warpcaustics as wc
+
+    print("\n## Wave texture on still water, 15° sun, 48 nodes across 4 m: floor / flux-ratio floor")
+    for depth in (1.5, 6.0, 12.0):
+        r = wc.render(wc.load_scene(None, {
+            "caustics.method": "wave3d", "water.model": "flat", "water.extent_m": 4.0, "water.resolution": 64,
+            "caustics.map_resolution": 64, "caustics.wave3d_resolution": 48, "sun.elevation_deg": 15.0,
+            "sun.azimuth_deg": 25.0, "floor.depth_m": depth,
+            "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2}}), device="cpu")
+        ratio = r.floor_irradiance.mean(axis=(1, 2)) / r.comparison.floor_irradiance.mean(axis=(1, 2))
+        print(f"{depth:4.1f} m: {np.round(ratio.astype(np.float64), 3).tolist()}")
 
 
 def _multiple_scattering() -> None:
