@@ -98,6 +98,38 @@ def test_beer_lambert_per_wavelength_for_water_types(water_type, device):
     np.testing.assert_allclose(result.floor_irradiance.mean(axis=(1, 2)), expected, rtol=1e-5)
 
 
+def test_iops_are_colour_spectral_distributions_on_the_render_shape():
+    """The render's a, b, c are colour-science SpectralDistributions on its bins (a regular shape
+    for equal bins, the listed wavelengths otherwise) holding the arrays the kernels used, and a bin
+    average through colour's linear interpolator equals a float64 numpy one (1e-12)."""
+    colour = pytest.importorskip("colour")
+    scene = wc.load_scene(None, {"water.model": "flat", "water.resolution": 8, "caustics.map_resolution": 8,
+                                 "optics.water_type": "jerlov_IB"})
+    result = wc.render(scene, device="cpu")
+    iops = result.water_iops()
+    assert all(isinstance(sd, colour.SpectralDistribution) for sd in iops.values())
+    width = result.bin_widths_nm[0]
+    assert iops["c"].shape == colour.SpectralShape(result.wavelengths_nm[0], result.wavelengths_nm[-1], width)
+    np.testing.assert_array_equal(iops["c"].values, result.attenuation_per_m)
+    np.testing.assert_allclose(iops["a"].values + iops["b"].values, iops["c"].values, rtol=1e-15)
+    listed_cfg = wc.config.WavelengthConfig(list_nm=(450.0, 510.0, 640.0))
+    listed = spectra.bins_for(OpticsConfig(wavelengths=listed_cfg))
+    assert list(spectra.water_optics(OpticsConfig(), listed).distributions(listed)["a"].wavelengths) == [
+        450.0, 510.0, 640.0]
+    wl, aw = spectra.pure_absorption_table()
+    bins = spectra.SpectralBins.uniform(412.0, 688.0, 23)
+    n = int(np.ceil(bins.widths_nm[0] * 10))  # the midpoint rule's 10 points per nm
+    midpoint = [np.interp(lo + (np.arange(n) + 0.5) * (hi - lo) / n, wl, aw).mean()
+                for lo, hi in zip(bins.edges_nm[:-1], bins.edges_nm[1:])]
+    np.testing.assert_allclose(bins.average(wl, aw, "Pope & Fry"), midpoint, rtol=1e-12)
+    # and the rule against the exact integral of the interpolant (trapezoids on its knots): 1e-4
+    exact = []
+    for lo, hi in zip(bins.edges_nm[:-1], bins.edges_nm[1:]):
+        x = np.unique(np.concatenate([[lo, hi], wl[(wl > lo) & (wl < hi)]]))
+        exact.append(np.trapezoid(np.interp(x, wl, aw), x) / (hi - lo))
+    np.testing.assert_allclose(bins.average(wl, aw, "Pope & Fry"), exact, rtol=1e-4)
+
+
 def test_jerlov_source_without_the_type_is_a_clear_error():
     """Asking Williamson 2022 for a type it does not have names the types it has."""
     with pytest.raises(wc.WarpcausticsError, match="has IB, II, III, 1C, 3C, 5C"):

@@ -103,6 +103,12 @@ class RenderResult:
     """Per camera pixel: ``position`` (H, W, 3) [m], ``normal`` (H, W, 3), ``depth`` (H, W) [m] along
     the ray (inf: no receiver), ``receiver`` (H, W) id (−1: none)."""
 
+    def water_iops(self) -> dict:
+        """The water's absorption ``a``, scattering ``b`` and beam attenuation ``c`` [1/m] used by
+        this render, as ``colour.SpectralDistribution``s on its wavelengths."""
+        optics = spectra.water_optics(self.scene.config.optics, self.bins)
+        return optics.distributions(self.bins)
+
     def receiver_irradiance(self, receiver: int) -> np.ndarray:
         """(F_r, K) irradiance on the faces of receiver id ``receiver`` [W m^-2 nm^-1]."""
         if self.face_flux_w_nm is None:

@@ -110,17 +110,38 @@ class SpectralBins:
                 f"({lo_nm:g}..{hi_nm:g} nm); narrow optics.wavelengths")
 
     def average(self, wavelength_nm: np.ndarray, values: np.ndarray, what: str) -> np.ndarray:
-        """Per bin: the average of the table's linear interpolant over the bin, or its value at the
-        listed wavelength."""
+        """Per bin: the average over the bin of the table as a colour-science spectral distribution
+        (linear interpolation, :func:`spectral_distribution`), or its value at the listed
+        wavelength."""
         self.check_covered(wavelength_nm[0], wavelength_nm[-1], what)
+        sd = spectral_distribution(wavelength_nm, values, what)
         if self.samples_nm is not None:
-            return np.interp(self.samples_nm, wavelength_nm, values)
+            return np.asarray(sd[self.samples_nm], dtype=np.float64)
         out = np.empty(len(self.edges_nm) - 1)
         for k, (a, b) in enumerate(zip(self.edges_nm[:-1], self.edges_nm[1:])):
             n = max(2, int(np.ceil((b - a) * _SAMPLES_PER_NM)))
             x = a + (np.arange(n) + 0.5) * (b - a) / n  # midpoint rule on a fine grid
-            out[k] = np.interp(x, wavelength_nm, values).mean()
+            out[k] = np.asarray(sd[x], dtype=np.float64).mean()
         return out
+
+    def distribution(self, values: np.ndarray, name: str):
+        """(K,) per-bin values as a ``colour.SpectralDistribution`` on the render's wavelengths
+        (bin centres, or the listed wavelengths): the form colour-science's own functions take."""
+        return spectral_distribution(self.centres_nm, values, name)
+
+
+def spectral_distribution(wavelength_nm: np.ndarray, values: np.ndarray, name: str):
+    """A table as a ``colour.SpectralDistribution`` interpolated linearly between its points (the
+    sources' own resolution, nothing invented between them). colour-science's default for regular
+    tables (Sprague) would overshoot at the sharp features of water absorption."""
+    import colour
+
+    return colour.SpectralDistribution(
+        np.asarray(values, dtype=np.float64),
+        np.asarray(wavelength_nm, dtype=np.float64),
+        name=name,
+        interpolator=colour.LinearInterpolator,
+    )
 
 
 @dataclass(frozen=True)
@@ -134,6 +155,14 @@ class WaterOptics:
     def attenuation_per_m(self) -> np.ndarray:
         """Beam attenuation c = a + b [1/m]: scattered light leaves the direct beam."""
         return self.absorption_per_m + self.scattering_per_m
+
+    def distributions(self, bins: SpectralBins) -> dict:
+        """a, b and c [1/m] as ``colour.SpectralDistribution``s aligned to the render's bins."""
+        return {
+            "a": bins.distribution(self.absorption_per_m, "absorption a [1/m]"),
+            "b": bins.distribution(self.scattering_per_m, "scattering b [1/m]"),
+            "c": bins.distribution(self.attenuation_per_m, "beam attenuation c [1/m]"),
+        }
 
 
 def bins_for(optics: OpticsConfig) -> SpectralBins:
