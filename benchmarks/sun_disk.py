@@ -1,10 +1,11 @@
 """The sun's disk and the sky vs a point sun: one frame of the default ocean by the flux-ratio
-map, same run.
+map and by the photons, same run.
 
-The disk costs one refraction and one deposit per direction over it, so the frame's caustic
-stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky over as many
-directions adds as many passes, each with its own crest-shading march. Median of a few frames after
-a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
+For the flux-ratio map the disk costs one refraction and one deposit per direction over it, so the
+frame's caustic stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky
+over as many directions adds as many passes, each with its own crest-shading march. The photons
+take the disk's directions in turn, one per photon, so their disk should cost nothing. Median of a
+few frames after a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
 """
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         ("point", {}),
         ("disk", {"sun.angular_diameter_deg": 0.53, "sun.disk_samples": samples}),
         ("sky", {"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "sky.directions": samples}),
+        ("photons_point", {"caustics.method": "photons"}),
+        ("photons_disk", {"caustics.method": "photons", "sun.angular_diameter_deg": 0.53,
+                          "sun.disk_samples": samples}),
     )
     for name, extra in cases:
         scene = wc.load_scene(
@@ -43,6 +47,9 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         "disk_over_point": rows["disk"] / rows["point"],
         "sky_frame_s": rows["sky"],
         "sky_over_point": rows["sky"] / rows["point"],
+        "photons_point_frame_s": rows["photons_point"],
+        "photons_disk_frame_s": rows["photons_disk"],
+        "photons_disk_over_point": rows["photons_disk"] / rows["photons_point"],
     }
 
 
@@ -59,7 +66,9 @@ def run(quick: bool, device: str) -> dict:
             f"sun disk     ocean N={n} M={m} | {samples:3d} directions | point "
             f"{row['point_frame_s'] * 1e3:8.1f} ms | disk {row['disk_frame_s'] * 1e3:8.1f} ms | "
             f"disk / point {row['disk_over_point']:5.1f}x | sky {row['sky_frame_s'] * 1e3:8.1f} ms | "
-            f"sky / point {row['sky_over_point']:5.1f}x",
+            f"sky / point {row['sky_over_point']:5.1f}x | photons: point "
+            f"{row['photons_point_frame_s'] * 1e3:8.1f} ms, "
+            f"disk / point {row['photons_disk_over_point']:5.2f}x",
             flush=True,
         )
     return {

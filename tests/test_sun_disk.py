@@ -64,7 +64,59 @@ def test_disk_widens_the_lens_focus_to_the_suns_image():
     assert spots[0.53][2] == pytest.approx(spots[0.0][2], rel=1e-3)
 
 
+def _encircled_radius(e: np.ndarray, x: np.ndarray, share: float) -> float:
+    """Radius about the map's centre holding ``share`` of the flux in the map."""
+    r = np.hypot(*np.meshgrid(x, x)).ravel()
+    order = np.argsort(r)
+    cumulative = np.cumsum(e.ravel()[order])
+    return float(r[order][np.searchsorted(cumulative, share * cumulative[-1])])
+
+
+def test_photons_take_the_disk_directions_in_turn():
+    """Photons (4×4 per cell, 16 disk directions, one each) under the lens at its focus: a point
+    sun's spot holds half its flux inside a texel or two; the disk's is the sun's image, a uniform
+    disc of radius a = f'·ρ/n, so a share q of its flux lies within √q·a (q = ¼, ½, ¾; to one 1 mm
+    texel), as with the flux-ratio map's disk; the flux is unchanged (1e-4). On still water the
+    floor mean is unchanged (1e-4)."""
+    r50, flux, maps = {}, {}, {}
+    for method in ("photons", "fluxratio"):
+        for diameter in (0.0, 0.53):
+            overrides = {
+                "floor.depth_m": FOCAL_M - APEX_M,
+                "optics.water_type": "none",
+                "optics.ior": IOR,
+                "optics.wavelengths": {"min_nm": 500.0, "max_nm": 600.0, "bins": 1},
+                "caustics.method": method,
+                "caustics.map_resolution": 2048,
+                "sun.angular_diameter_deg": diameter,
+            }
+            r = wc.render(wc.load_scene("configs/lens.toml", overrides), device="cpu")
+            e = r.floor_irradiance[0].astype(np.float64)
+            x, _ = r.map_coordinates()
+            centre = np.abs(x) < 0.02
+            spot = e[np.ix_(centre, centre)] - e[0, 0]  # above the flat water's irradiance
+            r50[method, diameter] = _encircled_radius(spot, x[centre], 0.5)
+            flux[method, diameter] = e.sum() * r.texel_area_m2
+            maps[method, diameter] = spot
+    texel = 2.0 / 2048
+    image_radius = IOR * RADIUS_OF_CURVATURE_M / (IOR - 1.0) * math.radians(0.53 / 2) / IOR
+    assert r50["photons", 0.0] < 2 * texel
+    assert flux["photons", 0.53] == pytest.approx(flux["photons", 0.0], rel=1e-4)
+    x = (np.arange(2048) + 0.5) * texel - 1.0
+    x = x[np.abs(x) < 0.02]
+    for share in (0.25, 0.5, 0.75):  # the image's encircled flux, √share·a, by both methods
+        for method in ("photons", "fluxratio"):
+            radius = _encircled_radius(maps[method, 0.53], x, share)
+            assert radius == pytest.approx(math.sqrt(share) * image_radius, abs=texel), (method, share)
+    flat = {"water.model": "flat", "water.resolution": 32, "caustics.map_resolution": 32,
+            "caustics.method": "photons", "sun.elevation_deg": 40.0, "optics.wavelengths": "rgb"}
+    point = wc.render(wc.load_scene(None, flat), device="cpu").floor_irradiance.mean(axis=(1, 2))
+    disk = wc.render(wc.load_scene(None, {**flat, "sun.angular_diameter_deg": 0.53}),
+                     device="cpu").floor_irradiance.mean(axis=(1, 2))
+    np.testing.assert_allclose(disk, point, rtol=1e-4)
+
+
 def test_disk_with_another_method_is_refused():
-    """The disk is integrated by the flux-ratio map only so far: other methods say so."""
+    """The disk is integrated by the flux-ratio map and the photons so far: other methods say so."""
     with pytest.raises(ConfigError, match="sun.angular_diameter_deg"):
         wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 0.53, "caustics.method": "beams"})

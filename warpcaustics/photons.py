@@ -108,7 +108,11 @@ class PhotonCaustics:
         device: str,
         *,
         periodic: bool,
+        disk_dirs: np.ndarray | None = None,
     ):
+        """``sun_dir``: the sun's centre (the light view for the Newton guesses is rendered from
+        it); ``disk_dirs``: (D, 3) directions over the sun's disk the photons take in turn (None: a
+        point sun)."""
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -146,6 +150,8 @@ class PhotonCaustics:
         )
         sun = np.asarray(sun_dir, np.float64)
         self.sun_dir = wp.vec3(*sun.astype(np.float32))
+        dirs = sun[None] if disk_dirs is None else np.asarray(disk_dirs, np.float64)
+        self.sun_dirs = wp.array(dirs.astype(np.float32), dtype=wp.vec3, device=device)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
         self.view = self._light_view(
@@ -198,7 +204,7 @@ class PhotonCaustics:
                 surface.normals,
                 visible,
                 ior,
-                self.sun_dir,
+                self.sun_dirs,
                 s,
                 extent,
                 int(self.periodic),

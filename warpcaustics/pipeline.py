@@ -287,7 +287,8 @@ class Renderer:
                     self.beams = beams.BeamCaustics(*args, periodic=self.water.periodic,
                                                     relief=scene.floor_relief)
                 if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
-                    self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic)
+                    self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic,
+                                                          disk_dirs=scene.sun_disk_directions())
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
                     photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, scene.sun_direction,
