@@ -290,6 +290,11 @@ class BeamCaustics:
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
 
+    def set_sun_direction(self, sun_dir: np.ndarray) -> None:
+        """Build the next :meth:`run`'s beams for light from ``sun_dir`` (a direction over the sun's
+        disk; the renderer averages the passes)."""
+        self.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
+
     # --- per frame --------------------------------------------------------------------------
 
     def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:

@@ -454,34 +454,49 @@ class Renderer:
 
     def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:
         """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the
-        RenderResult fields of receivers and camera), all on the host."""
+        RenderResult fields of receivers and camera), all on the host. Beams under a sun disk run
+        once per direction over it and average the passes (the photons take the directions in
+        turn inside one pass)."""
         cfg = self.scene.config
         photons = stage is self.photons
+        directions = self.scene.sun_disk_directions() if not photons else self.scene.sun_direction[None]
+        rec = self.receivers
+        other = rec.face_count - rec.floor_face_count
+        total: dict[str, np.ndarray] = {}
         extra = {}
-        with watch.stage("photons" if photons else "beams"):
-            floor = stage.run(surface, visible)
+        for direction in directions:
+            if not photons:
+                stage.set_sun_direction(direction)
+            with watch.stage("photons" if photons else "beams"):
+                floor = stage.run(surface, visible)
+            part = {}
+            if self.camera is not None:
+                with watch.stage("camera" if photons or self.photons is None else "camera_beams"):
+                    if photons:
+                        n = self.scene.water_resolution
+                        spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
+                        self.camera.render(stage, spacing, cfg.caustics.shafts)
+                    else:
+                        self.camera.render_beams(stage, cfg.caustics.shafts)
+                    part["camera_radiance"] = self.camera.radiance.numpy().astype(np.float64)
+            with watch.stage("readback"):
+                part["floor"] = floor.numpy().astype(np.float64)
+                part["transmitted"] = stage.transmitted_flux()
+                part["face_flux_w_nm"] = (stage.face_flux.numpy()[:other].astype(np.float64) if photons
+                                          else stage.face_flux_w_nm())
+                counts = vars(stage.stats())
+            for key, value in part.items():
+                total[key] = total[key] + value if key in total else value
+            stats_key = "photon_stats" if photons else "beam_stats"
+            extra[stats_key] = {k: extra.get(stats_key, {}).get(k, 0) + v for k, v in counts.items()}
+        share = 1.0 / len(directions)  # each direction carries its share of the sun
+        floor_np = (total.pop("floor") * share).astype(np.float32)
+        transmitted = total.pop("transmitted") * share
+        extra["face_flux_w_nm"] = total.pop("face_flux_w_nm") * share
         if self.camera is not None:
-            with watch.stage("camera" if photons or self.photons is None else "camera_beams"):
-                if photons:
-                    n = self.scene.water_resolution
-                    spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
-                    self.camera.render(stage, spacing, cfg.caustics.shafts)
-                else:
-                    self.camera.render_beams(stage, cfg.caustics.shafts)
-                extra["camera_radiance"] = self.camera.radiance.numpy().copy()
-                extra["camera_gbuffer"] = self.camera.gbuffer()
+            extra["camera_radiance"] = (total.pop("camera_radiance") * share).astype(np.float32)
+            extra["camera_gbuffer"] = self.camera.gbuffer()
         with watch.stage("readback"):
-            # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
-            floor_np = floor.numpy().copy()
-            transmitted = stage.transmitted_flux()
-            rec = self.receivers
-            other = rec.face_count - rec.floor_face_count
-            if photons:
-                extra["face_flux_w_nm"] = stage.face_flux.numpy()[:other].copy()
-                extra["photon_stats"] = vars(stage.stats())
-            else:
-                extra["face_flux_w_nm"] = stage.face_flux_w_nm()
-                extra["beam_stats"] = vars(stage.stats())
             extra.update(face_receiver=rec.face_receiver_np[rec.floor_face_count:],
                          face_area_m2=rec.face_area_m2[rec.floor_face_count:],
                          face_centres_m=rec.face_centres_m[rec.floor_face_count:],
