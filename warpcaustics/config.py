@@ -290,7 +290,7 @@ class SunConfig:
     """Direction towards the sun, from +x towards +y [deg]."""
     angular_diameter_deg: float = field(default=0.0, metadata=_range(0.0, 5.0))
     """Angular diameter of the sun's disk [deg]: 0 = a point; 0.53 = the real sun, integrated over
-    ``disk_samples`` directions (``fluxratio``, ``photons``, ``beams`` so far)."""
+    ``disk_samples`` directions (every method but ``sunmap``, which draws its own)."""
     disk_samples: int = field(default=16, metadata=_range(2, 1024))
     """Directions over the sun's disk (equal solid angles: a sunflower pattern and its mirror
     image; an odd number is rounded down to even) [-]."""
@@ -819,11 +819,10 @@ def _check_scattering(cfg: Config) -> None:
 
 
 def _check_sun_disk(cfg: Config) -> None:
-    if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method not in (
-            CausticsMethod.FLUXRATIO, CausticsMethod.PHOTONS, CausticsMethod.BEAMS, CausticsMethod.BOTH):
-        raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g} (a sun disk) is "
-                          f"integrated by the flux-ratio map, photons and beams only so far (the method is "
-                          f"{cfg.caustics.method.value!r}); set sun.angular_diameter_deg = 0")
+    if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method is CausticsMethod.SUNMAP:
+        raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g}: the sun map "
+                          f"draws the sun's disk itself (caustics.sunmap_disk_deg = "
+                          f"{cfg.caustics.sunmap_disk_deg:g}); set sun.angular_diameter_deg = 0")
 
 
 def _check_stats(cfg: Config) -> None:

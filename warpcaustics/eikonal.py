@@ -120,6 +120,55 @@ class GridCaustics:
         self.layers = 0
 
 
+    def disk_average(self, floor: np.ndarray, disk_dirs: np.ndarray) -> np.ndarray:
+        """The sun's disk for this grid method's map: :func:`parallax_disk_average`."""
+        return parallax_disk_average(floor, self.sun_dir, disk_dirs, self.ior, -self.floor_z, self.extent_m,
+                                     self.periodic)
+
+
+def parallax_disk_average(floor: np.ndarray, sun_dir: np.ndarray, disk_dirs: np.ndarray, ior: float,
+                          depth_m: float, extent_m: float, periodic: bool) -> np.ndarray:
+    """The sun's disk for a map made for its centre: the (K, M, M) map moved by each direction's
+    still-water parallax at the floor, D·(t_xy/|t_z| − t0_xy/|t0_z|) with t the refracted direction,
+    and averaged over the directions. Each direction's pattern is taken to be the centre's,
+    displaced as still water would displace it: the first-order effect of a 0.27° tilt, not a new
+    solve. Moves are bilinear (periodic maps wrap and keep their flux; on a pool or an open patch
+    what leaves the map is lost)."""
+    from warpcaustics.sunmap import still_water_refraction
+
+    if len(disk_dirs) < 2:
+        return floor
+    t0 = still_water_refraction(sun_dir, ior)
+    texel = extent_m / floor.shape[-1]
+    out = np.zeros(floor.shape, np.float64)
+    for d in disk_dirs:
+        t = still_water_refraction(d, ior)
+        shift = depth_m * (t[:2] / abs(t[2]) - t0[:2] / abs(t0[2])) / texel  # texels, (x, y)
+        whole = np.floor(shift).astype(int)
+        frac = shift - whole
+        for dy, wy in ((0, 1.0 - frac[1]), (1, frac[1])):
+            for dx, wx in ((0, 1.0 - frac[0]), (1, frac[0])):
+                out += wx * wy * _moved(floor, int(whole[0]) + dx, int(whole[1]) + dy, periodic)
+    return (out / len(disk_dirs)).astype(floor.dtype)
+
+
+def _moved(a: np.ndarray, sx: int, sy: int, periodic: bool) -> np.ndarray:
+    """(K, M, M) ``a`` with its content moved by ``sx`` texels along +x (columns) and ``sy`` along
+    +y (rows): wrapped, or with zeros coming in."""
+    if periodic:
+        return np.roll(a, (sy, sx), axis=(-2, -1))
+    out = np.zeros_like(a, dtype=np.float64)
+    m = a.shape[-1]
+    if abs(sx) >= m or abs(sy) >= m:
+        return out
+    src_y = slice(max(-sy, 0), m - max(sy, 0))
+    dst_y = slice(max(sy, 0), m - max(-sy, 0))
+    src_x = slice(max(-sx, 0), m - max(sx, 0))
+    dst_x = slice(max(sx, 0), m - max(-sx, 0))
+    out[..., dst_y, dst_x] = a[..., src_y, src_x]
+    return out
+
+
 class EikonalCaustics(GridCaustics):
     """Owns the 3-D grid (ψ, Laplacian, intensity, path, horizontal irradiance) of a scene."""
 

@@ -15,7 +15,7 @@ from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
 from warpcaustics.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.config import CausticsMethod, Scattering, SkyModel
-from warpcaustics.eikonal import EikonalCaustics, eikonal_bytes
+from warpcaustics.eikonal import EikonalCaustics, GridCaustics, eikonal_bytes
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.multiple import MultipleScattering
 from warpcaustics.phase import PhaseFunction
@@ -400,6 +400,8 @@ class Renderer:
                 with watch.stage(cfg.caustics.method.value):
                     floor_np, extra = self.approximate.floor_map(surface, self.water, time_s, highest,
                                                                  visible, flux_ratio_floor)
+                    if isinstance(self.approximate, GridCaustics):  # the sun's disk, if any
+                        floor_np = self.approximate.disk_average(floor_np, self.sun_directions)
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
