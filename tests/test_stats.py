@@ -163,3 +163,21 @@ def test_periodogram_keeps_the_power_for_odd_and_even_lengths():
         df = out["frequencies_hz"][1] - out["frequencies_hz"][0]
         power = np.sum(out["power_spectrum"][0]) * df
         assert power == pytest.approx(np.var(e / e.mean() - 1.0), rel=0.05)
+
+
+def test_sky_and_direct_parts_have_their_own_statistics():
+    """With a sky, the statistics also hold the direct sun's part and the sky's alone: their means
+    add up to the total's (1e-9) and the sky's is the mean of RenderResult.sky_floor_irradiance."""
+    import warpcaustics as wc
+    from warpcaustics.stats import band_integrated, frame_statistics
+
+    scene = wc.load_scene("configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 32,
+                                                 "sky.model": "uniform", "sky.diffuse_fraction": 0.3,
+                                                 "sky.directions": 4, "stats.collector_mm": 300.0})
+    r = wc.render(scene, device="cpu")
+    s = frame_statistics(r, scene.config.stats)
+    total, direct, sky = (s[k]["mean"] for k in ("irradiance_w_m2", "direct_irradiance_w_m2",
+                                                  "sky_irradiance_w_m2"))
+    assert direct + sky == pytest.approx(total, rel=1e-9)
+    assert sky == pytest.approx(band_integrated(r.sky_floor_irradiance, r.bin_widths_nm).mean(), rel=1e-9)
+    assert 0.0 < s["direct_irradiance_w_m2"]["cv"] and s["sky_irradiance_w_m2"]["cv"] > 0.0

@@ -89,6 +89,22 @@ def _parser() -> argparse.ArgumentParser:
                         description="Print DIR/summary.csv and write DIR/summary.png.")
     rp.add_argument("out", metavar="DIR", help="the folder of a sweep")
 
+    fd = sub.add_parser("field", help="compare the model with field measurements (Gernez & Antoine 2009)",
+                        description="Render SCENE at the conditions of a field data set (a resumable sweep "
+                                    "into DIR), and write the model against the measurements as CSV and PNG.")
+    fd.add_argument("dataset", choices=["gernez2009"], help="the field data set")
+    fd.add_argument("scene", metavar="SCENE",
+                    help="the scene of its conditions, e.g. configs/field/gernez2009.toml")
+    fd.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
+    fd.add_argument("--series", default="zenith,wind", metavar="S",
+                    help="comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); default both")
+    fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
+    fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
+    fd.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    fd.add_argument("--quick", action="store_true",
+                    help="a coarse run of three points, to check the command (not a comparison)")
+    fd.add_argument("--quiet", action="store_true", help="no progress lines")
+
     sub.add_parser("info", help="versions and the devices Warp sees",
                    description="Print package versions and the compute devices Warp can use.")
     return p
@@ -233,6 +249,14 @@ def main(argv: list[str] | None = None) -> int:
             return _preview(args)
         if args.command == "compare":
             return _compare(args)
+        if args.command == "field":
+            from warpcaustics.field import run_gernez2009
+
+            paths = run_gernez2009(args.scene, args.out, series=tuple(args.series.split(",")),
+                                   frames=args.frames, workers=args.workers, device=args.device,
+                                   quick=args.quick, quiet=args.quiet)
+            print("wrote " + ", ".join(str(p) for p in paths.values()))
+            return 0
         if args.command == "report":
             from warpcaustics.sweep import report_main
 

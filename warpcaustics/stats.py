@@ -111,9 +111,14 @@ def field_statistics(field: np.ndarray, flash_threshold: float) -> dict:
 
 
 def frame_statistics(result, cfg: StatsConfig) -> dict:
-    """The statistics of one frame's floor map: total irradiance [W m⁻²], PAR [µmol m⁻² s⁻¹] and,
-    if ``cfg.wavelength_nm`` is set, the band holding it [W m⁻² nm⁻¹], after the collector."""
+    """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
+    direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
+    band holding it [W m⁻² nm⁻¹], after the collector."""
     fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
+    sky = getattr(result, "sky_floor_irradiance", None)
+    if sky is not None:  # the direct sun's part and the sky's, each alone
+        fields["sky_irradiance_w_m2"] = band_integrated(sky, result.bin_widths_nm)
+        fields["direct_irradiance_w_m2"] = fields["irradiance_w_m2"] - fields["sky_irradiance_w_m2"]
     edges = result.bins.edges_nm if result.bins is not None else None
     covered = None
     if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0]:

@@ -96,8 +96,6 @@ def _values(table: Any, key: str) -> dict[str, list]:
 
 def load_sweep(path: str | Path) -> Sweep:
     """Read a sweep TOML and expand it into tasks; every variant is validated before anything runs."""
-    from warpcaustics.scene import load_scene
-
     path = Path(path)
     table = read_toml(path)
     unknown = set(table) - {"base", "set", "grid", "zip", "frames"}
@@ -123,6 +121,22 @@ def load_sweep(path: str | Path) -> Sweep:
     if not isinstance(fps, (int, float)) or not fps > 0:
         raise ConfigError(f"sweep frames.fps = {fps!r} must be a positive number")
     times = tuple(float(start) + i / float(fps) for i in range(count))
+    return expand_sweep(base, fixed, grid, zipped, times, path)
+
+
+def expand_sweep(
+    base: Path,
+    fixed: dict,
+    grid: dict[str, list],
+    zipped: dict[str, list],
+    times: tuple[float, ...],
+    source: Path,
+) -> Sweep:
+    """The tasks of a sweep: every ``grid`` combination (with the ``zip`` lists as one more axis)
+    applied after ``fixed``, each variant validated, and one task per frame time (a whole animation
+    for the stateful pools). Also used by commands that build their sweep in code
+    (``warpcaustics field``)."""
+    from warpcaustics.scene import load_scene
 
     axes = [[(k, v) for v in values] for k, values in grid.items()]
     if zipped:
@@ -147,7 +161,7 @@ def load_sweep(path: str | Path) -> Sweep:
                     task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
                 )
             )
-    return Sweep(base, tasks, path, list(grid) + list(zipped))
+    return Sweep(base, tasks, source, list(grid) + list(zipped))
 
 
 def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:

@@ -1,0 +1,95 @@
+"""The Gernez & Antoine (2009) field comparison: its data, its pooling and its command."""
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from warpcaustics.cli import main
+from warpcaustics.errors import ConfigError
+
+jerlov = pytest.importorskip("jerlov")
+field = pytest.importorskip("warpcaustics.field")
+
+
+def test_pooled_statistics_equal_those_of_all_texels():
+    """The CV pooled from each frame's (mean, CV) equals numpy's over all frames' texels (1e-12)."""
+    rng = np.random.default_rng(3)
+    frames = [rng.gamma(shape, scale, size=(32, 32)) for shape, scale in ((2.0, 1.0), (5.0, 0.7), (1.2, 2.5))]
+    stats = [(f.mean(), f.std() / f.mean()) for f in frames]
+    mean, cv = field.pooled_statistics(stats)
+    every = np.concatenate([f.ravel() for f in frames])
+    assert mean == pytest.approx(every.mean(), rel=1e-12)
+    assert cv == pytest.approx(every.std() / every.mean(), rel=1e-12)
+    backgrounds = [0.5, 2.0, 0.0]  # a uniform irradiance added to each frame
+    mean, cv = field.pooled_statistics(stats, backgrounds)
+    every = np.concatenate([(f + b).ravel() for f, b in zip(frames, backgrounds)])
+    assert cv == pytest.approx(every.std() / every.mean(), rel=1e-12)
+
+
+def test_points_carry_the_papers_values():
+    """Measured CVs are the package's; the diffuse share is the paper's at its printed zeniths and
+    linear between them; the wind series starts at √U = 1.2 and is at zenith 40°."""
+    by_zenith = jerlov.gernez2009_cv_by_sun_zenith()
+    share = jerlov.gernez2009_diffuse_share()
+    points = field.gernez2009_points()
+    zen = [p for p in points if p.series == "zenith"]
+    assert [p.sun_zenith_deg for p in zen] == list(by_zenith.sun_zenith_deg)
+    assert [p.measured_cv for p in zen] == list(by_zenith.cv)
+    for z, f in zip(share.sun_zenith_deg, share.diffuse_fraction):
+        assert field.diffuse_fraction(float(z)) == pytest.approx(float(f), abs=1e-12)
+    between = 0.5 * (share.diffuse_fraction[0] + share.diffuse_fraction[1])
+    assert field.diffuse_fraction(25.0) == pytest.approx(between, abs=1e-12)
+    by_wind = jerlov.gernez2009_cv_by("sqrt_wind")
+    wind = [p for p in points if p.series == "wind"]
+    kept = by_wind.x >= 1.2
+    assert [p.wind_m_s for p in wind] == pytest.approx(list(by_wind.x[kept] ** 2))
+    assert [p.measured_cv for p in wind] == list(by_wind.cv[kept])
+    assert {p.sun_zenith_deg for p in wind} == {40.0}
+
+
+def test_direct_transmission_is_beer_lambert_along_the_refracted_beam():
+    assert field.direct_transmission(0.0, 3.0, 1.34, 0.1) == pytest.approx(math.exp(-0.3), rel=1e-12)
+    cos_w = math.sqrt(1 - (math.sin(math.radians(60.0)) / 1.34) ** 2)
+    assert field.direct_transmission(60.0, 3.0, 1.34, 0.1) == pytest.approx(math.exp(-0.3 / cos_w), rel=1e-12)
+
+
+def _scene(tmp_path, water="model = 'flat'\nresolution = 8\nextent_m = 4.0\n", wavelengths="[510.0]"):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(f"[water]\n{water}[floor]\ndepth_m = 3.2\n"
+                     "[sky]\nmodel = 'uniform'\ndiffuse_fraction = 0.2\n"
+                     f"[optics]\nwater_type = 'jerlov_IB'\nwavelengths = {wavelengths}\n"
+                     "[caustics]\nmap_resolution = 16\nmap_extent_m = 1.0\n[stats]\ncollector_mm = 8.0\n")
+    return scene
+
+
+def test_command_on_still_water_measures_no_fluctuation(tmp_path, capsys):
+    """The command end to end (--quick, two frames): flat water under sun and sky gives CV = 0 at
+    every point, the measured columns beside it, a plot; a second run resumes without rendering."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "out"
+    args = ["field", "gernez2009", str(_scene(tmp_path)), "--out", str(out), "--quick", "--frames", "2",
+            "--device", "cpu", "--quiet"]
+    assert main(args) == 0
+    rows = list(csv.DictReader((out / "gernez2009.csv").open()))
+    assert [(r["series"], float(r["sun_zenith_deg"])) for r in rows] == [
+        ("zenith", 20.0), ("zenith", 85.0), ("wind", 40.0)]
+    cvs = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered")
+    assert all(float(r[c]) < 1e-5 for r in rows for c in cvs) and all(int(r["frames"]) == 2 for r in rows)
+    measured = jerlov.gernez2009_cv_by_sun_zenith().cv
+    assert float(rows[0]["measured_cv"]) == pytest.approx(measured[0], abs=1e-4)
+    # a lower sun through more diffuse sky: less light on the floor
+    assert float(rows[1]["model_mean_w_m2"]) < float(rows[0]["model_mean_w_m2"])
+    assert (out / "gernez2009.png").read_bytes()[:4] == b"\x89PNG"
+    capsys.readouterr()
+    assert main(args[:-1]) == 0
+    assert "done 0, skipped 6" in capsys.readouterr().out
+
+
+def test_bad_input_is_one_line(tmp_path, capsys):
+    with pytest.raises(ConfigError, match="optics.wavelengths"):
+        field.run_gernez2009(_scene(tmp_path, wavelengths="[450.0]"), tmp_path / "o", quick=True)
+    with pytest.raises(ConfigError, match="--series"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", series=("tide",), quick=True)
+    assert not (tmp_path / "o").exists()
