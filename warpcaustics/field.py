@@ -115,8 +115,9 @@ def pooled_statistics(
 
 def direct_transmission(sun_zenith_deg: float, depth_m: float, ior: float, scattering_per_m: float) -> float:
     """exp(−b·d/cos θ_w): the share of the sun's refracted beam not scattered on its way down. The
-    rest, lost by single scattering, is mostly scattered forward (Petzold's g ≈ 0.9) and arrives
-    spread over tens of centimetres, wider than the caustics: a uniform background is its limit."""
+    rest, lost by single scattering, is mostly scattered forward (Petzold's mean cosines are
+    0.87-0.95, docs/physics.md) and arrives spread over tens of centimetres, wider than the
+    caustics: a uniform background is its limit."""
     sin_w = math.sin(math.radians(sun_zenith_deg)) / ior
     return math.exp(-scattering_per_m * depth_m / math.sqrt(1.0 - sin_w * sin_w))
 
