@@ -458,7 +458,7 @@ class Renderer:
         """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the
         RenderResult fields of receivers and camera), all on the host. Beams under a sun disk run
         once per direction over it and average the passes (the photons take the directions in
-        turn inside one pass)."""
+        turn inside one pass); their counts add up over the passes."""
         cfg = self.scene.config
         photons = stage is self.photons
         directions = self.scene.sun_disk_directions() if not photons else self.scene.sun_direction[None]
