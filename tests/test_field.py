@@ -87,9 +87,26 @@ def test_command_on_still_water_measures_no_fluctuation(tmp_path, capsys):
     assert "done 0, skipped 6" in capsys.readouterr().out
 
 
+def test_a_condition_shared_by_both_series_is_rendered_once(tmp_path):
+    """With the scene's wind at a wind class (4 m/s = 2²), the 40° zenith point and that wind's
+    point are one condition: one variant, found by both points."""
+    import warpcaustics as wc
+
+    config = wc.load_scene(_scene(tmp_path, water="model = 'fft'\nwind_speed_m_s = 4.0\n")).config
+    points = field.gernez2009_points()
+    overrides, variants = field.point_variants(points, config)
+    assert len(variants) == len(points) - 1
+    shared = [i for i, o in enumerate(overrides) if overrides.count(o) == 2]
+    assert [(points[i].series, points[i].sun_zenith_deg) for i in shared] == [
+        ("zenith", 40.0), ("wind", 40.0)]
+
+
 def test_bad_input_is_one_line(tmp_path, capsys):
     with pytest.raises(ConfigError, match="optics.wavelengths"):
         field.run_gernez2009(_scene(tmp_path, wavelengths="[450.0]"), tmp_path / "o", quick=True)
+    with pytest.raises(ConfigError, match="one band at 510"):  # 510 nm inside, but summed with others
+        field.run_gernez2009(_scene(tmp_path, wavelengths="{ min_nm = 400.0, max_nm = 700.0, bins = 4 }"),
+                             tmp_path / "o", quick=True)
     with pytest.raises(ConfigError, match="--series"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", series=("tide",), quick=True)
     assert not (tmp_path / "o").exists()

@@ -116,6 +116,10 @@ def test_iops_are_colour_spectral_distributions_on_the_render_shape():
     listed = spectra.bins_for(OpticsConfig(wavelengths=listed_cfg))
     assert list(spectra.water_optics(OpticsConfig(), listed).distributions(listed)["a"].wavelengths) == [
         450.0, 510.0, 640.0]
+    one = wc.render(wc.load_scene(None, {"water.model": "flat", "water.resolution": 8,
+                                         "caustics.map_resolution": 8, "optics.wavelengths": [510.0]}),
+                    device="cpu").water_iops()["c"]  # one band: its value across its bin
+    assert list(one.wavelengths) == [505.0, 515.0] and one[510.0] == pytest.approx(one.values[0])
     wl, aw = spectra.pure_absorption_table()
     bins = spectra.SpectralBins.uniform(412.0, 688.0, 23)
     n = int(np.ceil(bins.widths_nm[0] * 10))  # the midpoint rule's 10 points per nm

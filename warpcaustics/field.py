@@ -148,17 +148,18 @@ def run_gernez2009(
     fixed = dict(QUICK_OVERRIDES) if quick else {}
     base = load_scene(scene_path, fixed)
     _check_scene(base.config)
+    _plotting()  # before the sweep, not after it
     points = gernez2009_points(series)
     if quick:  # the first and last zenith, the first wind
         ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
-    keys = sorted({k for p in points for k in p.overrides()})
-    # every point sets every varied key (the scene's value where the point leaves it), so that each
-    # point's tasks are found by their overrides alone
-    overrides = [{k: p.overrides().get(k, _scene_value(base.config, k)) for k in keys} for p in points]
-    zipped = {k: [o[k] for o in overrides] for k in keys}
+    overrides, variants = point_variants(points, base.config)
+    zipped = {k: [o[k] for o in variants] for k in variants[0]}
     times = tuple(i * frame_interval_s for i in range(frames))
     sweep = expand_sweep(scene_path, fixed, {}, zipped, times, scene_path)
+    bad = next((t.error for t in sweep.tasks if t.error is not None), None)
+    if bad is not None:
+        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
     report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet)
     if not quiet:
         print(format_report(report))
@@ -175,12 +176,31 @@ def run_gernez2009(
     return paths
 
 
+def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]:
+    """Each point's overrides, setting every varied key (the scene's value where the point leaves
+    it) so that a point's tasks are found by their overrides alone; and the distinct ones, to
+    render (points of the two series share a condition when the scene's wind is a wind class)."""
+    keys = sorted({k for p in points for k in p.overrides()})
+    overrides = [{k: p.overrides().get(k, _scene_value(config, k)) for k in keys} for p in points]
+    return overrides, [o for i, o in enumerate(overrides) if o not in overrides[:i]]
+
+
 def _check_scene(config) -> None:
-    """The comparison needs the paper's wavelength inside the bands and a sky that can take its share."""
+    """The comparison needs one band at the paper's 510 nm (its CV is of that band), a sky that can
+    take the paper's diffuse share and a stateless sea (each frame pooled is its own task)."""
     wl = config.optics.wavelengths
-    lo, hi = (min(wl.list_nm), max(wl.list_nm)) if wl.list_nm else (wl.min_nm, wl.max_nm)
-    if not lo <= 510.0 <= hi:
-        raise ConfigError("the Gernez 2009 comparison is at 510 nm: set optics.wavelengths = [510.0]")
+    one_band = (wl.list_nm == (510.0,)) or (
+        not wl.list_nm and wl.bins == 1 and wl.min_nm <= 510.0 <= wl.max_nm
+    )
+    if not one_band:
+        raise ConfigError(
+            "the Gernez 2009 comparison is of one band at 510 nm: set optics.wavelengths = [510.0]"
+        )
+    if config.water.stateful:
+        raise ConfigError(
+            f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
+            "independent frames of a wind sea: use water.model = 'fft'"
+        )
     if config.sky.model.value != "uniform":
         raise ConfigError(
             "the Gernez 2009 comparison needs the sky's diffuse share: set sky.model = 'uniform'"
@@ -245,7 +265,8 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
         writer.writerows(rows)
 
 
-def _plot(rows: list[dict], path: Path, quick: bool) -> None:
+def _plotting():
+    """matplotlib's pyplot (Agg), or a one-line error naming the extra to install."""
     try:
         import matplotlib
 
@@ -253,6 +274,11 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
         import matplotlib.pyplot as plt
     except ImportError:
         raise ConfigError("the comparison's plot needs matplotlib: pip install -e '.[study]'") from None
+    return plt
+
+
+def _plot(rows: list[dict], path: Path, quick: bool) -> None:
+    plt = _plotting()
     series = [s for s in SERIES if any(r["series"] == s for r in rows)]
     fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 4.2), squeeze=False)
     for ax, s in zip(axes[0], series):

@@ -126,7 +126,12 @@ class SpectralBins:
 
     def distribution(self, values: np.ndarray, name: str):
         """(K,) per-bin values as a ``colour.SpectralDistribution`` on the render's wavelengths
-        (bin centres, or the listed wavelengths): the form colour-science's own functions take."""
+        (bin centres, or the listed wavelengths): the form colour-science's own functions take. A
+        single band, which colour-science cannot hold as one point, is its value at both edges of
+        its bin."""
+        values = np.asarray(values, dtype=np.float64)
+        if len(values) == 1:
+            return spectral_distribution(self.edges_nm, np.repeat(values, 2), name)
         return spectral_distribution(self.centres_nm, values, name)
 
 
