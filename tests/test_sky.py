@@ -64,12 +64,32 @@ def test_sky_is_reported_apart_from_the_sun():
     [
         ({"sky.diffuse_fraction": 0.2}, "needs a sky"),
         ({"sky.model": "uniform"}, "no light"),
-        ({"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "caustics.method": "photons"}, "fluxratio"),
+        ({"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "caustics.method": "eikonal"},
+         "photons and beams"),
+        ({"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "caustics.method": "photons",
+          "caustics.intersection": "newton"}, "intersection"),
         ({"sky.model": "cie_clear", "sky.diffuse_fraction": 0.2}, "not implemented yet"),
     ],
 )
 def test_sky_errors_are_one_line(overrides, needle):
-    """A fraction without a sky, a sky without light, a sky with another method and the planned
-    CIE clear sky are refused naming the key."""
+    """A fraction without a sky, a sky without light, a sky with a grid method or with Newton
+    photons, and the planned CIE clear sky are refused naming the key."""
     with pytest.raises(ConfigError, match=needle):
         wc.load_scene(None, {**BASE, **overrides})
+
+
+@pytest.mark.parametrize("method", ["photons", "beams"])
+def test_photons_and_beams_see_the_sky_as_the_flux_ratio_map_does(method):
+    """The sky over still water by photons and by beams (a pass per sky direction, each shaded and
+    refracted as the flux-ratio map's): the sky's part has the flux-ratio map's mean (1e-4, float32
+    sums) and is reported apart from the sun's, whose map is the sun-only render's (1e-5)."""
+    sky = {"sky.model": "uniform", "sky.diffuse_fraction": 0.3, "sky.directions": 8,
+           "sun.elevation_deg": 50.0}
+    reference = wc.render(wc.load_scene(None, {**BASE, **sky}), device="cpu")
+    r = wc.render(wc.load_scene(None, {**BASE, **sky, "caustics.method": method}), device="cpu")
+    np.testing.assert_allclose(r.sky_floor_irradiance.mean(axis=(1, 2)),
+                               reference.sky_floor_irradiance.mean(axis=(1, 2)), rtol=1e-4)
+    sun_only = wc.render(wc.load_scene(None, {**BASE, "caustics.method": method, "sun.elevation_deg": 50.0}),
+                         device="cpu")
+    np.testing.assert_allclose(r.floor_irradiance - r.sky_floor_irradiance, sun_only.floor_irradiance,
+                               rtol=1e-5, atol=1e-6 * sun_only.floor_irradiance.max())

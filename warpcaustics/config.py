@@ -515,7 +515,7 @@ class OutputConfig:
 class SkyConfig:
     model: SkyModel = SkyModel.NONE
     """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky;
-    ``fluxratio`` so far). ``cie_clear`` is planned."""
+    ``fluxratio``, ``photons``, ``beams``). ``cie_clear`` is planned."""
     diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
     """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
     (``sun.*``) is the rest [-]."""
@@ -792,10 +792,15 @@ def _check_sky(cfg: Config) -> None:
             raise ConfigError(f"sky.diffuse_fraction = {sky.diffuse_fraction:g} needs a sky; set "
                               "sky.model = \"uniform\" (or sky.diffuse_fraction = 0)")
         return
-    if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
-        raise ConfigError(f"sky.model = {sky.model.value!r} is integrated by caustics.method = "
-                          f"\"fluxratio\" only so far (the method is {cfg.caustics.method.value!r}); set "
-                          "sky.model = \"none\"")
+    method = cfg.caustics.method
+    if method not in (CausticsMethod.FLUXRATIO, CausticsMethod.PHOTONS, CausticsMethod.BEAMS,
+                      CausticsMethod.BOTH):
+        raise ConfigError(f"sky.model = {sky.model.value!r} is integrated by the flux-ratio map, photons and "
+                          f"beams only so far (the method is {method.value!r}); set sky.model = \"none\"")
+    if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH) and (
+            cfg.caustics.intersection is Intersection.NEWTON):
+        raise ConfigError("sky.model with caustics.intersection = \"newton\": the Newton guesses come from "
+                          "the sun's light view, not the sky's; set caustics.intersection = \"exact\"")
     if sky.diffuse_fraction <= 0.0:
         raise ConfigError(f"sky.model = {sky.model.value!r} with sky.diffuse_fraction = 0 has no light; set "
                           "sky.diffuse_fraction (e.g. 0.15) or sky.model = \"none\"")

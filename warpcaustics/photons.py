@@ -263,6 +263,13 @@ class PhotonCaustics:
         )
         return self.irradiance
 
+    def set_light(self, directions: np.ndarray, irradiance: np.ndarray) -> None:
+        """Emit the next :meth:`run`'s photons with ``directions`` (D, 3) taken in turn (the sun's
+        disk, or one sky direction) carrying ``irradiance`` (K,) on a plane perpendicular to them
+        [W m⁻² nm⁻¹]; the renderer adds the passes up."""
+        self.sun_dirs = wp.array(np.asarray(directions, np.float32), dtype=wp.vec3, device=self.device)
+        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
+
     def transmitted_flux(self) -> np.ndarray:
         """(K,) flux the photons carry into the water before attenuation [W nm^-1] (float64)."""
         w = self.weight.numpy().astype(np.float64).reshape(self.groups, -1).sum(axis=1)

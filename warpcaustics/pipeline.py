@@ -276,6 +276,15 @@ class Renderer:
             self.approximate = None
             self.sky_directions = None
             self.multiple = None
+            if cfg.sky.model is not SkyModel.NONE:
+                self.sky_directions, shares = scene.sky_directions()
+                sky = scene.sky_irradiance(self.sun_irradiance)
+                self.sky_irradiance_np = [sky * w for w in shares]
+                """Per sky direction: its irradiance on a plane perpendicular to it (K,)."""
+                self.sky_irradiance_per_dir = [
+                    wp.array(e.astype(np.float32), dtype=wp.float32, device=self.device)
+                    for e in self.sky_irradiance_np]
+                self.sky_visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
@@ -291,8 +300,10 @@ class Renderer:
                                                           disk_dirs=scene.sun_disk_directions())
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
-                    photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, scene.sun_direction,
-                                                      self.group_ior)
+                    lights = [scene.sun_direction] + list(self.sky_directions if self.sky_directions
+                                                          is not None else [])
+                    for light in lights:
+                        photons.check_meshes_inside_patch(cfg, scene.receiver_meshes, light, self.group_ior)
                 self.camera = None
                 if cfg.camera.enabled:
                     check_camera_position(cfg, scene.floor_relief, self.water.periodic)
@@ -310,13 +321,6 @@ class Renderer:
                     self.multiple = MultipleScattering(cfg, scene.sun_direction, float(self.group_ior[0]),
                                                        self.sun_irradiance, optics.absorption_per_m,
                                                        optics.scattering_per_m, self.device)
-                if cfg.sky.model is not SkyModel.NONE:
-                    self.sky_directions, shares = scene.sky_directions()
-                    sky = scene.sky_irradiance(self.sun_irradiance)
-                    self.sky_irradiance_per_dir = [
-                        wp.array((sky * w).astype(np.float32), dtype=wp.float32, device=self.device)
-                        for w in shares]
-                    self.sky_visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
                 self.sun_directions = scene.sun_disk_directions()  # the centre alone for a point sun
                 disk_share = self.sun_irradiance / len(self.sun_directions)
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
@@ -370,7 +374,7 @@ class Renderer:
                     f"surface reaches down to z = {lowest:.3f} m at t = {time_s:g} s); viewing from "
                     "above the water is not implemented yet: lower the camera")
             stages = [st for st in (self.beams, self.photons) if st is not None]
-            outputs = [self._receiver_stage(st, surface, visible, watch) for st in stages]
+            outputs = [self._receiver_stage(st, surface, visible, highest, watch) for st in stages]
             floor_np, transmitted, extra = outputs[0]
         else:
             # A sun disk: one refraction and deposit per direction over it, each with an equal
@@ -454,23 +458,40 @@ class Renderer:
             flux = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
         return floor, flux
 
-    def _receiver_stage(self, stage, surface, visible, watch) -> tuple[np.ndarray, np.ndarray, dict]:
-        """Run the photon or beam stage (and the camera with it): (floor map, transmitted flux, the
-        RenderResult fields of receivers and camera), all on the host. Beams under a sun disk run
-        once per direction over it and average the passes (the photons take the directions in
-        turn inside one pass); their counts add up over the passes."""
+    def _light_passes(self, photons: bool) -> list[tuple[np.ndarray, np.ndarray, bool]]:
+        """The passes of a photon or beam stage: (directions (D, 3), irradiance (K,) on a plane
+        perpendicular to them, from the sky). Photons take the sun disk's directions in turn in one
+        pass; beams run a pass per direction with its share of the sun. Each sky direction is a
+        pass with its share of the sky."""
+        dirs = self.scene.sun_disk_directions()
+        if photons:
+            passes = [(dirs, self.sun_irradiance, False)]
+        else:
+            passes = [(d[None], self.sun_irradiance / len(dirs), False) for d in dirs]
+        if self.sky_directions is not None:
+            passes += [(d[None], e, True) for d, e in zip(self.sky_directions, self.sky_irradiance_np)]
+        return passes
+
+    def _receiver_stage(self, stage, surface, visible, highest, watch) -> tuple[np.ndarray, np.ndarray, dict]:
+        """Run the photon or beam stage (and the camera with it) over its light passes
+        (:meth:`_light_passes`): (floor map, transmitted flux, the RenderResult fields of receivers,
+        camera and sky), all on the host. Counts add up over the passes."""
         cfg = self.scene.config
         photons = stage is self.photons
-        directions = self.scene.sun_disk_directions() if not photons else self.scene.sun_direction[None]
         rec = self.receivers
         other = rec.face_count - rec.floor_face_count
-        total: dict[str, np.ndarray] = {}
+        totals: dict[bool, dict[str, np.ndarray]] = {False: {}, True: {}}
         extra = {}
-        for direction in directions:
-            if not photons:
-                stage.set_sun_direction(direction)
+        passes = self._light_passes(photons)
+        for directions, irradiance, from_sky in passes:
+            stage.set_light(directions, irradiance)
+            if from_sky:
+                with watch.stage("sky"):
+                    seen = sun_visibility(surface, directions[0], highest, self.device, out=self.sky_visible)
+            else:
+                seen = visible  # crests shade by the sun's centre
             with watch.stage("photons" if photons else "beams"):
-                floor = stage.run(surface, visible)
+                floor = stage.run(surface, seen)
             part = {}
             if self.camera is not None:
                 with watch.stage("camera" if photons or self.photons is None else "camera_beams"):
@@ -487,16 +508,20 @@ class Renderer:
                 part["face_flux_w_nm"] = (stage.face_flux.numpy()[:other].astype(np.float64) if photons
                                           else stage.face_flux_w_nm())
                 counts = vars(stage.stats())
+            total = totals[from_sky]
             for key, value in part.items():
                 total[key] = total[key] + value if key in total else value
             stats_key = "photon_stats" if photons else "beam_stats"
             extra[stats_key] = {k: extra.get(stats_key, {}).get(k, 0) + v for k, v in counts.items()}
-        share = 1.0 / len(directions)  # each direction carries its share of the sun
-        floor_np = (total.pop("floor") * share).astype(np.float32)
-        transmitted = total.pop("transmitted") * share
-        extra["face_flux_w_nm"] = total.pop("face_flux_w_nm") * share
+        sun, sky = totals[False], totals[True]
+        combined = {key: sun[key] + sky[key] if key in sky else sun[key] for key in sun}
+        floor_np = combined["floor"].astype(np.float32)
+        transmitted = combined["transmitted"]
+        extra["face_flux_w_nm"] = combined["face_flux_w_nm"]
+        if sky:
+            extra["sky_floor_irradiance"] = sky["floor"].astype(np.float32)
         if self.camera is not None:
-            extra["camera_radiance"] = (total.pop("camera_radiance") * share).astype(np.float32)
+            extra["camera_radiance"] = combined["camera_radiance"].astype(np.float32)
             extra["camera_gbuffer"] = self.camera.gbuffer()
         with watch.stage("readback"):
             extra.update(face_receiver=rec.face_receiver_np[rec.floor_face_count:],
