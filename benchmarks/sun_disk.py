@@ -4,7 +4,8 @@ map and by the photons, same run.
 For the flux-ratio map the disk costs one refraction and one deposit per direction over it, so the
 frame's caustic stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky
 over as many directions adds as many passes, each with its own crest-shading march. The photons
-take the disk's directions in turn, one per photon, so their disk should cost nothing. Median of a
+take the disk's directions in turn, one per photon, so their disk should cost nothing; their sky
+is a photon pass per sky direction. Median of a
 few frames after a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
 """
 
@@ -30,6 +31,8 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         ("photons_point", {"caustics.method": "photons"}),
         ("photons_disk", {"caustics.method": "photons", "sun.angular_diameter_deg": 0.53,
                           "sun.disk_samples": samples}),
+        ("photons_sky", {"caustics.method": "photons", "sky.model": "uniform", "sky.diffuse_fraction": 0.2,
+                         "sky.directions": samples}),
     )
     for name, extra in cases:
         scene = wc.load_scene(
@@ -50,6 +53,8 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         "photons_point_frame_s": rows["photons_point"],
         "photons_disk_frame_s": rows["photons_disk"],
         "photons_disk_over_point": rows["photons_disk"] / rows["photons_point"],
+        "photons_sky_frame_s": rows["photons_sky"],
+        "photons_sky_over_point": rows["photons_sky"] / rows["photons_point"],
     }
 
 
@@ -68,7 +73,8 @@ def run(quick: bool, device: str) -> dict:
             f"disk / point {row['disk_over_point']:5.1f}x | sky {row['sky_frame_s'] * 1e3:8.1f} ms | "
             f"sky / point {row['sky_over_point']:5.1f}x | photons: point "
             f"{row['photons_point_frame_s'] * 1e3:8.1f} ms, "
-            f"disk / point {row['photons_disk_over_point']:5.2f}x",
+            f"disk / point {row['photons_disk_over_point']:5.2f}x, "
+            f"sky / point {row['photons_sky_over_point']:5.1f}x",
             flush=True,
         )
     return {
