@@ -137,8 +137,8 @@ class SpectralBins:
 
 def spectral_distribution(wavelength_nm: np.ndarray, values: np.ndarray, name: str):
     """A table as a ``colour.SpectralDistribution`` interpolated linearly between its points (the
-    sources' own resolution, nothing invented between them). colour-science's default for regular
-    tables (Sprague) would overshoot at the sharp features of water absorption."""
+    sources' own resolution, nothing invented between them; colour-science's default for regular
+    tables, Sprague, is a higher-order polynomial that can overshoot between the points)."""
     import colour
 
     return colour.SpectralDistribution(
