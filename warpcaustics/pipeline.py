@@ -196,6 +196,7 @@ def scene_bytes(scene: Scene) -> int:
     n = scene.water_resolution
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
+    sky = n * n * 4 if cfg.sky.model is not SkyModel.NONE else 0  # its shading buffer
     if cfg.caustics.method.uses_receivers:
         periodic = cfg.water.periodic
         faces = receiver_face_estimate(scene, periodic)
@@ -207,11 +208,10 @@ def scene_bytes(scene: Scene) -> int:
             stage += beams.beams_bytes(cfg, n, k, groups, periodic, faces, sampled)
         if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
             stage += photons.photons_bytes(cfg, n, k, groups, periodic, faces)
-        return water_bytes(cfg, n) + stage + cam
+        return water_bytes(cfg, n) + stage + cam + sky
     m = cfg.caustics.map_resolution
     extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4,
              CausticsMethod.WAVE3D: wave3d_bytes(cfg) + k * m * m * 4}
-    sky = n * n * 4 if cfg.sky.model is not SkyModel.NONE else 0  # its shading buffer
     return (water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sky
             + extra.get(cfg.caustics.method, 0))
 
