@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -364,7 +364,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
 
     import warpcaustics as wc
 
-    scene = wc.load_scene(
+    scene = point_sun_scene(
         ROOT / "configs" / "ocean.toml",
         {
             "caustics.method": "beams",
@@ -558,7 +558,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     import warpcaustics as wc
     from warpcaustics.beams import SCREEN_TILE_PIXELS
 
-    scene = wc.load_scene(
+    scene = point_sun_scene(
         ROOT / "configs" / "ocean_floor.toml",
         {
             "caustics.method": "beams",
@@ -641,7 +641,7 @@ def _stage_time(n: int, m: int, device: str, repeats: int) -> dict:
 
     import warpcaustics as wc
 
-    scene = wc.load_scene(
+    scene = point_sun_scene(
         ROOT / "configs" / "ocean.toml",
         {
             "caustics.method": "beams",
@@ -683,7 +683,7 @@ def _adaptive_rows(config: str, overrides: dict, levels: int, device: str, repea
     cases = ([(0, 0.0)] + [(levels, t) for t in (0.05, 0.1, 0.25, 0.5, 1.0)]
              + [(lv, 1e30) for lv in range(1, levels + 1)])
     for lv, tol in cases:
-        renderer = wc.Renderer(wc.load_scene(ROOT / "configs" / config, {
+        renderer = wc.Renderer(point_sun_scene(ROOT / "configs" / config, {
             **base, "caustics.beam_levels": lv, "caustics.beam_tolerance": tol}), device)
         renderer.render(0.0)  # warm-up
         s = median_time(lambda renderer=renderer: renderer.render(0.0), repeats)
@@ -708,7 +708,7 @@ def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str) -> list[d
 
     rows = []
     for depth in depths:
-        scene = wc.load_scene(ROOT / "configs" / "ocean_floor.toml", {
+        scene = point_sun_scene(ROOT / "configs" / "ocean_floor.toml", {
             "caustics.method": "beams", "water.resolution": n, "floor.shape": "flat",
             "floor.depth_m": depth,
             "camera.width": size[0], "camera.height": size[1], "caustics.shafts": False,

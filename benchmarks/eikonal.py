@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import time
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 FULL = [64, 128, 256]
 QUICK = [64]
@@ -27,13 +27,12 @@ MERCIER_TABLE1_S = {64: (0.3, 17.0), 128: (2.5, 21.0), 256: (26.0, 107.0)}
 
 
 def measure(n: int, device: str, repeats: int) -> dict:
-    import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
     from warpcaustics.refraction import height_range
 
     from benchmarks.sunmap import flux_ratio_pass
 
-    scene = wc.load_scene("configs/mercier_pool.toml", {
+    scene = point_sun_scene("configs/mercier_pool.toml", {
         "caustics.eikonal_resolution": n, "water.resolution": n, "caustics.map_resolution": 2 * n})
     renderer = Renderer(scene, device)
     renderer.render(TIME_S)  # warm-up: JIT compile, first launches; the pool is now at TIME_S
@@ -57,11 +56,10 @@ def _wave(n: int, device: str) -> dict:
     """One wave3d frame at N (timed once: at 256 it takes minutes on a CPU)."""
     import warp as wp
 
-    import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
     from warpcaustics.refraction import height_range
 
-    scene = wc.load_scene("configs/mercier_pool.toml", {
+    scene = point_sun_scene("configs/mercier_pool.toml", {
         "caustics.method": "wave3d", "caustics.wave3d_resolution": n, "water.resolution": n,
         "caustics.map_resolution": 2 * n})
     renderer = Renderer(scene, device)

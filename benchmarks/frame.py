@@ -10,15 +10,16 @@ from __future__ import annotations
 import resource
 import time
 
+from benchmarks.run import point_sun_scene
+
 
 def _rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
 
 
 def _scene(n: int, m: int, bins: int):
-    import warpcaustics as wc
 
-    return wc.load_scene("configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m,
+    return point_sun_scene("configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m,
                                                 "optics.wavelengths.bins": bins})
 
 

@@ -9,20 +9,19 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 FULL = [(128, 4), (256, 4)]
 QUICK = [(64, 4)]
 
 
 def measure(n: int, samples: int, device: str, repeats: int) -> dict:
-    import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
     from warpcaustics.refraction import height_range
 
     from benchmarks.sunmap import flux_ratio_pass
 
-    scene = wc.load_scene(
+    scene = point_sun_scene(
         "configs/ocean.toml",
         {
             "water.resolution": n,

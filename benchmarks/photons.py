@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -230,12 +230,11 @@ def relative_l1(reference: np.ndarray, other: np.ndarray) -> float:
 
 
 def photon_scene(n: int, s: int, m: int, intersection: str, wavelengths=WAVELENGTHS):
-    import warpcaustics as wc
 
-    return wc.load_scene(ROOT / "configs" / "ocean.toml", {
+    return point_sun_scene(ROOT / "configs" / "ocean.toml", {
         "caustics.method": "photons", "caustics.intersection": intersection,
         "caustics.photon_subdivisions": s, "caustics.map_resolution": m, "water.resolution": n,
-        "optics.wavelengths": wavelengths})
+        "optics.wavelengths": wavelengths, "sun.angular_diameter_deg": 0.0})  # the numpy twin's point sun
 
 
 class PhotonCase:
@@ -292,7 +291,7 @@ def _camera_frames(quick: bool, device: str) -> list[dict]:
             if read_toml(path).get("camera", {}).get("enabled") is not True:
                 continue
             overrides = QUICK_CAMERA if quick else {}
-            scene = wc.load_scene(path, overrides)
+            scene = point_sun_scene(path, overrides)
             renderer = wc.Renderer(scene, device)
             renderer.render(0.0)  # warm-up: JIT compile, first allocations
             t0 = time.perf_counter()

@@ -32,6 +32,15 @@ STEPS = [("ocean_step", "FFT ocean step, choppy (4 complex 2-D FFTs)", [64, 128,
           [64, 128, 256, 512, 1024], [64, 128])]
 
 
+def point_sun_scene(path, overrides: dict | None = None):
+    """``warpcaustics.load_scene`` with a point sun (``sun.angular_diameter_deg = 0``) unless the
+    overrides set a disk: the numpy twins and the figures recorded in docs/ are a point sun's,
+    while the default sun is the 0.53° disk."""
+    import warpcaustics as wc
+
+    return wc.load_scene(path, {"sun.angular_diameter_deg": 0.0, **(overrides or {})})
+
+
 def median_time(func, repeats: int, device: str | None = None) -> float:
     """Median wall time [s] of ``repeats`` calls of ``func``; with ``device``, each call ends by
     synchronising it (Warp launches are asynchronous on CUDA)."""

@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 FULL = (256, 512, (8, 16, 32))
 QUICK = (128, 256, (8,))
 
 
 def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
-    import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
 
     rows = {}
@@ -35,7 +34,7 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
                          "sky.directions": samples}),
     )
     for name, extra in cases:
-        scene = wc.load_scene(
+        scene = point_sun_scene(
             "configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m, **extra}
         )
         renderer = Renderer(scene, device)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time
+from benchmarks.run import median_time, point_sun_scene
 
 FULL = [(256, 512), (512, 1024)]
 QUICK = [(128, 256)]
@@ -20,9 +20,8 @@ SCENES = ("configs/ocean.toml", "configs/procedural.toml")
 
 def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     """Times of the two floor maps of one frame (the water surface is computed once, outside)."""
-    import warpcaustics as wc
     from warpcaustics.pipeline import Renderer
-    scene = wc.load_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
+    scene = point_sun_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
                                    "caustics.map_resolution": m})
     renderer = Renderer(scene, device)
     result = renderer.render(0.5)  # warm-up: JIT compile, first launches

@@ -29,6 +29,7 @@ base = "{base}"
 [set]
 "water.resolution" = {n}
 "caustics.map_resolution" = {m}
+"sun.angular_diameter_deg" = 0.0
 "optics.wavelengths" = {{ min_nm = 400.0, max_nm = 700.0, bins = {k} }}
 [grid]
 "floor.depth_m" = {depths}

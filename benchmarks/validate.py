@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.run import point_sun_scene
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
@@ -68,7 +70,7 @@ def main() -> int:
     print("\n## Oblique sun on the lens (elevation 45°, azimuth 30°, floor 1.0 m)")
     with tempfile.TemporaryDirectory() as tmp:
         np.save(Path(tmp) / "lens.npy", h)
-        scene = wc.load_scene(None, {
+        scene = point_sun_scene(None, {
             "water.model": "heightfield", "water.file": str(Path(tmp) / "lens.npy"),
             "water.extent_m": EXTENT_M, "floor.depth_m": 1.0, "sun.elevation_deg": 45.0,
             "sun.azimuth_deg": 30.0, "optics.water_type": "none", "optics.wavelengths.bins": 1,
@@ -82,7 +84,7 @@ def main() -> int:
           f"distance {np.hypot(cx - ex, cy - ey) * 1000:.1f} mm (texel {EXTENT_M / N * 1000:.1f} mm)")
 
     print("\n## Shading by crests: steep sea, sun 10° high (64², water_type none)")
-    scene = wc.load_scene(None, {"water.model": "fft", "water.resolution": 64, "water.extent_m": 8.0,
+    scene = point_sun_scene(None, {"water.model": "fft", "water.resolution": 64, "water.extent_m": 8.0,
                                  "water.wind_speed_m_s": 5.0, "water.phillips_amplitude": 0.05,
                                  "floor.depth_m": 20.0, "caustics.map_resolution": 64,
                                  "sun.elevation_deg": 10.0, "optics.water_type": "none",
@@ -194,7 +196,7 @@ def _wave_depths() -> None:
 
     print("\n## Wave texture on still water, 15° sun, 48 nodes across 4 m: floor / flux-ratio floor")
     for depth in (1.5, 6.0, 12.0):
-        r = wc.render(wc.load_scene(None, {
+        r = wc.render(point_sun_scene(None, {
             "caustics.method": "wave3d", "water.model": "flat", "water.extent_m": 4.0, "water.resolution": 64,
             "caustics.map_resolution": 64, "caustics.wave3d_resolution": 48, "sun.elevation_deg": 15.0,
             "sun.azimuth_deg": 25.0, "floor.depth_m": depth,
@@ -236,7 +238,8 @@ def _approximate_methods() -> None:
               "configs/mercier_pool.toml": ({}, 0.3, APPROXIMATE)}
     for label, (overrides, time_s, methods) in scenes.items():
         config = label.split(",")[0]
-        rows = compare_methods(ROOT / config, overrides, time_s, "cpu", methods)["rows"]
+        rows = compare_methods(ROOT / config, {"sun.angular_diameter_deg": 0.0, **overrides}, time_s, "cpu",
+                               methods)["rows"]
         reference = rows[0]["contrast"]
         for r in rows[1:]:
             print(f"{label:37s} {r['method']:8s} correlation {r['correlation']:6.3f}  relative L1 "
@@ -264,13 +267,13 @@ def _photons() -> None:
         print(f"{mode:6s}: max relative error over elevations 20°, 55°, 90° and all texels {worst:.1e}")
 
     print("\n## Photon flux conservation (water_type = none)")
-    r = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", {
+    r = wc.render(point_sun_scene(ROOT / "configs" / "ocean.toml", {
         **PHOTONS, "water.resolution": 64, "water.wind_speed_m_s": 9.0, "water.choppiness": 0.8,
         "caustics.map_resolution": 48, "optics.water_type": "none", "optics.wavelengths": "rgb"}),
         device="cpu")
     print(f"rough choppy ocean: floor / transmitted - 1 = "
           f"{np.abs(r.floor_flux_w_nm / r.transmitted_flux_w_nm - 1).max():.1e}")
-    r = wc.Renderer(wc.load_scene(ROOT / "configs" / "pool.toml", {
+    r = wc.Renderer(point_sun_scene(ROOT / "configs" / "pool.toml", {
         **PHOTONS, "water.resolution": 48, "caustics.map_resolution": 48, "optics.water_type": "none",
         "optics.wavelengths": "rgb", "sun.elevation_deg": 40.0,
         "receivers": [{"mesh": "sphere", "scale": 0.8, "translate_m": [0.3, -0.2, -1.0]}]}),
@@ -295,9 +298,9 @@ def _photons() -> None:
     print("\n## Photons vs the flux-ratio map, configs/ocean.toml (256² surface, rgb)")
     for m in (64, 128):
         base = {"caustics.map_resolution": m, "optics.wavelengths": "rgb"}
-        ref = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", base), device="cpu").floor_irradiance
+        ref = wc.render(point_sun_scene(ROOT / "configs" / "ocean.toml", base), device="cpu").floor_irradiance
         for s in (1, 2, 4):
-            f = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml", {
+            f = wc.render(point_sun_scene(ROOT / "configs" / "ocean.toml", {
                 **base, **PHOTONS, "caustics.photon_subdivisions": s}), device="cpu").floor_irradiance
             per_texel = 256 * 256 * s * s / m / m
             print(f"map {m}², {s * s:2d} photons per cell ({per_texel:5.0f} per texel): relative L1 "
@@ -357,12 +360,12 @@ def _beams() -> None:
     print("\n## Beam floor map, configs/ocean.toml (128² surface, 64² map, rgb)")
     base = {"water.resolution": 128, "caustics.map_resolution": 64, "optics.wavelengths": "rgb"}
     ocean = ROOT / "configs" / "ocean.toml"
-    ref = wc.render(wc.load_scene(ocean, base), device="cpu").floor_irradiance
+    ref = wc.render(point_sun_scene(ocean, base), device="cpu").floor_irradiance
     for interp in ("flat", "smooth"):
-        b = wc.render(wc.load_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp,
+        b = wc.render(point_sun_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp,
                                             "optics.water_type": "none"}), device="cpu")
         flux = np.abs(b.floor_flux_w_nm / b.transmitted_flux_w_nm - 1).max()
-        f = wc.render(wc.load_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp}),
+        f = wc.render(point_sun_scene(ocean, {**base, **BEAMS, "caustics.beam_interpolation": interp}),
                       device="cpu").floor_irradiance
         print(f"{interp:6s}: flux (water_type none) floor / transmitted - 1 = {flux:.1e}; pure water, "
               f"relative L1 vs the flux-ratio map {np.abs(f - ref).sum() / np.abs(ref).sum():.1e}")
@@ -372,9 +375,9 @@ def _beams() -> None:
     base = {"water.resolution": 128, "caustics.map_resolution": 32, "optics.wavelengths": "rgb",
             "optics.water_type": "none",
             "receivers": [{"mesh": "sphere", "scale": 2.0, "translate_m": centre}]}
-    ph = wc.render(wc.load_scene(ocean, {**base, "caustics.method": "photons",
+    ph = wc.render(point_sun_scene(ocean, {**base, "caustics.method": "photons",
                                          "caustics.photon_subdivisions": 4}), device="cpu")
-    bm = wc.render(wc.load_scene(ocean, {**base, **BEAMS}), device="cpu")
+    bm = wc.render(point_sun_scene(ocean, {**base, **BEAMS}), device="cpu")
     floor_l1 = np.abs(bm.floor_irradiance - ph.floor_irradiance).sum() / np.abs(ph.floor_irradiance).sum()
     sb, sp = _sphere_bins(bm, 2, centre), _sphere_bins(ph, 2, centre)
     total = bm.floor_flux_w_nm + bm.face_flux_w_nm.sum(axis=0)
@@ -387,15 +390,15 @@ def _beams() -> None:
            "optics.wavelengths": "rgb", "floor.shape": "ripples", "floor.ripple_amplitude_m": 0.1,
            "floor.ripple_wavelength_m": 16.0 / np.hypot(7, 26),
            "floor.ripple_direction_deg": np.degrees(np.arctan2(26, 7))}
-    bm = wc.render(wc.load_scene(ocean, {**rip, **BEAMS}), device="cpu")
+    bm = wc.render(point_sun_scene(ocean, {**rip, **BEAMS}), device="cpu")
     for s in (8, 16):
-        ph = wc.render(wc.load_scene(ocean, {**rip, "caustics.method": "photons",
+        ph = wc.render(point_sun_scene(ocean, {**rip, "caustics.method": "photons",
                                              "caustics.photon_subdivisions": s}), device="cpu")
         l1 = np.abs(bm.floor_irradiance - ph.floor_irradiance).sum() / ph.floor_irradiance.sum()
         print(f"vs exact photons at {s * s} per cell: relative L1 {l1:.2%}; beams floor / transmitted - 1 = "
               f"{(bm.floor_flux_w_nm / bm.transmitted_flux_w_nm - 1).max():.1e}")
     for el in (20.0, 5.0):
-        low = wc.render(wc.load_scene(ocean, {**rip, **BEAMS, "sun.elevation_deg": el}), device="cpu")
+        low = wc.render(point_sun_scene(ocean, {**rip, **BEAMS, "sun.elevation_deg": el}), device="cpu")
         print(f"sun {el:g}° high: beams floor / transmitted - 1 = "
               f"{(low.floor_flux_w_nm / low.transmitted_flux_w_nm - 1).max():.1e}")
 

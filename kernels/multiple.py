@@ -27,7 +27,6 @@ TALLIES = 6
 
 @wp.struct
 class Walk:
-    sun_dir: wp.vec3
     eta: float
     """n_air / n_water."""
     floor_z: float
@@ -77,6 +76,7 @@ def random_walk(
     positions: wp.array2d[wp.vec3],
     normals: wp.array2d[wp.vec3],
     visible: wp.array2d[wp.float32],
+    sun_dirs: wp.array[wp.vec3],
     sun_irradiance: wp.array[wp.float32],
     absorption_per_m: wp.array[wp.float32],
     scattering_per_m: wp.array[wp.float32],
@@ -84,7 +84,9 @@ def random_walk(
     floor_texels: wp.array3d[wp.float32],
     tallies: wp.array2d[wp.float64],
 ):
-    """One photon in band b from sub-sample q of surface cell (iy, ix) of a periodic sea."""
+    """One photon in band b from sub-sample q of surface cell (iy, ix) of a periodic sea. With a
+    sun disk the photons of the surface take its directions ``sun_dirs`` in turn (a point sun is
+    one direction)."""
     b, iy, ix, q = wp.tid()
     n = positions.shape[0]
     m = floor_texels.shape[0]
@@ -104,8 +106,9 @@ def random_walk(
     lit = ((1.0 - tv) * ((1.0 - tu) * visible[iy, ix] + tu * visible[iy, ix1])
            + tv * ((1.0 - tu) * visible[iy1, ix] + tu * visible[iy1, ix1]))
     pos = wp.vec3(xy[0] + tu * cell, xy[1] + tv * cell, z)
-    cos_i = wp.dot(nrm, walk.sun_dir)
-    d, transmitted = sun_into_water(nrm, walk.sun_dir, walk.eta)
+    sun_dir = sun_dirs[((iy * n + ix) * s * s + q) % sun_dirs.shape[0]]
+    cos_i = wp.dot(nrm, sun_dir)
+    d, transmitted = sun_into_water(nrm, sun_dir, walk.eta)
     weight = sun_irradiance[b] * wp.max(cos_i, 0.0) * transmitted * lit * cell * cell / (
         float(s * s) * nrm[2])
     if weight <= 0.0:

@@ -28,6 +28,7 @@ def _flat(elevation_deg, depth_m, water_type="pure", **extra):
         "caustics.map_resolution": 32,
         "sun.elevation_deg": elevation_deg,
         "sun.azimuth_deg": 37.0,
+        "sun.angular_diameter_deg": 0.0,  # the analytic references are a point sun's
         "floor.depth_m": depth_m,
         "optics.water_type": water_type,
         "optics.wavelengths.bins": 8,

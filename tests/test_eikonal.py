@@ -19,7 +19,8 @@ def _flat(elevation, model="flat", **extra):
     overrides = {"caustics.method": "eikonal", "water.model": model, "water.extent_m": 4.0,
                  "water.resolution": 64, "caustics.map_resolution": 64, "caustics.eikonal_resolution": 48,
                  "sun.elevation_deg": elevation, "sun.azimuth_deg": 25.0, "optics.ior": IOR,
-                 "floor.depth_m": 1.5, "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2}}
+                 "floor.depth_m": 1.5, "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2},
+                 "sun.angular_diameter_deg": 0.0}  # the references are a point sun's
     overrides.update(extra)
     return wc.load_scene(None, overrides)
 

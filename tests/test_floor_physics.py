@@ -13,7 +13,7 @@ def _flat_scene(elevation_deg, depth_m, water_type="pure", **extra):
     overrides = {"water.model": "flat", "water.resolution": 32, "water.extent_m": 8.0,
                  "caustics.map_resolution": 48, "sun.elevation_deg": elevation_deg,
                  "sun.azimuth_deg": 37.0, "floor.depth_m": depth_m, "optics.water_type": water_type,
-                 "optics.wavelengths.bins": 8}
+                 "optics.wavelengths.bins": 8, "sun.angular_diameter_deg": 0.0}  # a point sun's references
     overrides.update(extra)
     return wc.load_scene(None, overrides)
 
@@ -48,7 +48,8 @@ def _rough_ocean(**extra):
     overrides = {"water.model": "fft", "water.resolution": 64, "water.extent_m": 8.0,
                  "water.wind_speed_m_s": 5.0, "water.phillips_amplitude": 4e-3, "floor.depth_m": 6.0,
                  "caustics.map_resolution": 96, "sun.elevation_deg": 55.0, "sun.azimuth_deg": 20.0,
-                 "optics.water_type": "none", "optics.wavelengths.bins": 4, "water.seed": 3}
+                 "optics.water_type": "none", "optics.wavelengths.bins": 4, "water.seed": 3,
+                 "sun.angular_diameter_deg": 0.0}  # the numpy reference is a point sun's
     overrides.update(extra)
     return wc.load_scene(None, overrides)
 

@@ -31,7 +31,8 @@ def _central_gain(lens_file, depth_m, device):
     scene = wc.load_scene(None, {
         "water.model": "heightfield", "water.file": str(lens_file), "water.extent_m": EXTENT_M,
         "floor.depth_m": float(depth_m), "sun.elevation_deg": 90.0, "optics.water_type": "none",
-        "optics.ior": IOR, "optics.wavelengths.bins": 1, "caustics.map_resolution": N})
+        "optics.ior": IOR, "optics.wavelengths.bins": 1, "caustics.map_resolution": N,
+        "sun.angular_diameter_deg": 0.0})  # paraxial optics of a point sun
     floor = wc.render(scene, device=device).floor_irradiance[0].astype(np.float64)
     centre = floor[N // 2 - 1:N // 2 + 1, N // 2 - 1:N // 2 + 1].mean()
     return centre / floor[0, 0]
@@ -63,7 +64,7 @@ def test_oblique_sun_moves_the_focus_away_from_the_sun(lens_file, device):
         "water.model": "heightfield", "water.file": str(lens_file), "water.extent_m": EXTENT_M,
         "floor.depth_m": depth, "sun.elevation_deg": elevation, "sun.azimuth_deg": azimuth,
         "optics.water_type": "none", "optics.ior": IOR, "optics.wavelengths.bins": 1,
-        "caustics.map_resolution": N})
+        "caustics.map_resolution": N, "sun.angular_diameter_deg": 0.0})
     floor = wc.render(scene, device=device).floor_irradiance[0].astype(np.float64)
     background = np.median(floor)
     spot = np.where(floor > 2.0 * background, floor, 0.0)  # the concentrated light only

@@ -10,7 +10,7 @@ from warpcaustics.errors import ConfigError
 
 from conftest import fresnel_t_angles
 
-BASE = {"water.resolution": 64, "optics.wavelengths": "rgb"}
+BASE = {"water.resolution": 64, "optics.wavelengths": "rgb", "sun.angular_diameter_deg": 0.0}
 
 
 @pytest.mark.parametrize("centre", [(2.0, -3.0), (7.5, 0.0)])

@@ -75,7 +75,8 @@ def contrast_without_noise(scene_overrides: dict) -> tuple[np.ndarray, np.ndarra
     maps = []
     for seed in (1, 2):
         r = wc.render(
-            wc.load_scene("configs/ocean.toml", {**scene_overrides, "optics.mc_seed": seed}), device="cpu"
+            wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 0.0, **scene_overrides,
+                                                 "optics.mc_seed": seed}), device="cpu"
         )
         maps.append(r.floor_irradiance.astype(np.float64))
     single = r.comparison.floor_irradiance.astype(np.float64)

@@ -24,6 +24,7 @@ def _flat(elevation_deg, depth_m, water_type="pure", **extra):
         "caustics.photon_subdivisions": 2,
         "sun.elevation_deg": elevation_deg,
         "sun.azimuth_deg": 37.0,
+        "sun.angular_diameter_deg": 0.0,  # the analytic references are a point sun's
         "floor.depth_m": depth_m,
         "optics.water_type": water_type,
         "optics.wavelengths.bins": 8,
@@ -117,6 +118,7 @@ def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
         "caustics.map_resolution": 64,
         "optics.wavelengths": "rgb",
         "caustics.photon_subdivisions": 2,
+        "sun.angular_diameter_deg": 0.0,  # Newton's guesses come from the sun's centre
         **overrides,
     }
     exact = wc.Renderer(wc.load_scene(config, {**base, "caustics.intersection": "exact"}), device)
@@ -261,6 +263,7 @@ def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
         "floor.albedo": 0.5,
         "caustics.map_resolution": 64,
         "sun.elevation_deg": 90.0,
+        "sun.angular_diameter_deg": 0.0,  # the analytic shafts are a point sun's
         "optics.water_type": "clear_ocean",
         "optics.wavelengths": "rgb",
         "camera.enabled": True,
@@ -397,6 +400,7 @@ def test_mesh_files_and_spectral_albedo_files(tmp_path):
             "caustics.photon_subdivisions": 2,
             "sun.elevation_deg": 50.0,
             "sun.azimuth_deg": 37.0,
+            "sun.angular_diameter_deg": 0.0,  # as _flat's
             "floor.depth_m": 3.0,
             "optics.water_type": "none",
             "optics.wavelengths.bins": 8,

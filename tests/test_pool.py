@@ -180,7 +180,8 @@ def test_walled_pool_floor_flux(device):
         scene = wc.load_scene(None, {"water.model": "pool", "water.resolution": 32, "water.extent_m": 2.0,
                                      "floor.depth_m": DEPTH_M, "sun.elevation_deg": elevation,
                                      "sun.azimuth_deg": azimuth, "optics.water_type": "none",
-                                     "caustics.map_resolution": 40, "optics.wavelengths.bins": 1})
+                                     "caustics.map_resolution": 40, "optics.wavelengths.bins": 1,
+                                     "sun.angular_diameter_deg": 0.0})  # the overlap is a point sun's
         result = wc.render(scene, device=device)
         theta = np.radians(90.0 - elevation)
         theta_t = np.arcsin(np.sin(theta) / 1.333)

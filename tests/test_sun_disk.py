@@ -167,7 +167,7 @@ def test_grid_methods_move_their_map_by_the_disk_parallax(focus_maps):
                  for m in (moved, disk_map)]
         assert radii[0] == pytest.approx(radii[1], abs=2.0 / 2048), share
     ocean = {"water.resolution": 64, "caustics.map_resolution": 64, "caustics.method": "eikonal",
-             "optics.wavelengths": "rgb"}
+             "optics.wavelengths": "rgb", "sun.angular_diameter_deg": 0.0}
     point = wc.render(wc.load_scene("configs/ocean.toml", ocean), device="cpu").floor_irradiance
     disk = wc.render(wc.load_scene("configs/ocean.toml", {**ocean, "sun.angular_diameter_deg": 0.53}),
                      device="cpu").floor_irradiance
@@ -175,10 +175,12 @@ def test_grid_methods_move_their_map_by_the_disk_parallax(focus_maps):
     assert np.abs(disk - point).max() > 0.0
 
 
-def test_disk_with_the_sun_map_is_refused():
-    """The sun map draws the disk itself (caustics.sunmap_disk_deg): a second disk is refused."""
+def test_the_sun_maps_disk_must_be_the_suns():
+    """The sun map draws the disk itself (caustics.sunmap_disk_deg): the default sun and the
+    default drawn disk agree; a different sun disk is refused naming both keys."""
+    wc.load_scene("configs/ocean.toml", {"caustics.method": "sunmap"})
     with pytest.raises(ConfigError, match="sunmap_disk_deg"):
-        wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 0.53, "caustics.method": "sunmap"})
+        wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 1.0, "caustics.method": "sunmap"})
 
 
 @pytest.mark.parametrize("periodic", [True, False])
@@ -213,3 +215,8 @@ def test_parallax_moves_a_map_as_still_water_displaces_light(periodic):
     kept = parallax_disk_average(edge, sun, np.stack([off, off]), n_w, depth, extent, periodic)[0].sum()
     assert 0.1 < expected[0] < 1.0
     assert kept == pytest.approx(1.0 if periodic else 1.0 - expected[0], rel=1e-12)
+
+
+def test_the_default_sun_is_the_real_suns_disk():
+    """DESIGN: 0.53° is the default once every method integrates the disk (they all do)."""
+    assert wc.load_scene(None).config.sun.angular_diameter_deg == 0.53

@@ -25,6 +25,7 @@ def _scene(**overrides):
         "caustics.map_resolution": 64,
         "optics.ior": IOR,
         "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2},
+        "sun.angular_diameter_deg": 0.0,  # the flux-ratio references are a point sun's
     }
     base.update(overrides)
     return wc.load_scene(None, base)

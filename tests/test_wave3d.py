@@ -17,7 +17,7 @@ def _scene(elevation=90.0, model="flat", **extra):
     overrides = {"caustics.method": "wave3d", "water.model": model, "water.extent_m": 4.0,
                  "water.resolution": 64, "caustics.map_resolution": 64, "caustics.wave3d_resolution": 48,
                  "sun.elevation_deg": elevation, "sun.azimuth_deg": 25.0, "optics.ior": IOR,
-                 "floor.depth_m": 1.5,
+                 "floor.depth_m": 1.5, "sun.angular_diameter_deg": 0.0,  # a point sun's references
                  "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2}}
     overrides.update(extra)
     return wc.load_scene(None, overrides)

@@ -288,7 +288,7 @@ class SunConfig:
     """Angle of the sun above the horizon [deg]."""
     azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction towards the sun, from +x towards +y [deg]."""
-    angular_diameter_deg: float = field(default=0.0, metadata=_range(0.0, 5.0))
+    angular_diameter_deg: float = field(default=0.53, metadata=_range(0.0, 5.0))
     """Angular diameter of the sun's disk [deg]: 0 = a point; 0.53 = the real sun, integrated over
     ``disk_samples`` directions (every method but ``sunmap``, which draws its own)."""
     disk_samples: int = field(default=16, metadata=_range(2, 1024))
@@ -814,8 +814,8 @@ def _check_scattering(cfg: Config) -> None:
         needs.append(f"caustics.method = \"fluxratio\" (not {cfg.caustics.method.value!r})")
     if not cfg.water.periodic:
         needs.append(f"a periodic sea (not water.model = {cfg.water.model.value!r})")
-    if cfg.sun.angular_diameter_deg or cfg.sky.model is not SkyModel.NONE or cfg.caustics.map_extent_m:
-        needs.append("no sun disk, sky or floor-map window")
+    if cfg.sky.model is not SkyModel.NONE or cfg.caustics.map_extent_m:
+        needs.append("no sky or floor-map window")
     if cfg.optics.dispersion:
         needs.append("optics.dispersion = false")
     if needs:
@@ -824,10 +824,10 @@ def _check_scattering(cfg: Config) -> None:
 
 
 def _check_sun_disk(cfg: Config) -> None:
-    if cfg.sun.angular_diameter_deg > 0.0 and cfg.caustics.method is CausticsMethod.SUNMAP:
-        raise ConfigError(f"sun.angular_diameter_deg = {cfg.sun.angular_diameter_deg:g}: the sun map "
-                          f"draws the sun's disk itself (caustics.sunmap_disk_deg = "
-                          f"{cfg.caustics.sunmap_disk_deg:g}); set sun.angular_diameter_deg = 0")
+    disk, drawn = cfg.sun.angular_diameter_deg, cfg.caustics.sunmap_disk_deg
+    if cfg.caustics.method is CausticsMethod.SUNMAP and disk > 0.0 and abs(disk - drawn) > 1e-9:
+        raise ConfigError(f"sun.angular_diameter_deg = {disk:g} but the sun map draws a disk of "
+                          f"caustics.sunmap_disk_deg = {drawn:g}; set them equal (or the sun to 0)")
 
 
 def _check_stats(cfg: Config) -> None:

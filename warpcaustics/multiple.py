@@ -34,13 +34,16 @@ def inverse_cdf_table(phase: PhaseFunction, device: str, nodes: int = 2049) -> n
 class MultipleScattering:
     """Owns the walk's floor accumulator, tallies and phase-function table."""
 
-    def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
+    def __init__(self, cfg: Config, sun_dirs: np.ndarray, ior: float, sun_irradiance: np.ndarray,
                  absorption_per_m: np.ndarray, scattering_per_m: np.ndarray, device: str):
+        """``sun_dirs``: (D, 3) the sun's direction, or the directions over its disk, which the
+        photons take in turn."""
         self.device = device
+        dirs = np.asarray(sun_dirs, np.float32).reshape(-1, 3)
+        self.sun_dirs = wp.array(dirs, dtype=wp.vec3, device=device)
         k = len(sun_irradiance)
         m = cfg.caustics.map_resolution
         walk = mc_kernels.Walk()
-        walk.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
         walk.eta = 1.0 / float(ior)
         walk.floor_z = -float(cfg.floor.depth_m)
         walk.extent_m = float(cfg.water.extent_m)
@@ -68,7 +71,8 @@ class MultipleScattering:
         self.texels.zero_()
         self.tallies.zero_()
         wp.launch(mc_kernels.random_walk, dim=(k, n, n, self.walk.samples * self.walk.samples),
-                  inputs=[self.walk, surface.positions, surface.normals, visible, self.sun_irradiance,
+                  inputs=[self.walk, surface.positions, surface.normals, visible, self.sun_dirs,
+                          self.sun_irradiance,
                           self.absorption, self.scattering, self.inverse_cdf],
                   outputs=[self.texels, self.tallies], device=self.device)
         floor = np.moveaxis(self.texels.numpy(), 2, 0) / self.texel_area_m2

@@ -318,7 +318,8 @@ class Renderer:
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
                 if cfg.optics.scattering is Scattering.MULTIPLE:
-                    self.multiple = MultipleScattering(cfg, scene.sun_direction, float(self.group_ior[0]),
+                    self.multiple = MultipleScattering(cfg, scene.sun_disk_directions(),
+                                                       float(self.group_ior[0]),
                                                        self.sun_irradiance, optics.absorption_per_m,
                                                        optics.scattering_per_m, self.device)
                 self.sun_directions = scene.sun_disk_directions()  # the centre alone for a point sun
