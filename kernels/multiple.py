@@ -31,8 +31,12 @@ class Walk:
     """n_air / n_water."""
     floor_z: float
     extent_m: float
+    map_center: wp.vec2
+    """Centre of the floor map [m] (a window's, or the patch's)."""
+    map_extent_m: float
+    """Side of the floor map [m]: a window's, or the patch's."""
     map_scale: float
-    """Texels per metre of the floor map (M / L)."""
+    """Texels per metre of the floor map (M / its side)."""
     samples: int
     """Photons per surface cell side."""
     max_events: int
@@ -63,11 +67,15 @@ def turn(d: wp.vec3, cos_theta: float, phi: float) -> wp.vec3:
 
 
 @wp.func
-def wrap_texel(x: float, walk: Walk, m: int) -> int:
-    """Texel of coordinate x [m] on the periodic floor map."""
-    u = (x + 0.5 * walk.extent_m) * walk.map_scale
-    r = u - float(m) * wp.floor(u / float(m))
-    return wp.min(int(r), m - 1)
+def map_texel(x: float, centre: float, walk: Walk, m: int) -> int:
+    """Texel of coordinate x [m] on the floor map, from the periodic image of x nearest the map's
+    centre (the whole patch, or a window at most half of it); −1 outside a window."""
+    d = x - centre
+    d = d - walk.extent_m * wp.floor(d / walk.extent_m + 0.5)
+    u = (d + 0.5 * walk.map_extent_m) * walk.map_scale
+    if u < 0.0 or u >= float(m):
+        return -1
+    return wp.min(int(u), m - 1)
 
 
 @wp.kernel
@@ -126,9 +134,10 @@ def random_walk(
             to_floor = (walk.floor_z - pos[2]) / d[2]
             if free >= to_floor:
                 hit = pos + to_floor * d
-                tx = wrap_texel(hit[0], walk, m)
-                ty = wrap_texel(hit[1], walk, m)
-                wp.atomic_add(floor_texels, ty, tx, b, weight)
+                tx = map_texel(hit[0], walk.map_center[0], walk, m)
+                ty = map_texel(hit[1], walk.map_center[1], walk, m)
+                if tx >= 0 and ty >= 0:
+                    wp.atomic_add(floor_texels, ty, tx, b, weight)
                 wp.atomic_add(tallies, b, FLOOR, wp.float64(weight))
                 if event == 0:
                     wp.atomic_add(tallies, b, UNSCATTERED, wp.float64(weight))

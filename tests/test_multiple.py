@@ -112,3 +112,20 @@ def test_multiple_scattering_errors_are_one_line():
         wc.load_scene(None, {**BASE, "caustics.method": "beams"})
     with pytest.raises(ConfigError, match="periodic sea"):
         wc.load_scene("configs/pool.toml", {"optics.scattering": "multiple"})
+
+
+def test_the_walk_into_a_window_fills_the_whole_maps_texels():
+    """A floor-map window (8 m of a 16 m sea, centred at (4, −2) m, texels half the whole map's):
+    the same photons land in the same places, so each 2×2 block of window texels averages to the
+    whole map's texel there (1e-5, float32 sums), and every watt on the floor is tallied alike."""
+    base = {"water.resolution": 32, "optics.wavelengths": "rgb", "optics.water_type": "coastal_ocean",
+            "floor.depth_m": 3.0, "optics.scattering": "multiple", "caustics.map_resolution": 32}
+    whole = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
+    window = wc.render(wc.load_scene("configs/ocean.toml", {**base, "caustics.map_extent_m": 8.0,
+                                                            "caustics.map_center_m": [4.0, -2.0]}),
+                       device="cpu")
+    blocks = window.floor_irradiance.reshape(3, 16, 2, 16, 2).mean(axis=(2, 4))
+    part = whole.floor_irradiance[:, 4:20, 16:32]  # rows from y = −6 m, columns from x = 0 m
+    np.testing.assert_allclose(blocks, part, rtol=1e-5, atol=1e-6 * part.max())
+    floor = whole.multiple_scattering_stats["floor"]
+    assert window.multiple_scattering_stats["floor"] == pytest.approx(floor, rel=1e-12)

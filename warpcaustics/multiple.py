@@ -47,12 +47,15 @@ class MultipleScattering:
         walk.eta = 1.0 / float(ior)
         walk.floor_z = -float(cfg.floor.depth_m)
         walk.extent_m = float(cfg.water.extent_m)
-        walk.map_scale = m / float(cfg.water.extent_m)
+        side = float(cfg.caustics.map_extent_m or cfg.water.extent_m)  # a window, or the patch
+        walk.map_center = wp.vec2(*(cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)))
+        walk.map_extent_m = side
+        walk.map_scale = m / side
         walk.samples = cfg.optics.mc_samples
         walk.max_events = cfg.optics.mc_max_events
         walk.seed = cfg.optics.mc_seed
         self.walk = walk
-        self.texel_area_m2 = (cfg.water.extent_m / m) ** 2
+        self.texel_area_m2 = (side / m) ** 2
 
         def arr(a):
             return wp.array(np.asarray(a, np.float32), dtype=wp.float32, device=device)
