@@ -19,28 +19,32 @@ import argparse
 import math
 import sys
 
+import numpy as np
+
 from benchmarks.run import ROOT
 
 ZENITHS_DEG = (20.0, 40.0, 60.0)
+
+
+def _collected(result, floor) -> np.ndarray:
+    """A (K, M, M) floor map summed over its bands and averaged over the 8 mm collector."""
+    from warpcaustics.stats import band_integrated, collector_average
+
+    texel = result.map_extent_m / floor.shape[-1]
+    return collector_average(band_integrated(floor, result.bin_widths_nm), texel, 8e-3, periodic=False)
 
 
 def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple[float, float]]:
     """((mean, CV) single, (mean, CV) multiple without photon noise) of one frame, after the
     collector."""
     import warpcaustics as wc
-    from warpcaustics.stats import band_integrated, collector_average
 
     maps = []
     for seed in (1, 2):
         scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**overrides, "optics.mc_seed": seed})
         r = wc.render(scene, time_s=time_s, device="cpu")
-        texel = r.map_extent_m / r.floor_irradiance.shape[-1]
-
-        def collected(floor, r=r, texel=texel):
-            return collector_average(band_integrated(floor, r.bin_widths_nm), texel, 8e-3, periodic=False)
-
-        maps.append(collected(r.floor_irradiance))
-    single = collected(r.comparison.floor_irradiance)
+        maps.append(_collected(r, r.floor_irradiance))
+    single = _collected(r, r.comparison.floor_irradiance)
     mean = 0.5 * (maps[0] + maps[1])
     noise = 0.5 * (maps[0] - maps[1]).var()  # of one seed's map; the mean's is half of it
     cv_multi = math.sqrt(max(mean.var() - 0.5 * noise, 0.0)) / mean.mean()

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.output import atomic_path
 
@@ -201,7 +202,7 @@ def _check_scene(config) -> None:
             f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
             "independent frames of a wind sea: use water.model = 'fft'"
         )
-    if config.sky.model.value != "uniform":
+    if config.sky.model is not SkyModel.UNIFORM:
         raise ConfigError(
             "the Gernez 2009 comparison needs the sky's diffuse share: set sky.model = 'uniform'"
         )

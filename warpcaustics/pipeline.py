@@ -276,6 +276,7 @@ class Renderer:
             self.approximate = None
             self.sky_directions = None
             self.multiple = None
+            self.sun_directions = scene.sun_disk_directions()  # the centre alone for a point sun
             if cfg.sky.model is not SkyModel.NONE:
                 self.sky_directions, shares = scene.sky_directions()
                 sky = scene.sky_irradiance(self.sun_irradiance)
@@ -297,7 +298,7 @@ class Renderer:
                                                     relief=scene.floor_relief)
                 if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
                     self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic,
-                                                          disk_dirs=scene.sun_disk_directions())
+                                                          disk_dirs=self.sun_directions)
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
                     lights = [scene.sun_direction] + list(self.sky_directions if self.sky_directions
@@ -318,11 +319,10 @@ class Renderer:
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
                 if cfg.optics.scattering is Scattering.MULTIPLE:
-                    self.multiple = MultipleScattering(cfg, scene.sun_disk_directions(),
+                    self.multiple = MultipleScattering(cfg, self.sun_directions,
                                                        float(self.group_ior[0]),
                                                        self.sun_irradiance, optics.absorption_per_m,
                                                        optics.scattering_per_m, self.device)
-                self.sun_directions = scene.sun_disk_directions()  # the centre alone for a point sun
                 disk_share = self.sun_irradiance / len(self.sun_directions)
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
                                                     self.attenuation_per_m, self.device,
@@ -464,7 +464,7 @@ class Renderer:
         perpendicular to them, from the sky). Photons take the sun disk's directions in turn in one
         pass; beams run a pass per direction with its share of the sun. Each sky direction is a
         pass with its share of the sky."""
-        dirs = self.scene.sun_disk_directions()
+        dirs = self.sun_directions
         if photons:
             passes = [(dirs, self.sun_irradiance, False)]
         else:

@@ -115,7 +115,7 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
     band holding it [W m⁻² nm⁻¹], after the collector."""
     fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
-    sky = getattr(result, "sky_floor_irradiance", None)
+    sky = result.sky_floor_irradiance
     if sky is not None:  # the direct sun's part and the sky's, each alone
         fields["sky_irradiance_w_m2"] = band_integrated(sky, result.bin_widths_nm)
         fields["direct_irradiance_w_m2"] = fields["irradiance_w_m2"] - fields["sky_irradiance_w_m2"]
