@@ -2,12 +2,13 @@
 
 The comparison (``warpcaustics field gernez2009``, docs/validation.md) renders single scattering and
 brackets the scattered light with a uniform background. This measures it instead: the scene of
-``configs/field/gernez2009.toml`` on a smaller patch (8 m at 256², the same 3.1 cm cells; no sky,
-which the random walk does not take) at a few sun zeniths, by single scattering and by the random
-walk (``optics.scattering = "multiple"``, Jerlov IB's Petzold-like phase function), each map
-averaged over the 8 mm collector. The walk runs with two seeds and its photon noise (half the
-variance of their difference) is taken out of the variance of their mean. Frames 2 s apart are
-pooled. Prints both CVs, their ratio and the uniform-background estimate exp(−b·d/cos θ_w).
+``configs/field/gernez2009.toml`` on a smaller patch (8 m at 256², the same 3.1 cm cells; its
+uniform sky with the paper's diffuse share at each zenith) at a few sun zeniths, by single
+scattering and by the random walk (``optics.scattering = "multiple"``, Jerlov IB's Petzold-like
+phase function; sun and sky both walked), each map averaged over the 8 mm collector. The walk
+runs with two seeds and its photon noise (half the variance of their difference) is taken out of
+the variance of their mean. Frames 2 s apart are pooled. Prints both CVs, their ratio and the
+uniform-background estimate exp(−b·d/cos θ_w).
 
 ``python -m benchmarks.gernez_scattering [--quick]`` (CPU, a few minutes; ``--quick``: one zenith,
 one frame, coarse photons).
@@ -52,7 +53,7 @@ def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple
 
 
 def main(argv: list[str] | None = None) -> int:
-    from warpcaustics.field import direct_transmission, pooled_statistics
+    from warpcaustics.field import diffuse_fraction, direct_transmission, pooled_statistics
     from warpcaustics.scene import load_scene
     from warpcaustics.spectra import bins_for, water_optics
 
@@ -63,8 +64,6 @@ def main(argv: list[str] | None = None) -> int:
     base = {
         "water.extent_m": 8.0,
         "water.resolution": 256,
-        "sky.model": "none",
-        "sky.diffuse_fraction": 0.0,
         "optics.scattering": "multiple",
         "optics.mc_samples": samples,
     }
@@ -72,15 +71,17 @@ def main(argv: list[str] | None = None) -> int:
     b = float(water_optics(config.optics, bins_for(config.optics)).scattering_per_m[0])
     print(
         f"gernez scattering | 8 m at 256², 1 m window, 8 mm collector, {samples}² photons per cell, "
-        f"{frames} frame(s), b = {b:.3f} 1/m"
+        f"{frames} frame(s), b = {b:.3f} 1/m, uniform sky of {config.sky.directions} directions"
     )
     for z in zeniths:
-        pairs = [_cv_pair({**base, "sun.elevation_deg": 90.0 - z}, 2.0 * i) for i in range(frames)]
+        condition = {**base, "sun.elevation_deg": 90.0 - z, "sky.diffuse_fraction": diffuse_fraction(z)}
+        pairs = [_cv_pair(condition, 2.0 * i) for i in range(frames)]
         _, cv_single = pooled_statistics([p[0] for p in pairs])
         _, cv_multi = pooled_statistics([p[1] for p in pairs])
         t = direct_transmission(z, config.floor.depth_m, float(config.optics.ior), b)
         print(
-            f"zenith {z:4.0f}° | CV single {cv_single:.3f} | CV multiple {cv_multi:.3f} | "
+            f"zenith {z:4.0f}° | diffuse {condition['sky.diffuse_fraction']:.2f} | "
+            f"CV single {cv_single:.3f} | CV multiple {cv_multi:.3f} | "
             f"multiple / single {cv_multi / cv_single:.2f} | uniform-background estimate {t:.2f}",
             flush=True,
         )

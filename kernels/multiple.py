@@ -1,7 +1,8 @@
 """Multiple scattering (``optics.scattering = "multiple"``): a Monte Carlo photon random walk.
 
 Photons leave the moving surface on a stratified grid (``mc_samples``² per surface cell), each
-carrying its share of the refracted sunlight in one band; they travel exponential free paths of
+carrying its share of the refracted light of one direction (the sun's, a point of its disk or of
+the sky, taken in turn) in one band; they travel exponential free paths of
 mean 1/c(λ), and at each interaction keep the single-scattering albedo b/c of their weight (the
 rest is absorbed there) and turn by the phase function, sampled by inverting its cumulative
 distribution (a table). A photon ends on the flat floor (its weight is deposited into the map),
@@ -41,6 +42,7 @@ class Walk:
     """Photons per surface cell side."""
     max_events: int
     seed: int
+    """Seed of the random streams (the sun's; the sky's walk is given another)."""
 
 
 @wp.func
@@ -83,18 +85,21 @@ def random_walk(
     walk: Walk,
     positions: wp.array2d[wp.vec3],
     normals: wp.array2d[wp.vec3],
-    visible: wp.array2d[wp.float32],
-    sun_dirs: wp.array[wp.vec3],
-    sun_irradiance: wp.array[wp.float32],
+    visible: wp.array3d[wp.float32],
+    light_dirs: wp.array[wp.vec3],
+    light_irradiance: wp.array2d[wp.float32],
     absorption_per_m: wp.array[wp.float32],
     scattering_per_m: wp.array[wp.float32],
     inverse_cdf: wp.array[wp.float32],
     floor_texels: wp.array3d[wp.float32],
     tallies: wp.array2d[wp.float64],
 ):
-    """One photon in band b from sub-sample q of surface cell (iy, ix) of a periodic sea. With a
-    sun disk the photons of the surface take its directions ``sun_dirs`` in turn (a point sun is
-    one direction)."""
+    """One photon in band b from sub-sample q of surface cell (iy, ix) of a periodic sea. The
+    photons of the surface take the D directions ``light_dirs`` in turn (a point sun is one; the
+    sun's disk or the sky are several), each direction j bringing ``light_irradiance[j, b]`` on a
+    plane perpendicular to it [W m⁻² nm⁻¹], so a photon stands for D times its direction's share.
+    ``visible`` (V, N, N) is the crests' shading: V = 1 shades every direction alike (the sun's
+    disk by its centre), V = D one shading per direction (the sky)."""
     b, iy, ix, q = wp.tid()
     n = positions.shape[0]
     m = floor_texels.shape[0]
@@ -111,13 +116,16 @@ def random_walk(
          + tv * ((1.0 - tu) * positions[iy1, ix][2] + tu * positions[iy1, ix1][2]))
     nrm = wp.normalize((1.0 - tv) * ((1.0 - tu) * normals[iy, ix] + tu * normals[iy, ix1])
                        + tv * ((1.0 - tu) * normals[iy1, ix] + tu * normals[iy1, ix1]))
-    lit = ((1.0 - tv) * ((1.0 - tu) * visible[iy, ix] + tu * visible[iy, ix1])
-           + tv * ((1.0 - tu) * visible[iy1, ix] + tu * visible[iy1, ix1]))
     pos = wp.vec3(xy[0] + tu * cell, xy[1] + tv * cell, z)
-    sun_dir = sun_dirs[((iy * n + ix) * s * s + q) % sun_dirs.shape[0]]
+    count = light_dirs.shape[0]
+    j = ((iy * n + ix) * s * s + q) % count
+    sun_dir = light_dirs[j]
+    v = visible[j % visible.shape[0]]
     cos_i = wp.dot(nrm, sun_dir)
+    lit = ((1.0 - tv) * ((1.0 - tu) * v[iy, ix] + tu * v[iy, ix1])
+           + tv * ((1.0 - tu) * v[iy1, ix] + tu * v[iy1, ix1]))
     d, transmitted = sun_into_water(nrm, sun_dir, walk.eta)
-    weight = sun_irradiance[b] * wp.max(cos_i, 0.0) * transmitted * lit * cell * cell / (
+    weight = light_irradiance[j, b] * float(count) * wp.max(cos_i, 0.0) * transmitted * lit * cell * cell / (
         float(s * s) * nrm[2])
     if weight <= 0.0:
         return

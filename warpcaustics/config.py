@@ -814,8 +814,6 @@ def _check_scattering(cfg: Config) -> None:
         needs.append(f"caustics.method = \"fluxratio\" (not {cfg.caustics.method.value!r})")
     if not cfg.water.periodic:
         needs.append(f"a periodic sea (not water.model = {cfg.water.model.value!r})")
-    if cfg.sky.model is not SkyModel.NONE:
-        needs.append("no sky")
     if cfg.optics.dispersion:
         needs.append("optics.dispersion = false")
     if needs:

@@ -3,6 +3,8 @@
 A reference mode for flux-ratio scenes on a periodic sea: the floor map comes from a Monte Carlo
 random walk of photons that scatter on (by the configured phase function) instead of being lost
 from the beam; the single-scattering flux-ratio map of the same frame is kept as the comparison.
+The sky, when there is one, is walked apart from the sun (its own floor map and tallies), its
+photons taking the sky's directions in turn.
 """
 
 from __future__ import annotations
@@ -17,6 +19,10 @@ from warpcaustics.water import Surface
 
 TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated")
 """The columns of the walk's tallies [W nm⁻¹ per band]."""
+
+SKY_STREAM = 0x5851F42D
+"""Added to ``optics.mc_seed`` for the sky's walk, so its photons draw other random numbers than the
+sun's."""
 
 
 def inverse_cdf_table(phase: PhaseFunction, device: str, nodes: int = 2049) -> np.ndarray:
@@ -35,32 +41,48 @@ class MultipleScattering:
     """Owns the walk's floor accumulator, tallies and phase-function table."""
 
     def __init__(self, cfg: Config, sun_dirs: np.ndarray, ior: float, sun_irradiance: np.ndarray,
-                 absorption_per_m: np.ndarray, scattering_per_m: np.ndarray, device: str):
-        """``sun_dirs``: (D, 3) the sun's direction, or the directions over its disk, which the
-        photons take in turn."""
+                 absorption_per_m: np.ndarray, scattering_per_m: np.ndarray, device: str, *,
+                 sky_dirs: np.ndarray | None = None, sky_irradiance: np.ndarray | None = None):
+        """``sun_dirs``: (S, 3) the sun's direction, or the directions over its disk, which the
+        photons take in turn, sharing ``sun_irradiance`` (K,) equally. ``sky_dirs`` (D, 3) and
+        ``sky_irradiance`` (D, K): the sky's directions and each one's irradiance on a plane
+        perpendicular to it [W m⁻² nm⁻¹], for :meth:`run_sky`."""
         self.device = device
         dirs = np.asarray(sun_dirs, np.float32).reshape(-1, 3)
         self.sun_dirs = wp.array(dirs, dtype=wp.vec3, device=device)
         k = len(sun_irradiance)
+        share = np.asarray(sun_irradiance, np.float64) / len(dirs)  # each disk direction's
+        self.sun_irradiance = wp.array(np.tile(share, (len(dirs), 1)).astype(np.float32), dtype=wp.float32,
+                                       device=device)
+        self.sky_dirs = self.sky_irradiance = None
+        if sky_dirs is not None:
+            sky_dirs = np.asarray(sky_dirs, np.float32).reshape(-1, 3)
+            self.sky_dirs = wp.array(sky_dirs, dtype=wp.vec3, device=device)
+            self.sky_irradiance = wp.array(np.asarray(sky_irradiance, np.float32).reshape(len(sky_dirs), k),
+                                           dtype=wp.float32, device=device)
         m = cfg.caustics.map_resolution
-        walk = mc_kernels.Walk()
-        walk.eta = 1.0 / float(ior)
-        walk.floor_z = -float(cfg.floor.depth_m)
-        walk.extent_m = float(cfg.water.extent_m)
         side = float(cfg.caustics.map_extent_m or cfg.water.extent_m)  # a window, or the patch
-        walk.map_center = wp.vec2(*(cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)))
-        walk.map_extent_m = side
-        walk.map_scale = m / side
-        walk.samples = cfg.optics.mc_samples
-        walk.max_events = cfg.optics.mc_max_events
-        walk.seed = cfg.optics.mc_seed
-        self.walk = walk
+
+        def walk(seed: int) -> mc_kernels.Walk:
+            w = mc_kernels.Walk()
+            w.eta = 1.0 / float(ior)
+            w.floor_z = -float(cfg.floor.depth_m)
+            w.extent_m = float(cfg.water.extent_m)
+            w.map_center = wp.vec2(*(cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)))
+            w.map_extent_m = side
+            w.map_scale = m / side
+            w.samples = cfg.optics.mc_samples
+            w.max_events = cfg.optics.mc_max_events
+            w.seed = seed
+            return w
+
+        self.walk = walk(cfg.optics.mc_seed)
+        self.sky_walk = walk((cfg.optics.mc_seed + SKY_STREAM) % 2**31)
         self.texel_area_m2 = (side / m) ** 2
 
         def arr(a):
             return wp.array(np.asarray(a, np.float32), dtype=wp.float32, device=device)
 
-        self.sun_irradiance = arr(sun_irradiance)
         self.absorption = arr(absorption_per_m)
         self.scattering = arr(scattering_per_m)
         self.inverse_cdf = arr(inverse_cdf_table(PhaseFunction.from_optics(cfg.optics, device), device))
@@ -68,18 +90,29 @@ class MultipleScattering:
         self.tallies = wp.zeros((k, mc_kernels.TALLIES), dtype=wp.float64, device=device)
 
     def run(self, surface: Surface, visible: wp.array2d) -> tuple[np.ndarray, dict]:
-        """(K, M, M) floor irradiance [W m⁻² nm⁻¹] by the walk, and its tallies per band."""
+        """The sun's walk: (K, M, M) floor irradiance [W m⁻² nm⁻¹] and the tallies per band; the
+        crests shade every direction of the disk as ``visible`` (N, N), the centre's, does."""
+        n = surface.resolution
+        return self._walk(surface, visible.reshape((1, n, n)), self.sun_dirs, self.sun_irradiance, self.walk)
+
+    def run_sky(self, surface: Surface, visible: wp.array3d) -> tuple[np.ndarray, dict]:
+        """The sky's walk, like :meth:`run`, with ``visible`` (D, N, N) the crests' shading from
+        each sky direction."""
+        if self.sky_dirs is None:
+            raise ValueError("this walk was made without a sky (sky_dirs)")
+        return self._walk(surface, visible, self.sky_dirs, self.sky_irradiance, self.sky_walk)
+
+    def _walk(self, surface, visible, dirs, irradiance, walk) -> tuple[np.ndarray, dict]:
         n = surface.resolution
         k = self.tallies.shape[0]
         self.texels.zero_()
         self.tallies.zero_()
-        wp.launch(mc_kernels.random_walk, dim=(k, n, n, self.walk.samples * self.walk.samples),
-                  inputs=[self.walk, surface.positions, surface.normals, visible, self.sun_dirs,
-                          self.sun_irradiance,
+        wp.launch(mc_kernels.random_walk, dim=(k, n, n, walk.samples * walk.samples),
+                  inputs=[walk, surface.positions, surface.normals, visible, dirs, irradiance,
                           self.absorption, self.scattering, self.inverse_cdf],
                   outputs=[self.texels, self.tallies], device=self.device)
         floor = np.moveaxis(self.texels.numpy(), 2, 0) / self.texel_area_m2
         tallies = self.tallies.numpy()
-        photons = k * n * n * self.walk.samples**2
+        photons = k * n * n * walk.samples**2
         stats = {"photons": photons, **{name: tallies[:, i].tolist() for i, name in enumerate(TALLY_NAMES)}}
         return floor.astype(np.float32), stats

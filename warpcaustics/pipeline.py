@@ -196,7 +196,9 @@ def scene_bytes(scene: Scene) -> int:
     n = scene.water_resolution
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
-    sky = n * n * 4 if cfg.sky.model is not SkyModel.NONE else 0  # its shading buffer
+    sky = 0
+    if cfg.sky.model is not SkyModel.NONE:  # its shading buffer: one, or one per direction for the walk
+        sky = n * n * 4 * (cfg.sky.directions if cfg.optics.scattering is Scattering.MULTIPLE else 1)
     if cfg.caustics.method.uses_receivers:
         periodic = cfg.water.periodic
         faces = receiver_face_estimate(scene, periodic)
@@ -212,7 +214,8 @@ def scene_bytes(scene: Scene) -> int:
     m = cfg.caustics.map_resolution
     extra = {CausticsMethod.SUNMAP: m * m * 4, CausticsMethod.EIKONAL: eikonal_bytes(cfg) + k * m * m * 4,
              CausticsMethod.WAVE3D: wave3d_bytes(cfg) + k * m * m * 4}
-    return (water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sky
+    walk = k * m * m * 4 if cfg.optics.scattering is Scattering.MULTIPLE else 0  # the walk's texels
+    return (water_bytes(cfg, n) + caustics.floor_bytes(n, m, k, groups) + sky + walk
             + extra.get(cfg.caustics.method, 0))
 
 
@@ -285,7 +288,11 @@ class Renderer:
                 self.sky_irradiance_per_dir = [
                     wp.array(e.astype(np.float32), dtype=wp.float32, device=self.device)
                     for e in self.sky_irradiance_np]
-                self.sky_visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
+                # The crests' shading from each sky direction: one buffer reused, or all of them
+                # for the random walk, whose photons take the directions in turn.
+                walked = cfg.optics.scattering is Scattering.MULTIPLE
+                shape = (len(self.sky_directions), n, n) if walked else (n, n)
+                self.sky_visible = wp.empty(shape, dtype=wp.float32, device=self.device)
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
                                            relief=scene.floor_relief, meshes=scene.receiver_meshes,
@@ -319,10 +326,14 @@ class Renderer:
                 window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                           if cfg.caustics.map_extent_m else None)
                 if cfg.optics.scattering is Scattering.MULTIPLE:
+                    sky = {}
+                    if self.sky_directions is not None:
+                        sky = dict(sky_dirs=self.sky_directions,
+                                   sky_irradiance=np.stack(self.sky_irradiance_np))
                     self.multiple = MultipleScattering(cfg, self.sun_directions,
                                                        float(self.group_ior[0]),
                                                        self.sun_irradiance, optics.absorption_per_m,
-                                                       optics.scattering_per_m, self.device)
+                                                       optics.scattering_per_m, self.device, **sky)
                 disk_share = self.sun_irradiance / len(self.sun_directions)
                 self.floor = caustics.FloorCaustics(n, cfg.caustics.map_resolution, disk_share,
                                                     self.attenuation_per_m, self.device,
@@ -389,14 +400,20 @@ class Renderer:
             with watch.stage("readback"):
                 # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
                 floor_np = floor.numpy().copy()
-            if self.multiple is not None:
-                single_floor, single_transmitted = floor_np, transmitted
-                with watch.stage("multiple_scattering"):
-                    floor_np, walk = self.multiple.run(surface, visible)
-                extra = {"multiple_scattering_stats": walk}
-                transmitted = np.asarray(walk["transmitted"])
             if self.sky_directions is not None:
                 sky_np, sky_transmitted = self._sky(surface, highest, watch)
+            if self.multiple is not None:  # the walk's maps replace the single-scattering ones
+                single_floor, single_transmitted = floor_np, transmitted
+                if self.sky_directions is not None:
+                    single_floor, single_transmitted = floor_np + sky_np, transmitted + sky_transmitted
+                with watch.stage("multiple_scattering"):
+                    floor_np, walk = self.multiple.run(surface, visible)
+                    transmitted = np.asarray(walk["transmitted"])
+                    if self.sky_directions is not None:
+                        sky_np, walk["sky"] = self.multiple.run_sky(surface, self.sky_visible)
+                        sky_transmitted = np.asarray(walk["sky"]["transmitted"])
+                extra = {"multiple_scattering_stats": walk}
+            if self.sky_directions is not None:
                 extra["sky_floor_irradiance"] = sky_np
                 floor_np = floor_np + sky_np
                 transmitted = transmitted + sky_transmitted
@@ -439,7 +456,8 @@ class Renderer:
         transmitted = 0.0
         for i, (direction, irradiance) in enumerate(zip(self.sky_directions, self.sky_irradiance_per_dir)):
             with watch.stage("sky"):
-                visible = sun_visibility(surface, direction, highest, self.device, out=self.sky_visible)
+                out = self.sky_visible[i] if self.sky_visible.ndim == 3 else self.sky_visible
+                visible = sun_visibility(surface, direction, highest, self.device, out=out)
             floor, flux = self._deposit(surface, visible, direction, watch, ("sky", "sky"), clear=i == 0,
                                         irradiance=irradiance)
             transmitted = transmitted + flux
