@@ -5,8 +5,8 @@ For the flux-ratio map the disk costs one refraction and one deposit per directi
 frame's caustic stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky
 over as many directions adds as many passes, each with its own crest-shading march. The photons
 take the disk's directions in turn, one per photon, so their disk should cost nothing; their sky
-is a photon pass per sky direction. Median of a
-few frames after a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
+is a photon pass per sky direction. The eikonal grid (64³) solves once more per sky direction.
+Median of a few frames after a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from benchmarks.run import median_time, point_sun_scene
 
 FULL = (256, 512, (8, 16, 32))
 QUICK = (128, 256, (8,))
+EIKONAL = {"caustics.method": "eikonal", "caustics.eikonal_resolution": 64}
 
 
 def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
@@ -31,6 +32,9 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         ("photons_disk", {"caustics.method": "photons", "sun.angular_diameter_deg": 0.53,
                           "sun.disk_samples": samples}),
         ("photons_sky", {"caustics.method": "photons", "sky.model": "uniform", "sky.diffuse_fraction": 0.2,
+                         "sky.directions": samples}),
+        ("eikonal_point", EIKONAL),
+        ("eikonal_sky", {**EIKONAL, "sky.model": "uniform", "sky.diffuse_fraction": 0.2,
                          "sky.directions": samples}),
     )
     for name, extra in cases:
@@ -54,6 +58,9 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
         "photons_disk_over_point": rows["photons_disk"] / rows["photons_point"],
         "photons_sky_frame_s": rows["photons_sky"],
         "photons_sky_over_point": rows["photons_sky"] / rows["photons_point"],
+        "eikonal_point_frame_s": rows["eikonal_point"],
+        "eikonal_sky_frame_s": rows["eikonal_sky"],
+        "eikonal_sky_over_point": rows["eikonal_sky"] / rows["eikonal_point"],
     }
 
 
@@ -73,7 +80,9 @@ def run(quick: bool, device: str) -> dict:
             f"sky / point {row['sky_over_point']:5.1f}x | photons: point "
             f"{row['photons_point_frame_s'] * 1e3:8.1f} ms, "
             f"disk / point {row['photons_disk_over_point']:5.2f}x, "
-            f"sky / point {row['photons_sky_over_point']:5.1f}x",
+            f"sky / point {row['photons_sky_over_point']:5.1f}x | eikonal 64³: point "
+            f"{row['eikonal_point_frame_s'] * 1e3:8.1f} ms, "
+            f"sky / point {row['eikonal_sky_over_point']:5.1f}x",
             flush=True,
         )
     return {

@@ -793,10 +793,9 @@ def _check_sky(cfg: Config) -> None:
                               "sky.model = \"uniform\" (or sky.diffuse_fraction = 0)")
         return
     method = cfg.caustics.method
-    if method not in (CausticsMethod.FLUXRATIO, CausticsMethod.PHOTONS, CausticsMethod.BEAMS,
-                      CausticsMethod.BOTH):
-        raise ConfigError(f"sky.model = {sky.model.value!r} is integrated by the flux-ratio map, photons and "
-                          f"beams only so far (the method is {method.value!r}); set sky.model = \"none\"")
+    if method is CausticsMethod.SUNMAP:
+        raise ConfigError("sky.model with caustics.method = \"sunmap\": the sun map looks up the sun alone "
+                          "(its halo stands in for the sky); set sky.model = \"none\"")
     if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH) and (
             cfg.caustics.intersection is Intersection.NEWTON):
         raise ConfigError("sky.model with caustics.intersection = \"newton\": the Newton guesses come from "

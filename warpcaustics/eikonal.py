@@ -119,6 +119,12 @@ class GridCaustics:
         self.top = wp.empty((self.n, self.n), dtype=wp.int32, device=device)
         self.layers = 0
 
+    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
+        """Light the next solves from ``direction`` (towards the light) with ``irradiance`` (K,) on
+        a plane perpendicular to it [W m⁻² nm⁻¹]: the sun, or one direction of the sky."""
+        s = np.asarray(direction, np.float64)
+        self.sun_dir = s / np.linalg.norm(s)
+        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
 
     def disk_average(self, floor: np.ndarray, disk_dirs: np.ndarray) -> np.ndarray:
         """The sun's disk for this grid method's map: :func:`parallax_disk_average`."""
@@ -176,10 +182,14 @@ class EikonalCaustics(GridCaustics):
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
         super().__init__(cfg, cfg.caustics.eikonal_resolution, sun_dir, ior, sun_irradiance,
                          attenuation_per_m, device, periodic=periodic)
-        self.gradient = self.ior * still_water_refraction(self.sun_dir, self.ior)
         self.scratch = wp.empty((self.n, self.n), dtype=wp.float32, device=device)
         self.changed = wp.zeros(1, dtype=wp.int32, device=device)
         self.stats = EikonalStats()
+
+    @property
+    def gradient(self) -> np.ndarray:
+        """∇φ of still water's refracted front, n_w t0 (the light's direction)."""
+        return self.ior * still_water_refraction(self.sun_dir, self.ior)
 
     def _grid(self, highest_m: float) -> eikonal_kernels.EikonalGrid:
         grid = make_grid(self.n, self.extent_m, highest_m, self.floor_z, 2, self.periodic, self.ior,

@@ -424,6 +424,11 @@ class Renderer:
                                                                  visible, flux_ratio_floor)
                     if isinstance(self.approximate, GridCaustics):  # the sun's disk, if any
                         floor_np = self.approximate.disk_average(floor_np, self.sun_directions)
+                if self.sky_directions is not None:  # the grid method's own sky replaces the flux ratio's
+                    with watch.stage("sky"):
+                        sky_np = self._grid_sky(surface, time_s, highest, flux_ratio_floor)
+                    extra["sky_floor_irradiance"] = sky_np
+                    floor_np = floor_np + sky_np
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
@@ -462,6 +467,22 @@ class Renderer:
                                         irradiance=irradiance)
             transmitted = transmitted + flux
         return floor.numpy().copy(), transmitted
+
+    def _grid_sky(self, surface, time_s: float, highest: float, flux_ratio: np.ndarray) -> np.ndarray:
+        """The sky's floor map by the eikonal or wave grid: a solve per sky direction, lit with its
+        share of the sky and shaded by the crests as seen from it (the sun's light is put back
+        after)."""
+        stage = self.approximate
+        total = None
+        try:
+            for direction, irradiance in zip(self.sky_directions, self.sky_irradiance_np):
+                seen = sun_visibility(surface, direction, highest, self.device, out=self.sky_visible)
+                stage.set_light(direction, irradiance)
+                floor, _ = stage.floor_map(surface, self.water, time_s, highest, seen, flux_ratio)
+                total = floor.astype(np.float64) if total is None else total + floor
+        finally:
+            stage.set_light(self.scene.sun_direction, self.sun_irradiance)
+        return total.astype(np.float32)
 
     def _deposit(self, surface, visible, direction, watch, stages: tuple[str, str], *, clear: bool,
                  irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:
