@@ -8,7 +8,7 @@ the analytic single-scattering integral of a lit pool.
 import numpy as np
 import pytest
 import warp as wp
-from test_photons import shaft_block
+from test_photons import shaft_block, shaft_scene
 
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
@@ -246,6 +246,19 @@ def test_beam_shafts_match_single_scattering_in_a_lit_pool(pitch_deg, sees):
     surface; photon lines are 1-3 % low on a 128² one)."""
     measured, expected = shaft_block(pitch_deg, sees, resolution=32, method="beams")
     np.testing.assert_allclose(measured, expected, rtol=1e-4)
+
+
+def test_beam_shafts_looking_into_the_light_are_the_forward_peak():
+    """The shaft scene's camera looking straight up, along the light (the view runs along the
+    beams, within 0.3° at the centre): every pixel is the single-scattering integral (1e-4; measured
+    6.3e-5), so the bright centre, 21× the image's mean, is the phase function's forward peak and
+    not an artefact of the scan planes. (Photon lines on a 128² surface are 0.21–2.9× the integral
+    here: a line seen end-on is no estimate of the radiance along it.)"""
+    result, expected, sees = shaft_scene(90.0, resolution=32, method="beams", up=(1.0, 0.0, 0.0))
+    assert np.all(sees == -1)  # the surface, seen from below
+    np.testing.assert_allclose(result.camera_radiance, expected, rtol=1e-4)
+    image = result.camera_radiance.sum(axis=0)
+    assert image[22:26, 30:34].mean() > 10.0 * image.mean()
 
 
 def test_rays_in_a_shadow_get_no_light():

@@ -248,8 +248,10 @@ def test_light_shafts_match_single_scattering_in_a_lit_pool(pitch_deg, sees):
     np.testing.assert_allclose(measured, expected, rtol=0.04)
 
 
-def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
-    """(measured, expected): block means per band of the camera radiance in the shaft scene."""
+def shaft_scene(pitch_deg, resolution=128, method="photons", up=(0.0, 0.0, 1.0)):
+    """The shaft scene (zenith sun over a still pool, clear ocean water, camera pitched up or down):
+    (result, expected camera radiance per band and pixel, which receiver each pixel sees). Expected:
+    ∫ σ_s p(θ) E_sun T e^{−c(ℓ(s)+s)} ds to the ray's end, plus the lit floor where it is seen."""
     z_cam = -0.75
     x_cam = -1.5
     pitch = np.radians(pitch_deg)
@@ -269,6 +271,7 @@ def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
         "camera.enabled": True,
         "camera.position_m": [x_cam, 0.0, z_cam],
         "camera.look_at_m": look_at,
+        "camera.up": list(up),
         "camera.width": 64,
         "camera.height": 48,
         "camera.fov_deg": 30.0,
@@ -282,20 +285,28 @@ def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
     b = optics.scattering_per_m[:, None, None]
     e_sun = result.sun_irradiance[:, None, None]
     t0 = fresnel_t_angles(np.array([0.0]), 1.0, 1.333)[0]
-    rows, cols = slice(16, 32), slice(12, 52)
-    assert np.all(g["receiver"][rows, cols] == sees)
-    ray = g["position"][rows, cols] - np.array([x_cam, 0.0, z_cam])
+    sees = g["receiver"]
+    ray = g["position"] - np.array([x_cam, 0.0, z_cam])
     ray /= np.linalg.norm(ray, axis=-1, keepdims=True)
     vz = ray[..., 2]
-    dist = g["depth"][rows, cols] if sees >= 0 else -z_cam / vz  # up: the ray ends at the surface
+    with np.errstate(divide="ignore"):
+        dist = np.where(sees >= 0, g["depth"], -z_cam / vz)  # up: the ray ends at the surface
     # The photon travels straight down, the light scatters towards the camera (−ray): cos θ = v_z.
     phase = PhaseFunction.from_optics(cfg.optics, "cpu").evaluate(vz.ravel(), "cpu").reshape(vz.shape)
     # Along the ray ℓ(s) = -(z_cam + s v_z), so e^{-c(ℓ + s)} = e^{c z_cam} e^{-c s (1 - v_z)}.
     k = c * (1.0 - vz)
-    expected = b * phase * e_sun * t0 * np.exp(c * z_cam) * (1.0 - np.exp(-k * dist)) / k
-    if sees == 0:
-        expected = expected + 0.5 * e_sun * t0 * np.exp(-c * 1.5) / np.pi * np.exp(-c * dist)
-    return result.camera_radiance[:, rows, cols].mean(axis=(1, 2)), expected.mean(axis=(1, 2))
+    expected = b * phase * e_sun * t0 * np.exp(c * z_cam) * -np.expm1(-k * dist) / k
+    floor = 0.5 * e_sun * t0 * np.exp(-c * 1.5) / np.pi * np.exp(-c * dist)
+    expected = expected + np.where(sees == 0, floor, 0.0)
+    return result, expected, sees
+
+
+def shaft_block(pitch_deg, sees, resolution=128, method="photons"):
+    """(measured, expected): block means per band of the camera radiance in the shaft scene."""
+    result, expected, seen = shaft_scene(pitch_deg, resolution, method)
+    rows, cols = slice(16, 32), slice(12, 52)
+    assert np.all(seen[rows, cols] == sees)
+    return result.camera_radiance[:, rows, cols].mean(axis=(1, 2)), expected[:, rows, cols].mean(axis=(1, 2))
 
 
 def test_photons_agree_with_the_flux_ratio_map():
