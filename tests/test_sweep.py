@@ -89,6 +89,25 @@ def test_local_sweep_runs_every_task_and_resumes(tmp_path):
         assert task_id(rec["config"], tuple(rec["times_s"])) == rec["id"]
 
 
+def test_a_stateless_frames_run_json_names_its_own_files(tmp_path):
+    """A stateless animation runs one task per frame: each task's run.json numbers its frame as
+    its files are numbered (frame k in frame_000k.*), so the record points at files that exist."""
+    path = tmp_path / "anim.toml"
+    path.write_text(
+        f'base = "{(ROOT / "configs" / "ocean.toml").as_posix()}"\n[set]\n"water.resolution" = 16\n'
+        '"caustics.map_resolution" = 16\n"optics.wavelengths" = "rgb"\n[frames]\ncount = 2\nfps = 4.0\n'
+    )
+    sweep = load_sweep(path)
+    out = tmp_path / "out"
+    report = run_sweep(sweep, out, workers=1, device="cpu", quiet=True)
+    assert report.done == 2
+    for task in sweep.tasks:
+        (entry,) = json.loads((out / task.id / "run.json").read_text(encoding="utf-8"))["frames"]
+        assert entry["frame"] == task.frame_start
+        assert all((out / task.id / name).exists() for name in entry["files"])
+    assert sorted(t.frame_start for t in sweep.tasks) == [0, 1]
+
+
 def test_a_failing_task_is_reported_and_the_rest_finish(tmp_path):
     """A variant whose override is invalid fails with its one-line error; the other tasks finish."""
     sweep = load_sweep(_sweep(tmp_path, types='"pure", "no_such_water"'))

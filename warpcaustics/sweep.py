@@ -218,7 +218,7 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
             result = renderer.render(t)
             save_frame(result, tmp, frame=task.frame_start + k)
             results.append(result)
-        entries = [frame_entry(k, r) for k, r in enumerate(results)]  # as write_run_json numbers them
+        entries = [frame_entry(task.frame_start + k, r) for k, r in enumerate(results)]  # as the files
         write_run_json(tmp, results, frames=entries)
         if final.exists():
             shutil.rmtree(final)
