@@ -6,6 +6,11 @@ Mass is updated in conservative flux form with upwind face depths, so the volume
 by rounding; walls are faces with zero normal velocity. Momentum: semi-Lagrangian advection, then
 gravity from the surface slope and an explicit viscous Laplacian (symplectic Euler: velocities
 first, then depths with the new velocities).
+
+The substep's kernels take ``span`` consecutive cells of a row per thread (launch dimension
+(rows, ⌈columns/span⌉)): one cell per thread on the GPU, a whole row per thread on the CPU, where
+Warp runs threads one after another and a thread's own fixed cost would otherwise be paid per cell.
+The arithmetic per cell is the same either way.
 """
 
 import warp as wp
@@ -32,25 +37,33 @@ def sample_faces(field: wp.array2d[wp.float32], fx: float, fy: float) -> float:
         (1.0 - tx) * field[j0 + 1, i0] + tx * field[j0 + 1, i0 + 1])
 
 
+@wp.func
+def span_end(chunk: int, span: int, cols: int) -> int:
+    """End (exclusive) of the ``chunk``-th run of ``span`` cells in a row of ``cols``."""
+    return wp.min((chunk + 1) * span, cols)
+
+
 @wp.kernel
-def advect_u(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float,
+def advect_u(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float, span: int,
              u_out: wp.array2d[wp.float32]):
     """Semi-Lagrangian advection of u (face (iy, jx) sits at cell coordinates (jx, iy + 0.5))."""
-    iy, jx = wp.tid()
-    vel_u = u[iy, jx]
-    # v at this u-face: mean of the four surrounding v-faces (v-grid index (ix, jy)).
-    vel_v = sample_faces(v, float(jx) - 0.5, float(iy) + 0.5)
-    u_out[iy, jx] = sample_faces(u, float(jx) - vel_u * dt_over_cell, float(iy) - vel_v * dt_over_cell)
+    iy, chunk = wp.tid()
+    for jx in range(chunk * span, span_end(chunk, span, u.shape[1])):
+        vel_u = u[iy, jx]
+        # v at this u-face: mean of the four surrounding v-faces (v-grid index (ix, jy)).
+        vel_v = sample_faces(v, float(jx) - 0.5, float(iy) + 0.5)
+        u_out[iy, jx] = sample_faces(u, float(jx) - vel_u * dt_over_cell, float(iy) - vel_v * dt_over_cell)
 
 
 @wp.kernel
-def advect_v(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float,
+def advect_v(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float, span: int,
              v_out: wp.array2d[wp.float32]):
     """Semi-Lagrangian advection of v (face (jy, ix) sits at cell coordinates (ix + 0.5, jy))."""
-    jy, ix = wp.tid()
-    vel_v = v[jy, ix]
-    vel_u = sample_faces(u, float(ix) + 0.5, float(jy) - 0.5)
-    v_out[jy, ix] = sample_faces(v, float(ix) - vel_u * dt_over_cell, float(jy) - vel_v * dt_over_cell)
+    jy, chunk = wp.tid()
+    for ix in range(chunk * span, span_end(chunk, span, v.shape[1])):
+        vel_v = v[jy, ix]
+        vel_u = sample_faces(u, float(ix) + 0.5, float(jy) - 0.5)
+        v_out[jy, ix] = sample_faces(v, float(ix) - vel_u * dt_over_cell, float(jy) - vel_v * dt_over_cell)
 
 
 @wp.func
@@ -65,30 +78,34 @@ def laplacian(f: wp.array2d[wp.float32], j: int, i: int) -> float:
 
 @wp.kernel
 def accelerate_u(u_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
-                 floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float,
+                 floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float, span: int,
                  u: wp.array2d[wp.float32]):
     """u += dt (−g ∂η/∂x + ν ∇²u); walls (first and last face) and dry faces stay at rest."""
-    iy, jx = wp.tid()
+    iy, chunk = wp.tid()
     n = h.shape[1]
-    if jx == 0 or jx == n or h[iy, jx - 1] <= 0.0 or h[iy, jx] <= 0.0:
-        u[iy, jx] = 0.0
-        return
-    slope = ((h[iy, jx] - floor_depth[iy, jx]) - (h[iy, jx - 1] - floor_depth[iy, jx - 1])) / cell
-    u[iy, jx] = u_adv[iy, jx] + dt * (-GRAVITY * slope + viscosity * laplacian(u_adv, iy, jx) / (cell * cell))
+    for jx in range(chunk * span, span_end(chunk, span, u.shape[1])):
+        if jx == 0 or jx == n or h[iy, jx - 1] <= 0.0 or h[iy, jx] <= 0.0:
+            u[iy, jx] = 0.0
+        else:
+            slope = ((h[iy, jx] - floor_depth[iy, jx]) - (h[iy, jx - 1] - floor_depth[iy, jx - 1])) / cell
+            u[iy, jx] = u_adv[iy, jx] + dt * (
+                -GRAVITY * slope + viscosity * laplacian(u_adv, iy, jx) / (cell * cell))
 
 
 @wp.kernel
 def accelerate_v(v_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
-                 floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float,
+                 floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float, span: int,
                  v: wp.array2d[wp.float32]):
     """v += dt (−g ∂η/∂y + ν ∇²v); walls and dry faces stay at rest."""
-    jy, ix = wp.tid()
+    jy, chunk = wp.tid()
     n = h.shape[0]
-    if jy == 0 or jy == n or h[jy - 1, ix] <= 0.0 or h[jy, ix] <= 0.0:
-        v[jy, ix] = 0.0
-        return
-    slope = ((h[jy, ix] - floor_depth[jy, ix]) - (h[jy - 1, ix] - floor_depth[jy - 1, ix])) / cell
-    v[jy, ix] = v_adv[jy, ix] + dt * (-GRAVITY * slope + viscosity * laplacian(v_adv, jy, ix) / (cell * cell))
+    for ix in range(chunk * span, span_end(chunk, span, v.shape[1])):
+        if jy == 0 or jy == n or h[jy - 1, ix] <= 0.0 or h[jy, ix] <= 0.0:
+            v[jy, ix] = 0.0
+        else:
+            slope = ((h[jy, ix] - floor_depth[jy, ix]) - (h[jy - 1, ix] - floor_depth[jy - 1, ix])) / cell
+            v[jy, ix] = v_adv[jy, ix] + dt * (
+                -GRAVITY * slope + viscosity * laplacian(v_adv, jy, ix) / (cell * cell))
 
 
 @wp.func
@@ -101,23 +118,24 @@ def upwind_flux(vel: float, h_minus: float, h_plus: float) -> float:
 
 @wp.kernel
 def update_depth(h: wp.array2d[wp.float32], u: wp.array2d[wp.float32], v: wp.array2d[wp.float32],
-                 dt_over_cell: float, h_out: wp.array2d[wp.float32]):
+                 dt_over_cell: float, span: int, h_out: wp.array2d[wp.float32]):
     """h −= dt/Δ · (flux out − flux in) over the four faces (conservative form)."""
-    iy, ix = wp.tid()
+    iy, chunk = wp.tid()
     n = h.shape[0]
-    west = float(0.0)
-    east = float(0.0)
-    south = float(0.0)
-    north = float(0.0)
-    if ix > 0:
-        west = upwind_flux(u[iy, ix], h[iy, ix - 1], h[iy, ix])
-    if ix < n - 1:
-        east = upwind_flux(u[iy, ix + 1], h[iy, ix], h[iy, ix + 1])
-    if iy > 0:
-        south = upwind_flux(v[iy, ix], h[iy - 1, ix], h[iy, ix])
-    if iy < n - 1:
-        north = upwind_flux(v[iy + 1, ix], h[iy, ix], h[iy + 1, ix])
-    h_out[iy, ix] = h[iy, ix] - dt_over_cell * (east - west + north - south)
+    for ix in range(chunk * span, span_end(chunk, span, n)):
+        west = float(0.0)
+        east = float(0.0)
+        south = float(0.0)
+        north = float(0.0)
+        if ix > 0:
+            west = upwind_flux(u[iy, ix], h[iy, ix - 1], h[iy, ix])
+        if ix < n - 1:
+            east = upwind_flux(u[iy, ix + 1], h[iy, ix], h[iy, ix + 1])
+        if iy > 0:
+            south = upwind_flux(v[iy, ix], h[iy - 1, ix], h[iy, ix])
+        if iy < n - 1:
+            north = upwind_flux(v[iy + 1, ix], h[iy, ix], h[iy + 1, ix])
+        h_out[iy, ix] = h[iy, ix] - dt_over_cell * (east - west + north - south)
 
 
 @wp.kernel

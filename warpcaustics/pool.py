@@ -130,6 +130,9 @@ class ShallowWaterPool(WalledPool):
         self._u_adv = wp.empty_like(self.u)
         self._v_adv = wp.empty_like(self.v)
         self._speed = wp.zeros(1, dtype=wp.float32, device=device)
+        # Cells per thread of the substep's kernels: a whole row on the CPU (threads run one after
+        # another there), one cell on the GPU.
+        self._span = n + 1 if wp.get_device(device).is_cpu else 1
         self.body = body if body is not None and body.radius_m > 0 else None
         self.substeps = 0
         self._init_drops(drops)
@@ -174,22 +177,27 @@ class ShallowWaterPool(WalledPool):
         n = self.resolution
         dev = self.device
         k = float(dt / self.cell_m)
-        wp.launch(pool_kernels.advect_u, dim=(n, n + 1), inputs=[self.u, self.v, k], outputs=[self._u_adv],
-                  device=dev)
-        wp.launch(pool_kernels.advect_v, dim=(n + 1, n), inputs=[self.u, self.v, k], outputs=[self._v_adv],
-                  device=dev)
-        args = [self.h, self.floor_depth, float(dt), self.cell_m, self.viscosity]
-        wp.launch(pool_kernels.accelerate_u, dim=(n, n + 1), inputs=[self._u_adv, *args], outputs=[self.u],
-                  device=dev)
-        wp.launch(pool_kernels.accelerate_v, dim=(n + 1, n), inputs=[self._v_adv, *args], outputs=[self.v],
-                  device=dev)
+        span = self._span
+
+        def rows(rows: int, cols: int) -> tuple[int, int]:  # (rows, runs of `span` cells per row)
+            return rows, -(-cols // span)
+
+        wp.launch(pool_kernels.advect_u, dim=rows(n, n + 1), inputs=[self.u, self.v, k, span],
+                  outputs=[self._u_adv], device=dev)
+        wp.launch(pool_kernels.advect_v, dim=rows(n + 1, n), inputs=[self.u, self.v, k, span],
+                  outputs=[self._v_adv], device=dev)
+        args = [self.h, self.floor_depth, float(dt), self.cell_m, self.viscosity, span]
+        wp.launch(pool_kernels.accelerate_u, dim=rows(n, n + 1), inputs=[self._u_adv, *args],
+                  outputs=[self.u], device=dev)
+        wp.launch(pool_kernels.accelerate_v, dim=rows(n + 1, n), inputs=[self._v_adv, *args],
+                  outputs=[self.v], device=dev)
         if self.body is not None:
             centre, velocity = self.body_state(self.time_s + dt)
             push = [self.extent_m, wp.vec2(*centre), self.body.radius_m, wp.vec2(*velocity),
                     min(1.0, dt / self.body.response_s)]
             wp.launch(pool_kernels.push_u, dim=(n, n + 1), inputs=[self.u, *push], device=dev)
             wp.launch(pool_kernels.push_v, dim=(n + 1, n), inputs=[self.v, *push], device=dev)
-        wp.launch(pool_kernels.update_depth, dim=(n, n), inputs=[self.h, self.u, self.v, k],
+        wp.launch(pool_kernels.update_depth, dim=rows(n, n), inputs=[self.h, self.u, self.v, k, span],
                   outputs=[self._h_next], device=dev)
         self.h, self._h_next = self._h_next, self.h
         self.substeps += 1
