@@ -530,11 +530,13 @@ class Renderer:
                     seen = sun_visibility(surface, directions[0], highest, self.device, out=self.sky_visible)
             else:
                 seen = visible  # crests shade by the sun's centre
-            with watch.stage("photons" if photons else "beams"):
+            # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are
+            with watch.stage("sky" if from_sky else "photons" if photons else "beams"):
                 floor = stage.run(surface, seen)
             part = {}
             if self.camera is not None:
-                with watch.stage("camera" if photons or self.photons is None else "camera_beams"):
+                camera_stage = "camera" if photons or self.photons is None else "camera_beams"
+                with watch.stage("sky" if from_sky else camera_stage):
                     if photons:
                         n = self.scene.water_resolution
                         spacing = cfg.water.extent_m / n / cfg.caustics.photon_subdivisions
