@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 FULL = [(128, 4), (256, 4)]
 QUICK = [(64, 4)]
@@ -52,8 +52,6 @@ def measure(n: int, samples: int, device: str, repeats: int) -> dict:
 
 
 def run(quick: bool, device: str) -> dict:
-    import warp as wp
-
     repeats = 2 if quick else 3
     rows = []
     for n, s in QUICK if quick else FULL:
@@ -67,9 +65,7 @@ def run(quick: bool, device: str) -> dict:
         )
     return {
         "benchmark": "multiple_scattering_walk",
-        "device": device,
-        "device_name": str(wp.get_device(device).name),
-        "warp_version": wp.__version__,
+        **device_record(device),
         "repeats": repeats,
         "results": rows,
     }

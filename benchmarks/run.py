@@ -41,6 +41,14 @@ def point_sun_scene(path, overrides: dict | None = None):
     return wc.load_scene(path, {"sun.angular_diameter_deg": 0.0, **(overrides or {})})
 
 
+def device_record(device: str) -> dict:
+    """The device fields every benchmark record starts with: the device asked for, its name, Warp's
+    version."""
+    import warp as wp
+
+    return {"device": device, "device_name": str(wp.get_device(device).name), "warp_version": wp.__version__}
+
+
 def median_time(func, repeats: int, device: str | None = None) -> float:
     """Median wall time [s] of ``repeats`` calls of ``func``; with ``device``, each call ends by
     synchronising it (Warp launches are asynchronous on CUDA)."""

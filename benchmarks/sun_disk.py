@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 FULL = (256, 512, (8, 16, 32))
 QUICK = (128, 256, (8,))
@@ -65,8 +65,6 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
 
 
 def run(quick: bool, device: str) -> dict:
-    import warp as wp
-
     n, m, sample_counts = QUICK if quick else FULL
     repeats = 2 if quick else 3
     results = []
@@ -87,9 +85,7 @@ def run(quick: bool, device: str) -> dict:
         )
     return {
         "benchmark": "sun_disk_and_sky_vs_point",
-        "device": device,
-        "device_name": str(wp.get_device(device).name),
-        "warp_version": wp.__version__,
+        **device_record(device),
         "repeats": repeats,
         "timing": "median wall time of a whole frame after a warm-up, device synchronised",
         "results": results,
