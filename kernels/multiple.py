@@ -43,6 +43,8 @@ class Walk:
     max_events: int
     seed: int
     """Seed of the random streams (the sun's; the sky's walk is given another)."""
+    turn_seed: int
+    """Seed of each surface cell's random turn of the directions over its photons."""
 
 
 @wp.func
@@ -118,7 +120,12 @@ def random_walk(
                        + tv * ((1.0 - tu) * normals[iy1, ix] + tu * normals[iy1, ix1]))
     pos = wp.vec3(xy[0] + tu * cell, xy[1] + tv * cell, z)
     count = light_dirs.shape[0]
-    j = ((iy * n + ix) * s * s + q) % count
+    j = int(0)
+    if count > 1:
+        # The cell's photons take the directions in turn from a random start drawn per cell (and
+        # band), so no direction is tied to one part of every cell: the expected map is unbiased.
+        cell_rng = wp.rand_init(walk.turn_seed, (b * n + iy) * n + ix)
+        j = (q + wp.randi(cell_rng, 0, count)) % count
     sun_dir = light_dirs[j]
     v = visible[j % visible.shape[0]]
     cos_i = wp.dot(nrm, sun_dir)

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+import warp as wp
 from scipy import integrate
 
 import warpcaustics as wc
@@ -219,3 +220,60 @@ def test_render_walks_the_sky_apart_from_the_sun():
     np.testing.assert_allclose(np.array(st["transmitted"]) + t, r.transmitted_flux_w_nm, rtol=1e-12)
     np.testing.assert_allclose(r.sky_floor_irradiance.sum(axis=(1, 2)) * r.texel_area_m2, sky_st["floor"],
                                rtol=1e-5)
+
+
+def test_sky_walk_shades_each_direction_by_its_own_crests():
+    """The sky's photons read the shading of their own direction: with every direction shaded out
+    but one (still water, 8 directions), exactly that direction's skylight enters the water —
+    the patch's area × E_sky T(θ)/8, Fresnel in angle form (1e-5) — for each of three directions."""
+    scene = wc.load_scene(None, {**BASE, "sky.model": "uniform", "sky.diffuse_fraction": 0.3,
+                                 "sky.directions": 8})
+    renderer = wc.Renderer(scene, device="cpu")
+    e_sky = scene.sky_irradiance(renderer.sun_irradiance)
+    dirs, shares = scene.sky_directions()
+    walk = MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance, np.zeros(3),
+                              np.zeros(3), "cpu", sky_dirs=dirs, sky_irradiance=shares[:, None] * e_sky)
+    surface = renderer.water.at(0.0)
+    theta = np.arccos(dirs[:, 2])
+    for lit in (0, 3, 7):
+        shading = np.zeros((8, 32, 32), np.float32)
+        shading[lit] = 1.0
+        _, st = walk.run_sky(surface, wp.array(shading, dtype=wp.float32, device="cpu"))
+        expected = 4.0**2 * e_sky * fresnel_t_angles(theta[lit : lit + 1], 1.0, 1.333)[0] / 8
+        np.testing.assert_allclose(st["transmitted"], expected, rtol=1e-5)
+
+
+@pytest.mark.parametrize(("light", "threshold"), [("sky", 0.05), ("disk", 0.03)])
+def test_no_direction_is_tied_to_a_part_of_every_cell(light, threshold):
+    """The photons of a cell take the directions (16 of the sky, or of the sun's disk) in turn
+    from a random start per cell, so the expected map carries no fixed pattern: over still water,
+    without scattering or absorption, two seeds' maps (texels half a cell) vary independently —
+    the correlation of their deviations stays within ~4σ of 0 for 12 288 texels (measured 0.01;
+    0.70 and 0.06 when each direction always took the same sub-cell)."""
+    overrides = {**BASE, "water.resolution": 32, "caustics.map_resolution": 64, "floor.depth_m": 2.0}
+    if light == "sky":
+        overrides.update({"sky.model": "uniform", "sky.diffuse_fraction": 0.3, "sky.directions": 16})
+    else:
+        overrides.update({"sun.angular_diameter_deg": 0.53, "sun.disk_samples": 16})
+    deviations = []
+    for seed in (1, 2):
+        scene = wc.load_scene(None, {**overrides, "optics.mc_seed": seed})
+        renderer = wc.Renderer(scene, device="cpu")
+        surface = renderer.water.at(0.0)
+        if light == "sky":
+            dirs, shares = scene.sky_directions()
+            e_sky = scene.sky_irradiance(renderer.sun_irradiance)
+            walk = MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance,
+                                      np.zeros(3), np.zeros(3), "cpu", sky_dirs=dirs,
+                                      sky_irradiance=shares[:, None] * e_sky)
+            renderer.sky_visible.fill_(1.0)
+            floor, _ = walk.run_sky(surface, renderer.sky_visible)
+        else:
+            walk = MultipleScattering(scene.config, renderer.sun_directions, 1.333, renderer.sun_irradiance,
+                                      np.zeros(3), np.zeros(3), "cpu")
+            renderer.visible.fill_(1.0)
+            floor, _ = walk.run(surface, renderer.visible)
+        floor = floor.astype(np.float64)
+        deviations.append(floor - floor.mean(axis=(1, 2), keepdims=True))
+    a, b = deviations
+    assert abs((a * b).sum() / np.sqrt((a * a).sum() * (b * b).sum())) < threshold

@@ -20,6 +20,9 @@ from warpcaustics.water import Surface
 TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated")
 """The columns of the walk's tallies [W nm⁻¹ per band]."""
 
+TURN_STREAM = 0x2545F491
+"""Added to a walk's seed for the random turn of the directions over each cell's photons."""
+
 SKY_STREAM = 0x5851F42D
 """Added to ``optics.mc_seed`` for the sky's walk, so its photons draw other random numbers than the
 sun's."""
@@ -74,6 +77,7 @@ class MultipleScattering:
             w.samples = cfg.optics.mc_samples
             w.max_events = cfg.optics.mc_max_events
             w.seed = seed
+            w.turn_seed = (seed + TURN_STREAM) % 2**31
             return w
 
         self.walk = walk(cfg.optics.mc_seed)
