@@ -95,19 +95,21 @@ def test_photons_and_beams_see_the_sky_as_the_flux_ratio_map_does(method):
                                rtol=1e-5, atol=1e-6 * sun_only.floor_irradiance.max())
 
 
-@pytest.mark.parametrize(("method", "rtol"), [("eikonal", 1e-4), ("wave3d", 0.02)])
+@pytest.mark.parametrize(("method", "rtol"), [("eikonal", 2e-5), ("wave3d", 0.02)])
 def test_grid_methods_solve_the_sky_a_direction_at_a_time(method, rtol):
     """The eikonal and wave grids light still water from each of 8 sky directions with its share
     of the sky (a solve each): the sky's part is Σ_d (E_sky/D) T(θ_d) e^{−cD/cosθt_d}, written out
-    with Fresnel and Snell in the test — within the method's own still-water accuracy (eikonal
-    2e-5 per direction, wave 2 % at suns down to 15°: these directions reach 14.5°), uniformly;
-    the sun's part is the sun-only render's (1e-5)."""
+    with Fresnel and Snell in the test — within the method's own still-water tolerance (eikonal
+    2e-5, measured 2e-7; wave 2 % at suns down to 15°, measured 1.8e-3: these directions reach
+    14.5°), uniformly. The sun's part is the sun-only render's (1e-5), and the grid is left lit by
+    the sun: a second frame is the first, bit for bit, and the eikonal texture is the sun's."""
     grid = {"caustics.method": method, "optics.ior": 1.333, "caustics.eikonal_resolution": 48,
             "caustics.wave3d_resolution": 48, "floor.depth_m": 1.5, "sun.angular_diameter_deg": 0.0,
             "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2}}
     sky = {"sky.model": "uniform", "sky.diffuse_fraction": 0.3, "sky.directions": 8}
     scene = wc.load_scene(None, {**BASE, **grid, **sky})
-    r = wc.render(scene, device="cpu")
+    renderer = wc.Renderer(scene, device="cpu")
+    r = renderer.render(0.0)
     dirs, _ = scene.sky_directions()
     theta = np.arccos(dirs[:, 2])
     theta_t = np.arcsin(np.sin(theta) / 1.333)
@@ -118,6 +120,10 @@ def test_grid_methods_solve_the_sky_a_direction_at_a_time(method, rtol):
     sky_part = r.sky_floor_irradiance
     np.testing.assert_allclose(sky_part.mean(axis=(1, 2)), expected, rtol=rtol)
     assert np.all(sky_part.std(axis=(1, 2)) < rtol * sky_part.mean(axis=(1, 2)))
-    sun_only = wc.render(wc.load_scene(None, {**BASE, **grid}), device="cpu")
+    sun_renderer = wc.Renderer(wc.load_scene(None, {**BASE, **grid}), device="cpu")
+    sun_only = sun_renderer.render(0.0)
     np.testing.assert_allclose(r.floor_irradiance - sky_part, sun_only.floor_irradiance, rtol=1e-5,
                                atol=1e-6 * sun_only.floor_irradiance.max())
+    np.testing.assert_array_equal(renderer.render(0.0).floor_irradiance, r.floor_irradiance)
+    if method == "eikonal":
+        np.testing.assert_array_equal(renderer.approximate.texture(), sun_renderer.approximate.texture())

@@ -409,9 +409,10 @@ class Renderer:
                 with watch.stage("multiple_scattering"):
                     floor_np, walk = self.multiple.run(surface, visible)
                     transmitted = np.asarray(walk["transmitted"])
-                    if self.sky_directions is not None:
+                if self.sky_directions is not None:
+                    with watch.stage("sky"):
                         sky_np, walk["sky"] = self.multiple.run_sky(surface, self.sky_visible)
-                        sky_transmitted = np.asarray(walk["sky"]["transmitted"])
+                    sky_transmitted = np.asarray(walk["sky"]["transmitted"])
                 extra = {"multiple_scattering_stats": walk}
             if self.sky_directions is not None:
                 extra["sky_floor_irradiance"] = sky_np
@@ -419,16 +420,20 @@ class Renderer:
                 transmitted = transmitted + sky_transmitted
             if self.approximate is not None:
                 flux_ratio_floor = floor_np
+                grid_sky = None
+                if self.sky_directions is not None and isinstance(self.approximate, GridCaustics):
+                    # the grid's own sky replaces the flux ratio's; solved before the sun, so that
+                    # the grid holds the sun's solve afterwards (texture(), stats)
+                    with watch.stage("sky"):
+                        grid_sky = self._grid_sky(surface, time_s, highest, flux_ratio_floor)
                 with watch.stage(cfg.caustics.method.value):
                     floor_np, extra = self.approximate.floor_map(surface, self.water, time_s, highest,
                                                                  visible, flux_ratio_floor)
                     if isinstance(self.approximate, GridCaustics):  # the sun's disk, if any
                         floor_np = self.approximate.disk_average(floor_np, self.sun_directions)
-                if self.sky_directions is not None:  # the grid method's own sky replaces the flux ratio's
-                    with watch.stage("sky"):
-                        sky_np = self._grid_sky(surface, time_s, highest, flux_ratio_floor)
-                    extra["sky_floor_irradiance"] = sky_np
-                    floor_np = floor_np + sky_np
+                if grid_sky is not None:
+                    extra["sky_floor_irradiance"] = grid_sky
+                    floor_np = floor_np + grid_sky
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
