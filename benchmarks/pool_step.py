@@ -3,10 +3,12 @@
 The same staggered grid and the same operations as ``kernels/pool.py``: semi-Lagrangian
 advection of u and v (bilinear, clamped), gravity and viscosity on the faces, conservative upwind
 update of the depths. Both start from the same state (a pool sloshing after drops).
+``python -m benchmarks.pool_step [--quick]`` runs it alone (``benchmarks.run`` runs it too).
 """
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -103,3 +105,26 @@ def measure_numpy(n: int, repeats: int) -> dict:
         h1, _, _ = numpy_step(h, u, v, depth, dt, pool.cell_m, pool.viscosity)
         times.append(time.perf_counter() - t0)
     return {"step_s": float(np.median(times)), "max_abs_depth_diff_m": float(np.abs(h1 - h_ref).max())}
+
+
+def run(quick: bool, device: str) -> dict:
+    """The substep at each size, Warp and numpy, each in its own process (as ``benchmarks.run``
+    does), with the log-log slopes and, in the full run, the plot."""
+    from benchmarks.run import ROOT, STEPS, _plot_steps, _steps, device_record
+
+    (title, full, short), = [(t, f, q) for name, t, f, q in STEPS if name == "pool_step"]
+    rows = _steps("pool_step", short if quick else full, device, 2 if quick else 5)
+    if not quick:
+        image = ROOT / "docs" / "images" / f"pool_step_scaling_{device.replace(':', '')}.png"
+        _plot_steps(rows, f"{title}, {device}", image)
+    return {"benchmark": "pool_substep", **device_record(device), "results": rows}
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "pool_step", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
