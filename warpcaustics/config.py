@@ -145,6 +145,11 @@ class DeviceChoice(str, enum.Enum):
 PLANNED_VALUES = {
     "sky.model": ("cie_clear",),
 }
+PLANNED_WHY = {
+    ("sky.model", "cie_clear"): "it needs the CIE standard-sky coefficients from a maintained source, which "
+    "no colour-science release has yet",
+}
+"""Why a planned value is not built yet, where that is known (said in its error)."""
 
 
 @dataclass(frozen=True)
@@ -514,8 +519,10 @@ class OutputConfig:
 @dataclass(frozen=True)
 class SkyConfig:
     model: SkyModel = SkyModel.NONE
-    """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky;
-    ``fluxratio``, ``photons``, ``beams``). ``cie_clear`` is planned."""
+    """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky; every
+    method but ``sunmap``). ``cie_clear`` is planned: it waits for a sourced table of the CIE
+    standard skies (colour-science's ``sky_luminance_distribution_CIE2003`` is in no release
+    yet)."""
     diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
     """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
     (``sun.*``) is the rest [-]."""
@@ -630,8 +637,9 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
             return tp(value)
         planned = PLANNED_VALUES.get(key, ())
         if value in planned:
-            raise ConfigError(f"{key} = {_describe(value)} is not implemented yet; allowed now: "
-                              f"{', '.join(allowed)}")
+            why = PLANNED_WHY.get((key, value))
+            raise ConfigError(f"{key} = {_describe(value)} is not implemented yet"
+                              + (f" ({why})" if why else "") + f"; allowed now: {', '.join(allowed)}")
         raise ConfigError(f"{key} = {_describe(value)} is not allowed; allowed: {', '.join(allowed)}")
     if typing.get_origin(tp) is tuple and typing.get_args(tp) == (float, Ellipsis):
         if isinstance(value, (int, float)) and not isinstance(value, bool):
