@@ -155,9 +155,9 @@ def emit_photons(
 ):
     """Photon (g, qy, qx, sub): its start on the bilinear surface patch of quad (qx, qy), its
     refracted direction for index group g and its weight A⊥·T [m²] (0 if lit from behind, on
-    total internal reflection or if it would not descend). With a sun disk, ``sun_dirs`` holds its
-    D directions and the photons of the surface take them in turn (every D consecutive photons, all
-    of them: stratified over the disk); a point sun is one direction."""
+    total internal reflection or if it would not descend). ``sun_dirs`` is the pass's direction (the
+    renderer runs a pass per direction of the sun's disk or of the sky); given several, the photons
+    take them in turn (every D consecutive photons)."""
     g, qy, qx, sub = wp.tid()
     n = positions.shape[0]
     quads = positions.shape[0] + 1 - periodic

@@ -352,10 +352,15 @@ def test_photon_scene_errors_are_one_line():
         wc.render(scene, device="cpu")
 
 
-def test_camera_sees_a_uniformly_lit_floor_as_uniform():
+@pytest.mark.parametrize("disk_deg", [0.0, 0.53])
+def test_camera_sees_a_uniformly_lit_floor_as_uniform(disk_deg):
     """Flat water, no absorption, a grey floor seen obliquely: every pixel's radiance is
-    albedo · E_sun cosθ T(θ) / π, however the pixel footprints vary across the image."""
+    albedo · E_sun cosθ T(θ) / π, however the pixel footprints vary across the image — under a
+    point sun and under the 0.53° disk (16 directions, a photon pass each: the disk changes the
+    still-water irradiance by ~1e-5). When the photons took the disk's directions in turn within
+    one pass, their lattice neighbours were other directions' and the splats drew that pattern."""
     overrides = {
+        "sun.angular_diameter_deg": disk_deg,
         "water.resolution": 128,
         "caustics.photon_subdivisions": 4,
         "floor.albedo": 0.5,

@@ -91,8 +91,8 @@ def _encircled_radius(e: np.ndarray, x: np.ndarray, share: float) -> float:
     return float(r[order][np.searchsorted(cumulative, share * cumulative[-1])])
 
 
-def test_photons_take_the_disk_directions_in_turn(focus_maps):
-    """Photons (4×4 per cell, 16 disk directions, one each) under the lens at its focus: a point
+def test_photons_run_a_pass_per_disk_direction(focus_maps):
+    """Photons (4×4 per cell, 16 disk directions, a pass each) under the lens at its focus: a point
     sun's spot holds half its flux inside a texel or two; the disk's is the sun's image, a uniform
     disc of radius a = f'·ρ/n, so a share q of its flux lies within √q·a (q = ¼, ½, ¾; to one 1 mm
     texel), as with the flux-ratio map's disk; the flux is unchanged (1e-4). On still water the

@@ -108,11 +108,9 @@ class PhotonCaustics:
         device: str,
         *,
         periodic: bool,
-        disk_dirs: np.ndarray | None = None,
     ):
         """``sun_dir``: the sun's centre (the light view for the Newton guesses is rendered from
-        it); ``disk_dirs``: (D, 3) directions over the sun's disk the photons take in turn (None: a
-        point sun)."""
+        it, and the photons' direction until :meth:`set_light`)."""
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -150,8 +148,7 @@ class PhotonCaustics:
         )
         sun = np.asarray(sun_dir, np.float64)
         self.sun_dir = wp.vec3(*sun.astype(np.float32))
-        dirs = sun[None] if disk_dirs is None else np.asarray(disk_dirs, np.float64)
-        self.sun_dirs = wp.array(dirs.astype(np.float32), dtype=wp.vec3, device=device)
+        self.sun_dirs = wp.array(sun[None].astype(np.float32), dtype=wp.vec3, device=device)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
         self.view = self._light_view(
@@ -264,9 +261,11 @@ class PhotonCaustics:
         return self.irradiance
 
     def set_light(self, directions: np.ndarray, irradiance: np.ndarray) -> None:
-        """Emit the next :meth:`run`'s photons with ``directions`` (D, 3) taken in turn (the sun's
-        disk, or one sky direction) carrying ``irradiance`` (K,) on a plane perpendicular to them
-        [W m⁻² nm⁻¹]; the renderer adds the passes up."""
+        """Emit the next :meth:`run`'s photons along ``directions`` carrying ``irradiance`` (K,) on a
+        plane perpendicular to them [W m⁻² nm⁻¹]; the renderer adds the passes up. It passes one
+        direction at a time (a point of the sun's disk, or of the sky): several are taken in turn,
+        which leaves a photon's lattice neighbours on other directions, and the camera's lattice
+        splats then draw that assignment's pattern."""
         self.sun_dirs = wp.array(np.asarray(directions, np.float32), dtype=wp.vec3, device=self.device)
         self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
 

@@ -304,8 +304,7 @@ class Renderer:
                     self.beams = beams.BeamCaustics(*args, periodic=self.water.periodic,
                                                     relief=scene.floor_relief)
                 if method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH):
-                    self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic,
-                                                          disk_dirs=self.sun_directions)
+                    self.photons = photons.PhotonCaustics(*args, periodic=self.water.periodic)
                 self.floor_top_z = self.receivers.floor_top_z
                 if self.water.periodic:
                     lights = [scene.sun_direction] + list(self.sky_directions if self.sky_directions
@@ -503,16 +502,14 @@ class Renderer:
             flux = self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)
         return floor, flux
 
-    def _light_passes(self, photons: bool) -> list[tuple[np.ndarray, np.ndarray, bool]]:
-        """The passes of a photon or beam stage: (directions (D, 3), irradiance (K,) on a plane
-        perpendicular to them, from the sky). Photons take the sun disk's directions in turn in one
-        pass; beams run a pass per direction with its share of the sun. Each sky direction is a
-        pass with its share of the sky."""
+    def _light_passes(self) -> list[tuple[np.ndarray, np.ndarray, bool]]:
+        """The passes of a photon or beam stage: (directions (1, 3), irradiance (K,) on a plane
+        perpendicular to them, from the sky). A pass per direction of the sun's disk with its share
+        of the sun, and per sky direction with its share of the sky. Photons too: taking the disk's
+        directions in turn within one pass made each photon's lattice neighbours another
+        direction's, and the camera's lattice splats then drew the pattern of that assignment."""
         dirs = self.sun_directions
-        if photons:
-            passes = [(dirs, self.sun_irradiance, False)]
-        else:
-            passes = [(d[None], self.sun_irradiance / len(dirs), False) for d in dirs]
+        passes = [(d[None], self.sun_irradiance / len(dirs), False) for d in dirs]
         if self.sky_directions is not None:
             passes += [(d[None], e, True) for d, e in zip(self.sky_directions, self.sky_irradiance_np)]
         return passes
@@ -527,7 +524,7 @@ class Renderer:
         other = rec.face_count - rec.floor_face_count
         totals: dict[bool, dict[str, np.ndarray]] = {False: {}, True: {}}
         extra = {}
-        passes = self._light_passes(photons)
+        passes = self._light_passes()
         for directions, irradiance, from_sky in passes:
             stage.set_light(directions, irradiance)
             if from_sky:
