@@ -4,9 +4,9 @@ map and by the photons, same run.
 For the flux-ratio map the disk costs one refraction and one deposit per direction over it, so the
 frame's caustic stages should take about ``sun.disk_samples`` times the point sun's; a uniform sky
 over as many directions adds as many passes, each with its own crest-shading march. The photons
-take the disk's directions in turn, one per photon, so their disk should cost nothing; their sky
-is a photon pass per sky direction. The eikonal grid (64³) solves once more per sky direction.
-Median of a few frames after a warm-up frame, device synchronised. ``python -m benchmarks.sun_disk --help``.
+run a pass per disk direction and per sky direction too. The eikonal grid (64³) solves once more
+per sky direction. Median of a few frames after a warm-up frame, device synchronised.
+``python -m benchmarks.sun_disk --help``.
 """
 
 from __future__ import annotations

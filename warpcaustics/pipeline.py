@@ -76,9 +76,11 @@ class RenderResult:
     """``photons``, ``beams``: (points (V, 3) [m], triangles (F, 3)) of the receivers other than the
     floor, the faces in the order of :attr:`face_flux_w_nm`."""
     photon_stats: dict[str, int] | None = None
-    """``photons``: photons emitted, carrying flux, and landed on a receiver."""
+    """``photons``: photons emitted, carrying flux, and landed on a receiver, added up over the
+    frame's light passes (one per direction of the sun's disk and of the sky)."""
     beam_stats: dict[str, int] | None = None
-    """``beams``: beams built, carrying flux, dropped, and tile-list entries."""
+    """``beams``: beams built, carrying flux, dropped, and tile-list entries, added up over the
+    frame's light passes."""
     method: str = "fluxratio"
     """The caustics method that made :attr:`floor_irradiance` (``beams`` for ``both``)."""
     comparison: RenderResult | None = None
