@@ -145,7 +145,7 @@ def emit_photons(
     normals: wp.array2d[wp.vec3],
     visible: wp.array2d[wp.float32],
     ior: wp.array[wp.float32],
-    sun_dirs: wp.array[wp.vec3],
+    sun_dir: wp.vec3,
     subdivisions: int,
     extent_m: float,
     periodic: int,
@@ -155,9 +155,8 @@ def emit_photons(
 ):
     """Photon (g, qy, qx, sub): its start on the bilinear surface patch of quad (qx, qy), its
     refracted direction for index group g and its weight A⊥·T [m²] (0 if lit from behind, on
-    total internal reflection or if it would not descend). ``sun_dirs`` is the pass's direction (the
-    renderer runs a pass per direction of the sun's disk or of the sky); given several, the photons
-    take them in turn (every D consecutive photons)."""
+    total internal reflection or if it would not descend). ``sun_dir`` is the pass's direction
+    towards the light (the renderer runs a pass per direction of the sun's disk or of the sky)."""
     g, qy, qx, sub = wp.tid()
     n = positions.shape[0]
     quads = positions.shape[0] + 1 - periodic
@@ -172,7 +171,6 @@ def emit_photons(
     p10 = lift(positions[y10, x10], h10)
     p01 = lift(positions[y01, x01], h01)
     p11 = lift(positions[y11, x11], h11)
-    sun_dir = sun_dirs[((qy * quads + qx) * s * s + sub) % sun_dirs.shape[0]]
     p = bilinear_vec3(p00, p10, p01, p11, tu, tv)
     dp_du = (1.0 - tv) * (p10 - p00) + tv * (p11 - p01)
     dp_dv = (1.0 - tu) * (p01 - p00) + tu * (p11 - p10)

@@ -148,7 +148,7 @@ class PhotonCaustics:
         )
         sun = np.asarray(sun_dir, np.float64)
         self.sun_dir = wp.vec3(*sun.astype(np.float32))
-        self.sun_dirs = wp.array(sun[None].astype(np.float32), dtype=wp.vec3, device=device)
+        self.light_dir = self.sun_dir  # the photons' direction (the disk's or the sky's, per pass)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
         self.view = self._light_view(
@@ -201,7 +201,7 @@ class PhotonCaustics:
                 surface.normals,
                 visible,
                 ior,
-                self.sun_dirs,
+                self.light_dir,
                 s,
                 extent,
                 int(self.periodic),
@@ -261,12 +261,13 @@ class PhotonCaustics:
         return self.irradiance
 
     def set_light(self, directions: np.ndarray, irradiance: np.ndarray) -> None:
-        """Emit the next :meth:`run`'s photons along ``directions`` carrying ``irradiance`` (K,) on a
-        plane perpendicular to them [W m⁻² nm⁻¹]; the renderer adds the passes up. It passes one
-        direction at a time (a point of the sun's disk, or of the sky): several are taken in turn,
-        which leaves a photon's lattice neighbours on other directions, and the camera's lattice
-        splats then draw that assignment's pattern."""
-        self.sun_dirs = wp.array(np.asarray(directions, np.float32), dtype=wp.vec3, device=self.device)
+        """Emit the next :meth:`run`'s photons along ``directions`` (1, 3) (a point of the sun's disk,
+        or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it [W m⁻² nm⁻¹]; the
+        renderer adds the passes up. One direction per pass: a photon's lattice neighbours must share
+        its direction, or the camera's lattice splats draw a pattern."""
+        if len(directions) != 1:
+            raise ValueError("photons take one light direction per pass")
+        self.light_dir = wp.vec3(*np.asarray(directions[0], np.float32))
         self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
 
     def transmitted_flux(self) -> np.ndarray:
