@@ -20,7 +20,6 @@ homogeneous, stationary sea (ergodicity), which a linear random FFT sea is.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import dataclass
@@ -30,7 +29,7 @@ import numpy as np
 
 from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
-from warpcaustics.output import atomic_path
+from warpcaustics.output import atomic_path, pyplot, write_csv
 
 SERIES = ("zenith", "wind")
 
@@ -172,7 +171,7 @@ def run_gernez2009(
     rows = _rows(points, overrides, sweep, Path(out), base.config)
     out = Path(out)
     paths = {"csv": out / "gernez2009.csv", "png": out / "gernez2009.png"}
-    _write_csv(paths["csv"], rows)
+    write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
     return paths
 
@@ -259,23 +258,9 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     return rows
 
 
-def _write_csv(path: Path, rows: list[dict]) -> None:
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def _plotting():
-    """matplotlib's pyplot (Agg), or a one-line error naming the extra to install."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise ConfigError("the comparison's plot needs matplotlib: pip install -e '.[study]'") from None
-    return plt
+    """matplotlib's pyplot, or a one-line error naming the extra to install."""
+    return pyplot("the comparison's plot needs")
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:

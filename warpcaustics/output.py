@@ -6,6 +6,7 @@ array's last row (largest y).
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import platform
@@ -34,6 +35,29 @@ def atomic_path(path: Path):
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    """Rows of equal keys as a CSV table (header from the first row), written atomically."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def pyplot(needs: str):
+    """matplotlib's pyplot on the Agg backend, or a one-line ConfigError: ``needs`` says what needs
+    it (e.g. "the study's plots need") and the error names the extra to install."""
+    from warpcaustics.errors import ConfigError
+
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ConfigError(f"{needs} matplotlib: pip install -e '.[study]'") from None
+    return plt
 
 
 def spectral_channel_name(wavelength_nm: float) -> str:

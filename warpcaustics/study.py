@@ -7,7 +7,6 @@ of ``water_types`` × ``depths_m`` × ``sun_elevations_deg`` and writes ``study.
 
 from __future__ import annotations
 
-import csv
 import itertools
 import warnings
 from dataclasses import dataclass
@@ -17,7 +16,7 @@ import numpy as np
 
 from warpcaustics.config import WaterType, read_toml
 from warpcaustics.errors import ConfigError
-from warpcaustics.output import atomic_path
+from warpcaustics.output import atomic_path, pyplot, write_csv
 
 STUDY_KEYS = {"scene", "water_types", "depths_m", "sun_elevations_deg", "overrides"}
 
@@ -116,8 +115,8 @@ def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> d
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = {"study": out_dir / "study.csv", "kd": out_dir / "kd.csv",
              "plot": out_dir / "irradiance_vs_depth.png"}
-    _write_csv(paths["study"], rows)
-    _write_csv(paths["kd"], _attenuation_rows(study, spectra_by))
+    write_csv(paths["study"], rows)
+    write_csv(paths["kd"], _attenuation_rows(study, spectra_by))
     _plot(study, rows, paths["plot"])
     return paths
 
@@ -147,21 +146,8 @@ def _attenuation_rows(study: StudyConfig, spectra_by: dict) -> list[dict]:
     return rows
 
 
-def _write_csv(path: Path, rows: list[dict]) -> None:
-    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def _plot(study: StudyConfig, rows: list[dict], path: Path) -> None:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise ConfigError("the study's plots need matplotlib: pip install -e '.[study]'") from None
+    plt = pyplot("the study's plots need")
     elevations = study.sun_elevations_deg
     fig, axes = plt.subplots(1, len(elevations), figsize=(4.2 * len(elevations), 3.6), dpi=110,
                              sharey=True, squeeze=False)
