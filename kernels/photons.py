@@ -48,17 +48,18 @@ def bilinear_vec3(a: wp.vec3, b: wp.vec3, c: wp.vec3, d: wp.vec3, tu: float, tv:
 
 
 @wp.kernel
-def render_light_view(mesh: wp.uint64, sun_dir: wp.vec3, distance_m: float, view: LightView):
-    """Fill the light view: the first receiver point seen along −s through each texel (face −1:
-    none)."""
+def render_light_view(mesh: wp.uint64, view_dir: wp.vec3, start_z: float, view: LightView):
+    """Fill the light view: the first receiver point below the plane z = ``start_z`` seen along
+    −``view_dir`` through each texel (face −1: none). ``view_dir`` points up (z > 0): it is the
+    sun's direction under still water, and receivers above the water get no refracted light."""
     j, i = wp.tid()
     centre = (
         view.origin + ((float(i) + 0.5) * view.texel_m) * view.u + ((float(j) + 0.5) * view.texel_m) * view.v
     )
-    start = centre + distance_m * sun_dir
-    q = wp.mesh_query_ray(mesh, start, -sun_dir, RAY_LENGTH_M)
+    start = centre + ((start_z - centre[2]) / view_dir[2]) * view_dir
+    q = wp.mesh_query_ray(mesh, start, -view_dir, RAY_LENGTH_M)
     if q.result:
-        view.positions[j, i] = start - q.t * sun_dir
+        view.positions[j, i] = start - q.t * view_dir
         view.faces[j, i] = q.face
     else:
         view.positions[j, i] = centre

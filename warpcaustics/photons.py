@@ -79,6 +79,26 @@ def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, i
                 "move it towards the centre (receivers[].translate_m) or enlarge water.extent_m")
 
 
+WATER_AT_REST_Z = 0.0
+"""Height of the water surface at rest [m]: the Newton light view sees only receivers below it
+(a walled pool's walls stand 1 m above the water; above it light runs along the sun, not the view)."""
+
+
+def light_view_direction(sun_dir: np.ndarray, group_ior: np.ndarray) -> np.ndarray:
+    """The direction the Newton light view looks from: towards the sun as seen under still water,
+    i.e. minus the sun's refracted direction (mean index of the groups).
+
+    The receivers all lie in the water, where the light runs along refracted directions. A view
+    along the sun's direction in air would see receivers the refracted light never reaches and
+    hide those it does: at a 40° sun a pool's near wall hides two thirds of the floor's light
+    from a view along the sun, none from the refracted view (tests/test_photons.py)."""
+    from warpcaustics.reference import refract
+
+    s = np.asarray(sun_dir, np.float64)
+    d = refract(-s, np.array([0.0, 0.0, 1.0]), 1.0 / float(np.mean(group_ior)))
+    return -d / np.linalg.norm(d)
+
+
 def light_view_frame(points: np.ndarray, sun_dir: np.ndarray, resolution: int):
     """(origin, u, v, texel) of an orthographic sun view covering all ``points``; u, v ⊥ sun."""
     s = np.asarray(sun_dir, np.float64)
@@ -109,8 +129,8 @@ class PhotonCaustics:
         *,
         periodic: bool,
     ):
-        """``sun_dir``: the sun's centre (the light view for the Newton guesses is rendered from
-        it, and the photons' direction until :meth:`set_light`)."""
+        """``sun_dir``: the sun's centre (the light view for the Newton guesses looks along its
+        refracted direction, and it is the photons' direction until :meth:`set_light`)."""
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -151,15 +171,16 @@ class PhotonCaustics:
         self.light_dir = self.sun_dir  # the photons' direction (the disk's or the sky's, per pass)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
+        self.view_dir = light_view_direction(sun, group_ior)
         self.view = self._light_view(
-            sun,
+            self.view_dir,
             cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 1,
         )
         self.newton_iterations = (
             cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
         )
 
-    def _light_view(self, sun: np.ndarray, resolution: int) -> photon_kernels.LightView:
+    def _light_view(self, view_dir: np.ndarray, resolution: int) -> photon_kernels.LightView:
         # The view needs the receivers where photons land: on a periodic sea that is the patch
         # (photons are moved by whole periods first), not the floor's margin beyond it.
         points = self.receivers.points
@@ -169,7 +190,7 @@ class PhotonCaustics:
                 np.all(np.abs(points[:, :2]) <= reach, axis=1)
                 | (np.arange(len(points)) >= self.receivers.floor_vertex_count)
             ]
-        origin, u, v, texel = light_view_frame(points, sun, resolution)
+        origin, u, v, texel = light_view_frame(points, view_dir, resolution)
         view = photon_kernels.LightView()
         view.origin = wp.vec3(*origin.astype(np.float32))
         view.u = wp.vec3(*u.astype(np.float32))
@@ -178,11 +199,10 @@ class PhotonCaustics:
         view.positions = wp.empty((resolution, resolution), dtype=wp.vec3, device=self.device)
         view.faces = wp.empty((resolution, resolution), dtype=wp.int32, device=self.device)
         if resolution > 1:
-            distance = float(np.abs(self.receivers.points @ sun).max() + 1.0)
             wp.launch(
                 photon_kernels.render_light_view,
                 dim=(resolution, resolution),
-                inputs=[self.receivers.mesh.id, self.sun_dir, distance, view],
+                inputs=[self.receivers.mesh.id, wp.vec3(*view_dir.astype(np.float32)), WATER_AT_REST_Z, view],
                 device=self.device,
             )
         return view
