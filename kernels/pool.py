@@ -50,8 +50,12 @@ def advect_u(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell:
     iy, chunk = wp.tid()
     for jx in range(chunk * span, span_end(chunk, span, u.shape[1])):
         vel_u = u[iy, jx]
-        # v at this u-face: mean of the four surrounding v-faces (v-grid index (ix, jy)).
-        vel_v = sample_faces(v, float(jx) - 0.5, float(iy) + 0.5)
+        # v at this u-face: mean of the four surrounding v-faces (v-grid index (ix, jy)), the
+        # nearest column's two at the walls. Bit for bit the bilinear sample at (jx − ½, iy + ½)
+        # (weights ½ scale exactly), without its clamps and conversions.
+        ia = wp.max(jx - 1, 0)
+        ib = wp.min(jx, v.shape[1] - 1)
+        vel_v = 0.25 * ((v[iy, ia] + v[iy, ib]) + (v[iy + 1, ia] + v[iy + 1, ib]))
         u_out[iy, jx] = sample_faces(u, float(jx) - vel_u * dt_over_cell, float(iy) - vel_v * dt_over_cell)
 
 
@@ -62,7 +66,10 @@ def advect_v(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell:
     jy, chunk = wp.tid()
     for ix in range(chunk * span, span_end(chunk, span, v.shape[1])):
         vel_v = v[jy, ix]
-        vel_u = sample_faces(u, float(ix) + 0.5, float(jy) - 0.5)
+        # u at this v-face: mean of the four surrounding u-faces (as vel_v in advect_u).
+        ja = wp.max(jy - 1, 0)
+        jb = wp.min(jy, u.shape[0] - 1)
+        vel_u = 0.25 * ((u[ja, ix] + u[ja, ix + 1]) + (u[jb, ix] + u[jb, ix + 1]))
         v_out[jy, ix] = sample_faces(v, float(ix) - vel_u * dt_over_cell, float(jy) - vel_v * dt_over_cell)
 
 
