@@ -38,7 +38,7 @@ QUICK_CAMERA = {"water.resolution": 64, "caustics.photon_subdivisions": 2, "caus
 
 @dataclass(frozen=True)
 class LightViewArrays:
-    """Host copy of the Warp ``LightView`` (Shah's receiver-position buffer seen from the sun)."""
+    """Host copy of the Warp ``LightView`` (Shah's receiver-position buffer seen from the light)."""
 
     positions: np.ndarray
     """(R, R, 3) first receiver point seen through texel [j, i] [m]."""
@@ -93,7 +93,7 @@ def _fresnel_transmittance(cos_i: np.ndarray, eta: float) -> np.ndarray:
 
 
 def _look_up(view: LightViewArrays, x: np.ndarray):
-    """``look_up``: the receiver point R(x) the sun sees through each x, its receiver id (−1: none
+    """``look_up``: the receiver point R(x) the light view sees through each x, its receiver id (−1: none
     or outside the view). Bilinear between the four texel centres around x where they all show
     the receiver of x's own texel, else that texel's point."""
     res = view.positions.shape[0]

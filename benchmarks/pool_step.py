@@ -110,10 +110,10 @@ def measure_numpy(n: int, repeats: int) -> dict:
 def run(quick: bool, device: str) -> dict:
     """The substep at each size, Warp and numpy, each in its own process (as ``benchmarks.run``
     does), with the log-log slopes and, in the full run, the plot."""
-    from benchmarks.run import ROOT, STEPS, _plot_steps, _steps, device_record
+    from benchmarks.run import ROOT, STEPS, _plot_steps, _steps, device_record, step_sizes
 
-    (title, full, short), = [(t, f, q) for name, t, f, q in STEPS if name == "pool_step"]
-    rows = _steps("pool_step", short if quick else full, device, 2 if quick else 5)
+    title, = [t for name, t, _, _ in STEPS if name == "pool_step"]
+    rows = _steps("pool_step", step_sizes("pool_step", quick, device), device, 2 if quick else 5)
     if not quick:
         image = ROOT / "docs" / "images" / f"pool_step_scaling_{device.replace(':', '')}.png"
         _plot_steps(rows, f"{title}, {device}", image)

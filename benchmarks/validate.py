@@ -295,16 +295,16 @@ def _photons() -> None:
             print(f"  k={k}: {e['mean'] * 1000:10.4f} {e['median'] * 1000:10.4f} {e['p95'] * 1000:10.4f}  "
                   f"{e['within_texel']:.1%}")
 
-    print("\n## Newton vs exact hits: where a walled pool's light lands "
-          "(configs/pool.toml, 0.6 s, no absorption)")
+    print("\n## Newton vs exact hits: where a walled pool's light lands (0.6 s, no absorption)")
     from test_photons import pool_flux_by_intersection
 
-    for el in (20.0, 40.0, 70.0):
-        f = pool_flux_by_intersection(el)
+    for config, el in (("pool", 20.0), ("pool", 40.0), ("pool", 70.0), ("wavepool", 30.0)):
+        f = pool_flux_by_intersection(el, f"configs/{config}.toml")
         share = {mode: {part: f[mode][part] / f["transmitted"] for part in ("floor", "walls")}
                  for mode in ("exact", "newton")}
-        print(f"sun {el:4.0f}°: floor {share['exact']['floor']:.2%} exact, {share['newton']['floor']:.2%} "
-              f"Newton; walls {share['exact']['walls']:.2%} exact, {share['newton']['walls']:.2%} Newton "
+        print(f"{config}.toml, sun {el:2.0f}°: floor {share['exact']['floor']:.2%} exact, "
+              f"{share['newton']['floor']:.2%} Newton; walls {share['exact']['walls']:.2%} exact, "
+              f"{share['newton']['walls']:.2%} Newton "
               "(of the transmitted flux)")
 
     print("\n## Photons vs the flux-ratio map, configs/ocean.toml (256² surface, rgb)")

@@ -22,15 +22,16 @@ RAY_LENGTH_M = 1.0e5
 """Longest ray queried on the BVH [m]."""
 
 MAX_BLEND_DEPTH_TEXELS = 8.0
-"""Light-view texels are blended only if their depths along the sun differ by less than this many
+"""Light-view texels are blended only if their depths along the view differ by less than this many
 texel widths (a surface inclined up to ~83° to the view); beyond, the nearest texel is used."""
 
 
 @wp.struct
 class LightView:
-    """Orthographic view from the sun onto the receivers (Shah's receiver-position buffer).
+    """Orthographic view from the light onto the receivers (Shah's receiver-position buffer),
+    along the sun's refracted direction under still water (``u × v``, pointing up).
 
-    Texel (i, j) looks along −s through ``origin + (i + ½) texel u + (j + ½) texel v``.
+    Texel (i, j) looks along −(u × v) through ``origin + (i + ½) texel u + (j + ½) texel v``.
     """
 
     origin: wp.vec3
@@ -47,18 +48,38 @@ def bilinear_vec3(a: wp.vec3, b: wp.vec3, c: wp.vec3, d: wp.vec3, tu: float, tv:
     return (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)
 
 
+MAX_WALLS_PASSED = 2
+"""Walls a light-view ray may pass from outside: two where it crosses a pool's corner."""
+WALL_PASS_M = 1.0e-4
+"""How far past a wall hit from outside a light-view ray starts again [m]."""
+
+
 @wp.kernel
-def render_light_view(mesh: wp.uint64, view_dir: wp.vec3, start_z: float, view: LightView):
-    """Fill the light view: the first receiver point below the plane z = ``start_z`` seen along
-    −``view_dir`` through each texel (face −1: none). ``view_dir`` points up (z > 0): it is the
-    sun's direction under still water, and receivers above the water get no refracted light."""
+def render_light_view(
+    mesh: wp.uint64,
+    face_receiver: wp.array[wp.int32],
+    walls_id: int,
+    view_dir: wp.vec3,
+    distance_m: float,
+    view: LightView,
+):
+    """Fill the light view: the first receiver point seen along −``view_dir`` through each texel
+    (face −1: none). ``view_dir`` is the sun's direction under still water. A pool's walls are
+    seen only from inside (their faces face inwards): light enters the pool through the water, so a
+    wall hit from outside is passed through. Without that the walls, which stand above the water,
+    would hide the floor and the far wall that the refracted light reaches."""
     j, i = wp.tid()
     centre = (
         view.origin + ((float(i) + 0.5) * view.texel_m) * view.u + ((float(j) + 0.5) * view.texel_m) * view.v
     )
-    start = centre + ((start_z - centre[2]) / view_dir[2]) * view_dir
+    start = centre + distance_m * view_dir
     q = wp.mesh_query_ray(mesh, start, -view_dir, RAY_LENGTH_M)
-    if q.result:
+    for _wall in range(MAX_WALLS_PASSED):
+        if not q.result or face_receiver[q.face] != walls_id or q.sign > 0.0:
+            break
+        start = start - (q.t + WALL_PASS_M) * view_dir
+        q = wp.mesh_query_ray(mesh, start, -view_dir, RAY_LENGTH_M)
+    if q.result and not (face_receiver[q.face] == walls_id and q.sign < 0.0):
         view.positions[j, i] = start - q.t * view_dir
         view.faces[j, i] = q.face
     else:
@@ -68,7 +89,7 @@ def render_light_view(mesh: wp.uint64, view_dir: wp.vec3, start_z: float, view: 
 
 @wp.func
 def look_up(view: LightView, face_receiver: wp.array[wp.int32], x: wp.vec3):
-    """The receiver point R(x) the sun sees through x and its face (−1 outside the view).
+    """The receiver point R(x) the light view sees through x and its face (−1 outside the view).
 
     R is interpolated bilinearly between texel centres when the four texels around x show the same
     receiver (exact on planes, smooth on curved receivers), else taken from the nearest texel
@@ -107,7 +128,7 @@ def look_up(view: LightView, face_receiver: wp.array[wp.int32], x: wp.vec3):
     p10 = view.positions[j0, i0 + 1]
     p01 = view.positions[j0 + 1, i0]
     p11 = view.positions[j0 + 1, i0 + 1]
-    # A depth jump (part of a mesh hiding another part from the sun) must not be blended across.
+    # A depth jump (part of a mesh hiding another part from the light) must not be blended across.
     s = wp.cross(view.u, view.v)
     d0 = wp.dot(p00, s)
     jump = wp.max(wp.abs(wp.dot(p10, s) - d0), wp.abs(wp.dot(p01, s) - d0))

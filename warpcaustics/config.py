@@ -405,13 +405,14 @@ class CausticsConfig:
     """Centre (x, y) of the floor-map window [m]."""
     intersection: Intersection = Intersection.EXACT
     """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
-    ``newton`` (Shah's iteration on a receiver-position buffer rendered from the sun)."""
+    ``newton`` (Shah's iteration on a receiver-position buffer rendered from the light, along the
+    sun's refracted direction under still water)."""
     photon_subdivisions: int = field(default=4, metadata=_range(1, 64))
     """s: photons per surface cell are s×s [-]."""
     newton_iterations: int = field(default=3, metadata=_range(0, 64))
     """Iterations k of the ``newton`` intersection [-]."""
     newton_buffer_resolution: int = field(default=1024, metadata=_range(16, 16384))
-    """Texels per side of the ``newton`` receiver-position buffer seen from the sun [-]."""
+    """Texels per side of the ``newton`` receiver-position buffer seen from the light [-]."""
     beam_interpolation: BeamInterpolation = BeamInterpolation.FLAT
     """How ``beams`` spread a beam's light over its section: ``flat`` (each beam's own flux over its
     own section, as the flux-ratio map; triangle facets can show in close-ups) or ``smooth`` (after
