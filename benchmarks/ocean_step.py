@@ -2,11 +2,13 @@
 
 Both compute the same choppy surface (λ = 1: four packed complex 2-D transforms) from the same
 initial spectrum: the four Hermitian spectra at time t, their inverse FFTs, then positions,
-normals and the Jacobian at every vertex.
+normals and the Jacobian at every vertex. ``python -m benchmarks.ocean_step [--quick] [--device D]``
+runs it alone (``benchmarks.run`` runs it too; on CUDA to 2048²).
 """
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -73,3 +75,21 @@ def measure_numpy(n: int, repeats: int) -> dict:
     warp_pos = ocean.at(0.1 * repeats).positions.numpy()
     err = float(np.abs(warp_pos - positions).max())
     return {"step_s": float(np.median(times)), "max_abs_position_diff_m": err}
+
+
+def run(quick: bool, device: str) -> dict:
+    """The step at each size, Warp and numpy, each in its own process, with the log-log slopes and,
+    in the full run, the plot."""
+    from benchmarks.run import run_steps
+
+    return run_steps("ocean_step", "fft_ocean_step", quick, device)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "ocean_step", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -108,16 +108,11 @@ def measure_numpy(n: int, repeats: int) -> dict:
 
 
 def run(quick: bool, device: str) -> dict:
-    """The substep at each size, Warp and numpy, each in its own process (as ``benchmarks.run``
-    does), with the log-log slopes and, in the full run, the plot."""
-    from benchmarks.run import ROOT, STEPS, _plot_steps, _steps, device_record, step_sizes
+    """The substep at each size, Warp and numpy, each in its own process, with the log-log slopes
+    and, in the full run, the plot."""
+    from benchmarks.run import run_steps
 
-    title, = [t for name, t, _, _ in STEPS if name == "pool_step"]
-    rows = _steps("pool_step", step_sizes("pool_step", quick, device), device, 2 if quick else 5)
-    if not quick:
-        image = ROOT / "docs" / "images" / f"pool_step_scaling_{device.replace(':', '')}.png"
-        _plot_steps(rows, f"{title}, {device}", image)
-    return {"benchmark": "pool_substep", **device_record(device), "results": rows}
+    return run_steps("pool_step", "pool_substep", quick, device)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -116,6 +116,18 @@ def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dic
     return rows
 
 
+def run_steps(module: str, benchmark: str, quick: bool, device: str) -> dict:
+    """The record of step benchmark ``module`` run alone (``python -m benchmarks.<module>``): each
+    size, Warp and numpy, in their own processes as in the full run, the log-log slopes and, in
+    the full run, the plot."""
+    title, = [t for name, t, _, _ in STEPS if name == module]
+    rows = _steps(module, step_sizes(module, quick, device), device, 2 if quick else 5)
+    if not quick:
+        image = ROOT / "docs" / "images" / f"{module}_scaling_{device.replace(':', '')}.png"
+        _plot_steps(rows, f"{title}, {device}", image)
+    return {"benchmark": benchmark, **device_record(device), "results": rows}
+
+
 def _bins(n: int, m: int, bins_list: list[int], device: str, repeats: int) -> list[dict]:
     """Frame cost vs the number of spectral bins K, Warp and numpy, with a linear fit t = t0 + s·K."""
     rows = []
