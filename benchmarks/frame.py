@@ -18,9 +18,8 @@ def _rss_mib() -> float:
 
 
 def _scene(n: int, m: int, bins: int):
-
     return point_sun_scene("configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m,
-                                                "optics.wavelengths.bins": bins})
+                                                  "optics.wavelengths.bins": bins})
 
 
 def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:

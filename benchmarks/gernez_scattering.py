@@ -17,7 +17,6 @@ one frame, coarse photons).
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 
 import numpy as np
@@ -28,17 +27,19 @@ ZENITHS_DEG = (20.0, 40.0, 60.0)
 
 
 def _collected(result, floor) -> np.ndarray:
-    """A (K, M, M) floor map summed over its bands and averaged over the 8 mm collector."""
+    """A (K, M, M) floor map summed over its bands and averaged over the config's collector."""
     from warpcaustics.stats import band_integrated, collector_average
 
     texel = result.map_extent_m / floor.shape[-1]
-    return collector_average(band_integrated(floor, result.bin_widths_nm), texel, 8e-3, periodic=False)
+    return collector_average(band_integrated(floor, result.bin_widths_nm), texel,
+                             1e-3 * result.scene.config.stats.collector_mm, periodic=result.map_periodic)
 
 
 def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple[float, float]]:
     """((mean, CV) single, (mean, CV) multiple without photon noise) of one frame, after the
     collector."""
     import warpcaustics as wc
+    from warpcaustics.stats import cv_without_noise
 
     maps = []
     for seed in (1, 2):
@@ -46,10 +47,8 @@ def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple
         r = wc.render(scene, time_s=time_s, device="cpu")
         maps.append(_collected(r, r.floor_irradiance))
     single = _collected(r, r.comparison.floor_irradiance)
-    mean = 0.5 * (maps[0] + maps[1])
-    noise = 0.5 * (maps[0] - maps[1]).var()  # of one seed's map; the mean's is half of it
-    cv_multi = math.sqrt(max(mean.var() - 0.5 * noise, 0.0)) / mean.mean()
-    return (float(single.mean()), float(single.std() / single.mean())), (float(mean.mean()), cv_multi)
+    mean, cv_multi = cv_without_noise(maps[0], maps[1])
+    return (float(single.mean()), float(single.std() / single.mean())), (float(mean.mean()), float(cv_multi))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -230,11 +230,11 @@ def relative_l1(reference: np.ndarray, other: np.ndarray) -> float:
 
 
 def photon_scene(n: int, s: int, m: int, intersection: str, wavelengths=WAVELENGTHS):
-
+    """The ocean with photons, under the point sun of the numpy twin."""
     return point_sun_scene(ROOT / "configs" / "ocean.toml", {
         "caustics.method": "photons", "caustics.intersection": intersection,
         "caustics.photon_subdivisions": s, "caustics.map_resolution": m, "water.resolution": n,
-        "optics.wavelengths": wavelengths, "sun.angular_diameter_deg": 0.0})  # the numpy twin's point sun
+        "optics.wavelengths": wavelengths})
 
 
 class PhotonCase:

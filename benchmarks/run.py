@@ -116,15 +116,20 @@ def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dic
     return rows
 
 
-def run_steps(module: str, benchmark: str, quick: bool, device: str) -> dict:
-    """The record of step benchmark ``module`` run alone (``python -m benchmarks.<module>``): each
-    size, Warp and numpy, in their own processes as in the full run, the log-log slopes and, in
-    the full run, the plot."""
+def _step_rows(module: str, quick: bool, device: str, repeats: int) -> list[dict]:
+    """Step benchmark ``module`` at each of its sizes, Warp and numpy in their own processes, with
+    the log-log slopes and, in the full run, the plot in docs/images/."""
     title, = [t for name, t, _, _ in STEPS if name == module]
-    rows = _steps(module, step_sizes(module, quick, device), device, 2 if quick else 5)
+    rows = _steps(module, step_sizes(module, quick, device), device, repeats)
     if not quick:
         image = ROOT / "docs" / "images" / f"{module}_scaling_{device.replace(':', '')}.png"
         _plot_steps(rows, f"{title}, {device}", image)
+    return rows
+
+
+def run_steps(module: str, benchmark: str, quick: bool, device: str) -> dict:
+    """The record of step benchmark ``module`` run alone (``python -m benchmarks.<module>``)."""
+    rows = _step_rows(module, quick, device, 2 if quick else 5)
     return {"benchmark": benchmark, **device_record(device), "results": rows}
 
 
@@ -212,13 +217,7 @@ def main(argv: list[str] | None = None) -> int:
 
     bins_rows = _bins(*(BINS_QUICK if args.quick else BINS_FULL), args.device, repeats)
 
-    steps = {}
-    for module, title, _, _ in STEPS:
-        steps[module] = _steps(module, step_sizes(module, args.quick, args.device), args.device, repeats)
-        if not args.quick:
-            device_tag = args.device.replace(":", "")
-            _plot_steps(steps[module], f"{title}, {args.device}",
-                        ROOT / "docs" / "images" / f"{module}_scaling_{device_tag}.png")
+    steps = {module: _step_rows(module, args.quick, args.device, repeats) for module, _, _, _ in STEPS}
 
     # Photon splatting vs its numpy twin, both in one child process (benchmarks/photons.py).
     photons = _in_child("run", args.quick, args.device, module="photons")

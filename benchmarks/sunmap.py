@@ -22,7 +22,7 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     """Times of the two floor maps of one frame (the water surface is computed once, outside)."""
     from warpcaustics.pipeline import Renderer
     scene = point_sun_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
-                                   "caustics.map_resolution": m})
+                                     "caustics.map_resolution": m})
     renderer = Renderer(scene, device)
     result = renderer.render(0.5)  # warm-up: JIT compile, first launches
     surface = renderer.water.at(0.5)

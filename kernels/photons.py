@@ -54,6 +54,12 @@ WALL_PASS_M = 1.0e-4
 """How far past a wall hit from outside a light-view ray starts again [m]."""
 
 
+@wp.func
+def wall_from_outside(q: wp.MeshQueryRay, face_receiver: wp.array[wp.int32], walls_id: int) -> bool:
+    """Whether ray query ``q`` hit a pool's wall from outside (its faces face inwards)."""
+    return q.result and face_receiver[q.face] == walls_id and q.sign < 0.0
+
+
 @wp.kernel
 def render_light_view(
     mesh: wp.uint64,
@@ -75,11 +81,11 @@ def render_light_view(
     start = centre + distance_m * view_dir
     q = wp.mesh_query_ray(mesh, start, -view_dir, RAY_LENGTH_M)
     for _wall in range(MAX_WALLS_PASSED):
-        if not q.result or face_receiver[q.face] != walls_id or q.sign > 0.0:
+        if not wall_from_outside(q, face_receiver, walls_id):
             break
         start = start - (q.t + WALL_PASS_M) * view_dir
         q = wp.mesh_query_ray(mesh, start, -view_dir, RAY_LENGTH_M)
-    if q.result and not (face_receiver[q.face] == walls_id and q.sign < 0.0):
+    if q.result and not wall_from_outside(q, face_receiver, walls_id):
         view.positions[j, i] = start - q.t * view_dir
         view.faces[j, i] = q.face
     else:

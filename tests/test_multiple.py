@@ -10,6 +10,7 @@ from scipy import integrate
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 from warpcaustics.multiple import MultipleScattering
+from warpcaustics.stats import cv_without_noise
 
 from conftest import fresnel_t_angles
 
@@ -84,9 +85,7 @@ def contrast_without_noise(scene_overrides: dict) -> tuple[np.ndarray, np.ndarra
         )
         maps.append(r.floor_irradiance.astype(np.float64))
     single = r.comparison.floor_irradiance.astype(np.float64)
-    mean = 0.5 * (maps[0] + maps[1])
-    noise = 0.5 * (maps[0] - maps[1]).var(axis=(1, 2))  # per map; the mean's is half of it
-    cv_multi = np.sqrt(np.maximum(mean.var(axis=(1, 2)) - 0.5 * noise, 0.0)) / mean.mean(axis=(1, 2))
+    mean, cv_multi = cv_without_noise(maps[0], maps[1], axis=(1, 2))
     cv_single = single.std(axis=(1, 2)) / single.mean(axis=(1, 2))
     return cv_single, cv_multi, mean.mean(axis=(1, 2)) / single.mean(axis=(1, 2))
 
@@ -135,6 +134,14 @@ def test_the_walk_into_a_window_fills_the_whole_maps_texels():
     assert window.multiple_scattering_stats["floor"] == pytest.approx(floor, rel=1e-12)
 
 
+def sky_walker(scene, renderer, absorption: np.ndarray, scattering: np.ndarray) -> MultipleScattering:
+    """A walk of ``scene``'s sky, each direction carrying its share of the sky's irradiance."""
+    dirs, shares = scene.sky_directions()
+    e_sky = scene.sky_irradiance(renderer.sun_irradiance)
+    return MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance, absorption,
+                              scattering, "cpu", sky_dirs=dirs, sky_irradiance=shares[:, None] * e_sky)
+
+
 def sky_walk(absorption: np.ndarray, scattering: np.ndarray, depth_m: float = 2.0):
     """The sky's walk alone over still water, uniform sky, every crest lit: (scene, walk, floor,
     tallies, E_sky per band)."""
@@ -142,9 +149,7 @@ def sky_walk(absorption: np.ndarray, scattering: np.ndarray, depth_m: float = 2.
                                  "sky.diffuse_fraction": 0.3})
     renderer = wc.Renderer(scene, device="cpu")
     e_sky = scene.sky_irradiance(renderer.sun_irradiance)
-    dirs, shares = scene.sky_directions()
-    walk = MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance, absorption,
-                              scattering, "cpu", sky_dirs=dirs, sky_irradiance=shares[:, None] * e_sky)
+    walk = sky_walker(scene, renderer, absorption, scattering)
     visible = renderer.sky_visible
     visible.fill_(1.0)
     floor, st = walk.run_sky(renderer.water.at(0.0), visible)
@@ -231,9 +236,8 @@ def test_sky_walk_shades_each_direction_by_its_own_crests():
                                  "sky.directions": 8})
     renderer = wc.Renderer(scene, device="cpu")
     e_sky = scene.sky_irradiance(renderer.sun_irradiance)
-    dirs, shares = scene.sky_directions()
-    walk = MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance, np.zeros(3),
-                              np.zeros(3), "cpu", sky_dirs=dirs, sky_irradiance=shares[:, None] * e_sky)
+    dirs, _ = scene.sky_directions()
+    walk = sky_walker(scene, renderer, np.zeros(3), np.zeros(3))
     surface = renderer.water.at(0.0)
     theta = np.arccos(dirs[:, 2])
     for lit in (0, 3, 7):
@@ -262,11 +266,7 @@ def test_no_direction_is_tied_to_a_part_of_every_cell(light, threshold):
         renderer = wc.Renderer(scene, device="cpu")
         surface = renderer.water.at(0.0)
         if light == "sky":
-            dirs, shares = scene.sky_directions()
-            e_sky = scene.sky_irradiance(renderer.sun_irradiance)
-            walk = MultipleScattering(scene.config, scene.sun_direction, 1.333, renderer.sun_irradiance,
-                                      np.zeros(3), np.zeros(3), "cpu", sky_dirs=dirs,
-                                      sky_irradiance=shares[:, None] * e_sky)
+            walk = sky_walker(scene, renderer, np.zeros(3), np.zeros(3))
             renderer.sky_visible.fill_(1.0)
             floor, _ = walk.run_sky(surface, renderer.sky_visible)
         else:

@@ -2,14 +2,7 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pytest
-
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:  # benchmarks/ is not installed; plain `pytest` may not see it
-    sys.path.insert(0, str(ROOT))
 
 
 @pytest.mark.parametrize("intersection", ["exact", "newton"])

@@ -286,12 +286,6 @@ def test_substep_is_the_numpy_baseline_scheme():
     the same scheme: from a sloshing state one substep gives the same depths to 2 float32 ulps at
     1.5 m and the same velocities to 1e-5 of their largest (measured 1.2e-7 m and 1.1e-6). A
     cross-velocity averaged over two faces instead of four is off by 7e-5 of the largest."""
-    import sys
-    from pathlib import Path
-
-    root = str(Path(__file__).resolve().parents[1])
-    if root not in sys.path:  # benchmarks/ is not installed
-        sys.path.insert(0, root)
     from benchmarks.pool_step import _dt, _pool, numpy_step
 
     pool = _pool(64, "cpu")

@@ -290,13 +290,11 @@ class BeamCaustics:
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
 
-    def set_light(self, directions: np.ndarray, irradiance: np.ndarray) -> None:
-        """Build the next :meth:`run`'s beams for light from ``directions`` (1, 3) (a direction over
+    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
+        """Build the next :meth:`run`'s beams for light from ``direction`` (3,) (towards a point of
         the sun's disk or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
         [W m⁻² nm⁻¹]; the renderer adds the passes up."""
-        if len(directions) != 1:
-            raise ValueError("beams take one light direction per pass")
-        self.sun_dir = wp.vec3(*np.asarray(directions[0], np.float32))
+        self.sun_dir = wp.vec3(*np.asarray(direction, np.float32))
         self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
 
     # --- per frame --------------------------------------------------------------------------

@@ -10,7 +10,6 @@ previews left to right, in the order of the table) and each method's frame in ``
 
 from __future__ import annotations
 
-import csv
 import json
 import time
 from pathlib import Path
@@ -79,7 +78,7 @@ def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Pa
     """compare.json, compare.csv, compare.png and each method's frame (EXR, PNG, run.json) in
     ``out/<method>/``."""
     from warpcaustics import colour_out
-    from warpcaustics.output import save_frame, write_png, write_run_json
+    from warpcaustics.output import save_frame, write_csv, write_png, write_run_json
 
     out.mkdir(parents=True, exist_ok=True)
     rows = comparison["rows"]
@@ -92,10 +91,7 @@ def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Pa
         images.append(colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1]))
     gap = np.full((images[0].shape[0], 6, 3), 255, np.uint8)
     write_png(paths["png"], np.concatenate([x for img in images for x in (img, gap)][:-1], axis=1))
-    with open(paths["csv"], "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    write_csv(paths["csv"], rows)
     paths["json"].write_text(json.dumps({
         "time_s": time_s, "reference": "fluxratio",
         "note": "maps summed over bands, normalised by their means; contrast = std of the normalised map",

@@ -141,15 +141,14 @@ class DeviceChoice(str, enum.Enum):
     CUDA = "cuda"
 
 
-# Values other issues will add: named so an error can say where they stand instead of "unknown".
+# Values other issues will add, each with why it is not built yet ("" where that is not known): named
+# so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
-    "sky.model": ("cie_clear",),
+    "sky.model": {
+        "cie_clear": "it needs the CIE standard-sky coefficients from a maintained source, which no "
+        "colour-science release has yet",
+    },
 }
-PLANNED_WHY = {
-    ("sky.model", "cie_clear"): "it needs the CIE standard-sky coefficients from a maintained source, which "
-    "no colour-science release has yet",
-}
-"""Why a planned value is not built yet, where that is known (said in its error)."""
 
 
 @dataclass(frozen=True)
@@ -578,6 +577,15 @@ class Config:
     device: DeviceChoice = DeviceChoice.AUTO
     """``auto`` (CUDA when available, else CPU), ``cpu`` or ``cuda``."""
 
+    @property
+    def map_window(self) -> tuple[float, tuple[float, float]]:
+        """(side [m], centre (x, y) [m]) of the floor map: ``caustics.map_extent_m``'s window, or the
+        whole water patch about the origin."""
+        c = self.caustics
+        if c.map_extent_m:
+            return c.map_extent_m, (float(c.map_center_m[0]), float(c.map_center_m[1]))
+        return self.water.extent_m, (0.0, 0.0)
+
 
 # ---------------------------------------------------------------------------------------------
 # Validation
@@ -636,9 +644,9 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
         allowed = [m.value for m in tp]
         if isinstance(value, str) and value in allowed:
             return tp(value)
-        planned = PLANNED_VALUES.get(key, ())
+        planned = PLANNED_VALUES.get(key, {})
         if value in planned:
-            why = PLANNED_WHY.get((key, value))
+            why = planned[value]
             raise ConfigError(f"{key} = {_describe(value)} is not implemented yet"
                               + (f" ({why})" if why else "") + f"; allowed now: {', '.join(allowed)}")
         raise ConfigError(f"{key} = {_describe(value)} is not allowed; allowed: {', '.join(allowed)}")
@@ -837,8 +845,7 @@ def _check_sun_disk(cfg: Config) -> None:
 
 
 def _check_stats(cfg: Config) -> None:
-    side = cfg.caustics.map_extent_m or cfg.water.extent_m
-    cx, cy = cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)
+    side, (cx, cy) = cfg.map_window
     half = 0.5 * side
     for i, p in enumerate(cfg.stats.probes):
         if abs(p.x_m - cx) > half or abs(p.y_m - cy) > half:

@@ -17,7 +17,7 @@ import warp as wp
 from warpcaustics.config import Config
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels import eikonal as eikonal_kernels
-from warpcaustics.sunmap import still_water_refraction
+from warpcaustics.refraction import still_water_refraction
 from warpcaustics.water import Surface
 
 MAX_PASSES_PER_LAYER = 512
@@ -106,11 +106,9 @@ class GridCaustics:
         self.floor_z = -float(cfg.floor.depth_m)
         self.map_resolution = cfg.caustics.map_resolution
         self.periodic = periodic
-        s = np.asarray(sun_dir, np.float64)
-        self.sun_dir = s / np.linalg.norm(s)
         self.ior = float(ior)
-        self.sun_irradiance = wp.array(np.asarray(sun_irradiance, np.float32), dtype=wp.float32,
-                                       device=device)
+        self.sun_irradiance = wp.empty(len(sun_irradiance), dtype=wp.float32, device=device)
+        self.set_light(sun_dir, sun_irradiance)
         self.attenuation_per_m = wp.array(np.asarray(attenuation_per_m, np.float32), dtype=wp.float32,
                                           device=device)
         m = self.map_resolution
@@ -140,8 +138,6 @@ def parallax_disk_average(floor: np.ndarray, sun_dir: np.ndarray, disk_dirs: np.
     displaced as still water would displace it: the first-order effect of a 0.27° tilt, not a new
     solve. Moves are bilinear (periodic maps wrap and keep their flux; on a pool or an open patch
     what leaves the map is lost)."""
-    from warpcaustics.sunmap import still_water_refraction
-
     if len(disk_dirs) < 2:
         return floor
     t0 = still_water_refraction(sun_dir, ior)
@@ -250,6 +246,7 @@ class EikonalCaustics(GridCaustics):
         g = self.grid
         c = (np.arange(self.n) + 0.5) * self.h - 0.5 * self.extent_m
         z = g.z_top - np.arange(g.layers) * self.h
-        phi0 = (self.gradient[0] * c[None, None, :] + self.gradient[1] * c[None, :, None]
-                + self.gradient[2] * z[:, None, None])
+        gradient = self.gradient
+        phi0 = (gradient[0] * c[None, None, :] + gradient[1] * c[None, :, None]
+                + gradient[2] * z[:, None, None])
         return self.psi.numpy().astype(np.float64) + phi0

@@ -148,7 +148,7 @@ def run_gernez2009(
     fixed = dict(QUICK_OVERRIDES) if quick else {}
     base = load_scene(scene_path, fixed)
     _check_scene(base.config)
-    _plotting()  # before the sweep, not after it
+    pyplot(PLOT_NEEDS)  # before the sweep, not after it
     points = gernez2009_points(series)
     if quick:  # the first and last zenith, the first wind
         ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
@@ -258,13 +258,12 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     return rows
 
 
-def _plotting():
-    """matplotlib's pyplot, or a one-line error naming the extra to install."""
-    return pyplot("the comparison's plot needs")
+PLOT_NEEDS = "the comparison's plot needs"
+"""How the missing-matplotlib error begins (output.pyplot)."""
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:
-    plt = _plotting()
+    plt = pyplot(PLOT_NEEDS)
     series = [s for s in SERIES if any(r["series"] == s for r in rows)]
     fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 4.2), squeeze=False)
     for ax, s in zip(axes[0], series):

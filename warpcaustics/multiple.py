@@ -64,14 +64,14 @@ class MultipleScattering:
             self.sky_irradiance = wp.array(np.asarray(sky_irradiance, np.float32).reshape(len(sky_dirs), k),
                                            dtype=wp.float32, device=device)
         m = cfg.caustics.map_resolution
-        side = float(cfg.caustics.map_extent_m or cfg.water.extent_m)  # a window, or the patch
+        side, centre = cfg.map_window  # a window, or the patch
 
         def walk(seed: int) -> mc_kernels.Walk:
             w = mc_kernels.Walk()
             w.eta = 1.0 / float(ior)
             w.floor_z = -float(cfg.floor.depth_m)
             w.extent_m = float(cfg.water.extent_m)
-            w.map_center = wp.vec2(*(cfg.caustics.map_center_m if cfg.caustics.map_extent_m else (0.0, 0.0)))
+            w.map_center = wp.vec2(*centre)
             w.map_extent_m = side
             w.map_scale = m / side
             w.samples = cfg.optics.mc_samples

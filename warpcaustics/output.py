@@ -37,10 +37,11 @@ def atomic_path(path: Path):
             tmp.unlink()
 
 
-def write_csv(path: Path, rows: list[dict]) -> None:
-    """Rows of equal keys as a CSV table (header from the first row), written atomically."""
+def write_csv(path: Path, rows: list[dict], fieldnames: list[str] | None = None) -> None:
+    """Rows as a CSV table, written atomically: the columns ``fieldnames`` (a row without one
+    leaves it empty), or the first row's keys."""
     with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]) if fieldnames is None else fieldnames)
         writer.writeheader()
         writer.writerows(rows)
 

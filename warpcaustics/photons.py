@@ -15,6 +15,7 @@ from warpcaustics.config import Config, Intersection
 from warpcaustics.kernels import floor as floor_kernels
 from warpcaustics.kernels import photons as photon_kernels
 from warpcaustics.receivers import WALLS_ID, Receivers
+from warpcaustics.refraction import still_water_refraction
 from warpcaustics.water import Surface
 
 PHOTON_BYTES = 12 + 12 + 4 + 12 + 4
@@ -55,7 +56,6 @@ def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, i
     rest, it lands in the patch; a mesh only gets the light of photons whose path through it would
     land there. Refuse meshes so near the patch edge that some of their light would be missed."""
     from warpcaustics.errors import ConfigError
-    from warpcaustics.reference import refract
 
     if not meshes:
         return
@@ -64,7 +64,7 @@ def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, i
     for i, mesh in enumerate(meshes):
         worst = 0.0
         for n in (float(np.min(ior)), float(np.max(ior))):
-            d = refract(-np.asarray(sun_dir, np.float64), np.array([0.0, 0.0, 1.0]), 1.0 / n)
+            d = still_water_refraction(sun_dir, n)
             drop = mesh.points[:, 2] - plane_z
             landing = mesh.points[:, :2] + (drop / -d[2])[:, None] * d[None, :2]
             # Waves tilt the rays: allow for a tenth of the drop either way, and 2 % of the patch.
@@ -87,11 +87,7 @@ def light_view_direction(sun_dir: np.ndarray, group_ior: np.ndarray) -> np.ndarr
     iteration converges where a view along the sun in air does not: on the sphere of
     tests/test_photons.py 98 % of the photons end within a texel of their exact hit, against 86 %
     (docs/validation.md). A pool's walls are passed from outside (``render_light_view``)."""
-    from warpcaustics.reference import refract
-
-    s = np.asarray(sun_dir, np.float64)
-    d = refract(-s, np.array([0.0, 0.0, 1.0]), 1.0 / float(np.mean(group_ior)))
-    return -d / np.linalg.norm(d)
+    return -still_water_refraction(sun_dir, float(np.mean(group_ior)))
 
 
 def light_view_frame(points: np.ndarray, view_dir: np.ndarray, resolution: int):
@@ -163,13 +159,11 @@ class PhotonCaustics:
             (1.0 / receivers.floor_texel_area_m2).astype(np.float32), dtype=wp.float32, device=device
         )
         sun = np.asarray(sun_dir, np.float64)
-        self.sun_dir = wp.vec3(*sun.astype(np.float32))
-        self.light_dir = self.sun_dir  # the photons' direction (the disk's or the sky's, per pass)
+        self.light_dir = wp.vec3(*sun.astype(np.float32))  # the photons' direction (set per pass)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
-        self.view_dir = light_view_direction(sun, group_ior)
         self.view = self._light_view(
-            self.view_dir,
+            light_view_direction(sun, group_ior),
             cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 1,
         )
         self.newton_iterations = (
@@ -278,14 +272,12 @@ class PhotonCaustics:
         )
         return self.irradiance
 
-    def set_light(self, directions: np.ndarray, irradiance: np.ndarray) -> None:
-        """Emit the next :meth:`run`'s photons along ``directions`` (1, 3) (a point of the sun's disk,
-        or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it [W m⁻² nm⁻¹]; the
-        renderer adds the passes up. One direction per pass: a photon's lattice neighbours must share
-        its direction, or the camera's lattice splats draw a pattern."""
-        if len(directions) != 1:
-            raise ValueError("photons take one light direction per pass")
-        self.light_dir = wp.vec3(*np.asarray(directions[0], np.float32))
+    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
+        """Emit the next :meth:`run`'s photons from ``direction`` (3,) (towards a point of the sun's
+        disk, or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
+        [W m⁻² nm⁻¹]; the renderer adds the passes up. One direction per pass: a photon's lattice
+        neighbours must share its direction, or the camera's lattice splats draw a pattern."""
+        self.light_dir = wp.vec3(*np.asarray(direction, np.float32))
         self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
 
     def transmitted_flux(self) -> np.ndarray:

@@ -125,13 +125,12 @@ class RenderResult:
     @property
     def map_extent_m(self) -> float:
         """Side of the floor map [m]: the water extent, or ``caustics.map_extent_m``'s window."""
-        return self.scene.config.caustics.map_extent_m or self.extent_m
+        return self.scene.config.map_window[0]
 
     @property
     def map_center_m(self) -> tuple[float, float]:
         """Centre of the floor map [m]."""
-        c = self.scene.config.caustics
-        return (float(c.map_center_m[0]), float(c.map_center_m[1])) if c.map_extent_m else (0.0, 0.0)
+        return self.scene.config.map_window[1]
 
     @property
     def map_periodic(self) -> bool:
@@ -192,6 +191,14 @@ class _Stopwatch:
         return _Stage()
 
 
+def keeps_sky_shading(cfg) -> bool:
+    """Whether the crests' shading from each sky direction is kept, (D, N, N), rather than one
+    (N, N) buffer reused per direction: the random walk takes the directions in turn, and the
+    eikonal and wave grids solve per direction with the shading the flux ratio's sky pass made."""
+    return (cfg.optics.scattering is Scattering.MULTIPLE
+            or cfg.caustics.method in (CausticsMethod.EIKONAL, CausticsMethod.WAVE3D))
+
+
 def scene_bytes(scene: Scene) -> int:
     """Device memory one frame of this scene needs [bytes]."""
     cfg = scene.config
@@ -199,8 +206,8 @@ def scene_bytes(scene: Scene) -> int:
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
     sky = 0
-    if cfg.sky.model is not SkyModel.NONE:  # its shading buffer: one, or one per direction for the walk
-        sky = n * n * 4 * (cfg.sky.directions if cfg.optics.scattering is Scattering.MULTIPLE else 1)
+    if cfg.sky.model is not SkyModel.NONE:  # its shading buffer: one, or one per direction
+        sky = n * n * 4 * (cfg.sky.directions if keeps_sky_shading(cfg) else 1)
     if cfg.caustics.method.uses_receivers:
         periodic = cfg.water.periodic
         faces = receiver_face_estimate(scene, periodic)
@@ -291,9 +298,8 @@ class Renderer:
                     wp.array(e.astype(np.float32), dtype=wp.float32, device=self.device)
                     for e in self.sky_irradiance_np]
                 # The crests' shading from each sky direction: one buffer reused, or all of them
-                # for the random walk, whose photons take the directions in turn.
-                walked = cfg.optics.scattering is Scattering.MULTIPLE
-                shape = (len(self.sky_directions), n, n) if walked else (n, n)
+                # (keeps_sky_shading).
+                shape = (len(self.sky_directions), n, n) if keeps_sky_shading(cfg) else (n, n)
                 self.sky_visible = wp.empty(shape, dtype=wp.float32, device=self.device)
             if cfg.caustics.method.uses_receivers:
                 self.receivers = Receivers(cfg, self.bins, self.device, periodic=self.water.periodic,
@@ -403,22 +409,20 @@ class Renderer:
                 floor_np = floor.numpy().copy()
             if self.sky_directions is not None:
                 sky_np, sky_transmitted = self._sky(surface, highest, watch)
+                extra["sky_floor_irradiance"] = sky_np
+                floor_np, transmitted = floor_np + sky_np, transmitted + sky_transmitted
             if self.multiple is not None:  # the walk's maps replace the single-scattering ones
                 single_floor, single_transmitted = floor_np, transmitted
-                if self.sky_directions is not None:
-                    single_floor, single_transmitted = floor_np + sky_np, transmitted + sky_transmitted
                 with watch.stage("multiple_scattering"):
                     floor_np, walk = self.multiple.run(surface, visible)
                     transmitted = np.asarray(walk["transmitted"])
                 if self.sky_directions is not None:
                     with watch.stage("sky"):
                         sky_np, walk["sky"] = self.multiple.run_sky(surface, self.sky_visible)
-                    sky_transmitted = np.asarray(walk["sky"]["transmitted"])
-                extra = {"multiple_scattering_stats": walk}
-            if self.sky_directions is not None:
-                extra["sky_floor_irradiance"] = sky_np
-                floor_np = floor_np + sky_np
-                transmitted = transmitted + sky_transmitted
+                    extra["sky_floor_irradiance"] = sky_np
+                    floor_np = floor_np + sky_np
+                    transmitted = transmitted + np.asarray(walk["sky"]["transmitted"])
+                extra["multiple_scattering_stats"] = walk
             if self.approximate is not None:
                 flux_ratio_floor = floor_np
                 grid_sky = None
@@ -476,15 +480,15 @@ class Renderer:
 
     def _grid_sky(self, surface, time_s: float, highest: float, flux_ratio: np.ndarray) -> np.ndarray:
         """The sky's floor map by the eikonal or wave grid: a solve per sky direction, lit with its
-        share of the sky and shaded by the crests as seen from it (the sun's light is put back
-        after)."""
+        share of the sky and shaded by the crests as seen from it, as :meth:`_sky` shaded them this
+        frame (the sun's light is put back after)."""
         stage = self.approximate
         total = None
         try:
-            for direction, irradiance in zip(self.sky_directions, self.sky_irradiance_np):
-                seen = sun_visibility(surface, direction, highest, self.device, out=self.sky_visible)
+            for i, (direction, irradiance) in enumerate(zip(self.sky_directions, self.sky_irradiance_np)):
                 stage.set_light(direction, irradiance)
-                floor, _ = stage.floor_map(surface, self.water, time_s, highest, seen, flux_ratio)
+                floor, _ = stage.floor_map(surface, self.water, time_s, highest, self.sky_visible[i],
+                                           flux_ratio)
                 total = floor.astype(np.float64) if total is None else total + floor
         finally:
             stage.set_light(self.scene.sun_direction, self.sun_irradiance)
@@ -505,15 +509,15 @@ class Renderer:
         return floor, flux
 
     def _light_passes(self) -> list[tuple[np.ndarray, np.ndarray, bool]]:
-        """The passes of a photon or beam stage: (directions (1, 3), irradiance (K,) on a plane
-        perpendicular to them, from the sky). A pass per direction of the sun's disk with its share
+        """The passes of a photon or beam stage: (direction (3,), irradiance (K,) on a plane
+        perpendicular to it, from the sky). A pass per direction of the sun's disk with its share
         of the sun, and per sky direction with its share of the sky. Photons too: taking the disk's
         directions in turn within one pass made each photon's lattice neighbours another
         direction's, and the camera's lattice splats then drew the pattern of that assignment."""
         dirs = self.sun_directions
-        passes = [(d[None], self.sun_irradiance / len(dirs), False) for d in dirs]
+        passes = [(d, self.sun_irradiance / len(dirs), False) for d in dirs]
         if self.sky_directions is not None:
-            passes += [(d[None], e, True) for d, e in zip(self.sky_directions, self.sky_irradiance_np)]
+            passes += [(d, e, True) for d, e in zip(self.sky_directions, self.sky_irradiance_np)]
         return passes
 
     def _receiver_stage(self, stage, surface, visible, highest, watch) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -527,11 +531,11 @@ class Renderer:
         totals: dict[bool, dict[str, np.ndarray]] = {False: {}, True: {}}
         extra = {}
         passes = self._light_passes()
-        for directions, irradiance, from_sky in passes:
-            stage.set_light(directions, irradiance)
+        for direction, irradiance, from_sky in passes:
+            stage.set_light(direction, irradiance)
             if from_sky:
                 with watch.stage("sky"):
-                    seen = sun_visibility(surface, directions[0], highest, self.device, out=self.sky_visible)
+                    seen = sun_visibility(surface, direction, highest, self.device, out=self.sky_visible)
             else:
                 seen = visible  # crests shade by the sun's centre
             # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are

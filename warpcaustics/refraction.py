@@ -29,6 +29,14 @@ class Refracted:
                    wp.empty((groups, n, n), dtype=wp.float32, device=device))
 
 
+def still_water_refraction(sun_dir: np.ndarray, ior: float) -> np.ndarray:
+    """Unit direction of the sun's light refracted into still water (float64, pointing down)."""
+    from warpcaustics.reference import refract
+
+    t = refract(-np.asarray(sun_dir, np.float64), np.array([0.0, 0.0, 1.0]), 1.0 / ior)
+    return t / np.linalg.norm(t)
+
+
 def height_range(surface: Surface, device: str) -> tuple[float, float]:
     """(lowest, highest) surface height [m] (one small read-back)."""
     z_range = wp.array(np.array([np.inf, -np.inf], np.float32), dtype=wp.float32, device=device)

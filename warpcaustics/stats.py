@@ -45,6 +45,15 @@ def par_map(floor: np.ndarray, edges_nm: np.ndarray) -> np.ndarray:
     return np.einsum("kij,k->ij", np.asarray(floor, np.float64), par_weights(np.asarray(edges_nm)))
 
 
+def cv_without_noise(first: np.ndarray, second: np.ndarray, axis=None) -> tuple[np.ndarray, np.ndarray]:
+    """(mean map, CV over ``axis``) of two maps of one field with independent noise (a Monte Carlo
+    run with two seeds), the noise taken out: half the variance of their difference is one map's
+    noise variance, and their mean carries half of that."""
+    mean = 0.5 * (first + second)
+    noise = 0.5 * (first - second).var(axis=axis)
+    return mean, np.sqrt(np.maximum(mean.var(axis=axis) - 0.5 * noise, 0.0)) / mean.mean(axis=axis)
+
+
 def collector_kernel(texel_m: float, diameter_m: float, supersample: int = 8) -> np.ndarray:
     """A disc of diameter ``diameter_m`` on texels of side ``texel_m``: each weight is the disc's
     share of its texel (``supersample``² points per texel), normalised to sum 1."""

@@ -15,6 +15,7 @@ import warp as wp
 
 from warpcaustics.config import Config
 from warpcaustics.kernels import sunmap as sunmap_kernels
+from warpcaustics.refraction import still_water_refraction
 from warpcaustics.water import ProceduralWater, Surface
 
 
@@ -71,14 +72,6 @@ class SunMapCaustics:
         backward rays know no shading by crests."""
         brightness = self.run(surface, water, time_s).numpy().copy()
         return scale_to_flux_ratio(brightness, flux_ratio), {"sunmap_brightness": brightness}
-
-
-def still_water_refraction(sun_dir: np.ndarray, ior: float) -> np.ndarray:
-    """Unit direction of the sun's light refracted into still water (float64, pointing down)."""
-    from warpcaustics.reference import refract
-
-    t = refract(-np.asarray(sun_dir, np.float64), np.array([0.0, 0.0, 1.0]), 1.0 / ior)
-    return t / np.linalg.norm(t)
 
 
 def scale_to_flux_ratio(brightness: np.ndarray, flux_ratio: np.ndarray) -> np.ndarray:

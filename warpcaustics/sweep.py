@@ -541,7 +541,7 @@ def _run_on_ray(
 def write_summary(out_dir: Path, sweep: Sweep) -> Path:
     """``summary.csv`` (and ``summary.parquet`` if pyarrow is installed): one row per frame of the
     sweep's finished tasks, in task order; written atomically."""
-    from warpcaustics.output import atomic_path
+    from warpcaustics.output import atomic_path, write_csv
 
     records = read_manifest(out_dir)
     rows = [
@@ -554,10 +554,7 @@ def write_summary(out_dir: Path, sweep: Sweep) -> Path:
     columns: list[str] = []
     for row in rows:
         columns += [c for c in row if c not in columns]
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(rows)
+    write_csv(path, rows, columns)
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
