@@ -73,13 +73,14 @@ def turn(d: wp.vec3, cos_theta: float, phi: float) -> wp.vec3:
 @wp.func
 def map_texel(x: float, centre: float, walk: Walk, m: int) -> int:
     """Texel of coordinate x [m] on the floor map, from the periodic image of x nearest the map's
-    centre (the whole patch, or a window at most half of it); −1 outside a window."""
+    centre (the whole patch, or a window at most half of it); −1 outside a window. On the whole
+    patch every x has a texel: one rounded onto the far edge of the seam is kept on the map."""
     d = x - centre
     d = d - walk.extent_m * wp.floor(d / walk.extent_m + 0.5)
     u = (d + 0.5 * walk.map_extent_m) * walk.map_scale
-    if u < 0.0 or u >= float(m):
+    if walk.map_extent_m < walk.extent_m and (u < 0.0 or u >= float(m)):
         return -1
-    return wp.min(int(u), m - 1)
+    return wp.clamp(int(u), 0, m - 1)
 
 
 @wp.kernel
