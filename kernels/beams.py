@@ -31,7 +31,7 @@ run to run; on the CPU launches are serial and the result is deterministic.
 
 import warp as wp
 
-from warpcaustics.kernels.camera import PinholeCamera, pixel_ray
+from warpcaustics.kernels.camera import PinholeCamera
 from warpcaustics.kernels.floor import lift, quad_corner
 from warpcaustics.kernels.geometry import clip_side, clip_to_slab, polygon_area, sun_into_water, vec8
 from warpcaustics.kernels.phase import phase_value
@@ -894,27 +894,64 @@ def point_irradiance(
                 )
 
 
+@wp.struct
+class BeamCorners:
+    """What the volume pass reads of beam b, read once per (pixel, beam) pair: base vertices v_i,
+    unit edge directions d_i, per-vertex transmittance, A(z)'s coefficients, the base centroid's
+    height, and ``ends[b]`` (end plane point and normal, d̄, base plane normal)."""
+
+    v0: wp.vec3
+    v1: wp.vec3
+    v2: wp.vec3
+    d0: wp.vec3
+    d1: wp.vec3
+    d2: wp.vec3
+    transmit: wp.vec3
+    coef: wp.vec3
+    base_z: float
+    end_point: wp.vec3
+    end_normal: wp.vec3
+    dbar: wp.vec3
+    base_normal: wp.vec3
+
+
 @wp.func
-def clamped_sample(
+def load_corners(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
     transmit: wp.array2d[wp.float32],
     ends: wp.array2d[wp.vec3],
     area_coef: wp.array[wp.vec3],
     b: int,
-    p: wp.vec3,
-) -> BeamSample:
+) -> BeamCorners:
+    c = BeamCorners()
+    c.v0 = base[b, 0]
+    c.v1 = base[b, 1]
+    c.v2 = base[b, 2]
+    c.d0 = direction[b, 0]
+    c.d1 = direction[b, 1]
+    c.d2 = direction[b, 2]
+    c.transmit = wp.vec3(transmit[b, 0], transmit[b, 1], transmit[b, 2])
+    c.coef = area_coef[b]
+    c.base_z = (c.v0[2] + c.v1[2] + c.v2[2]) / 3.0
+    c.end_point = ends[b, 0]
+    c.end_normal = ends[b, 1]
+    c.dbar = ends[b, 2]
+    c.base_normal = ends[b, 3]
+    return c
+
+
+@wp.func
+def clamped_sample(c: BeamCorners, p: wp.vec3) -> BeamSample:
     """:func:`sample_beam` with the barycentrics clamped to the triangle and renormalised: for points
     on a section's edge to rounding, and for scan-plane samples of a warped beam, whose chord
     follows the edge lines' plane cut rather than the horizontal sections exactly."""
-    v0 = base[b, 0]
-    v1 = base[b, 1]
-    v2 = base[b, 2]
-    d0 = direction[b, 0]
-    d1 = direction[b, 1]
-    d2 = direction[b, 2]
     z = p[2]
-    lam = barycentrics(section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p))
+    # Distances along the edges to height z: the section's vertices and the path length share them.
+    l0 = (z - c.v0[2]) / c.d0[2]
+    l1 = (z - c.v1[2]) / c.d1[2]
+    l2 = (z - c.v2[2]) / c.d2[2]
+    lam = barycentrics(xy(c.v0) + l0 * xy(c.d0), xy(c.v1) + l1 * xy(c.d1), xy(c.v2) + l2 * xy(c.d2), xy(p))
     lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
     total = lam[0] + lam[1] + lam[2]
     if total <= 0.0:
@@ -924,11 +961,11 @@ def clamped_sample(
     out = BeamSample()
     out.inside = 1
     out.lam = lam
-    out.path_m = lam[0] * (v0[2] - z) / -d0[2] + lam[1] * (v1[2] - z) / -d1[2] + lam[2] * (v2[2] - z) / -d2[2]
-    out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
-    out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
-    out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
-    out.beyond_end_m = beyond_end(ends, b, p)
+    out.path_m = lam[0] * l0 + lam[1] * l1 + lam[2] * l2
+    out.d = wp.normalize(lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2)
+    out.transmit = lam[0] * c.transmit[0] + lam[1] * c.transmit[1] + lam[2] * c.transmit[2]
+    out.area = safe_area(c.coef, z, c.base_z)
+    out.beyond_end_m = wp.dot(p - c.end_point, c.end_normal)
     return out
 
 
@@ -1091,7 +1128,7 @@ def floor_texels(
                     s = sample_beam(base, direction, transmit, ends, area_coef, b, p)
                     if s.inside == 0:
                         # The centroid sits on the section's boundary to rounding: clamp it in.
-                        s = clamped_sample(base, direction, transmit, ends, area_coef, b, p)
+                        s = clamped_sample(load_corners(base, direction, transmit, ends, area_coef, b), p)
                     if not lit(mesh, occluders, s, p):
                         continue
                     # The piece's flux over the texel's true area. Flat: the beam's flux w Σλ T spread
@@ -1287,27 +1324,18 @@ def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
 
 
 @wp.func
-def scan_chord(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    ends: wp.array2d[wp.vec3],
-    b: int,
-    shift: wp.vec3,
-    o: wp.vec3,
-    v: wp.vec3,
-):
+def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
     """[s_a, s_b] of the ray o + s v inside beam b moved by ``shift``, by the scan plane (Ernst
     2005, Liktor & Dachsbacher 2011): the plane through the ray most nearly perpendicular to the
     beam cuts the three edge lines in a triangle; the ray's chord through it is clipped to the
     beam's base and end planes. Returns s_a > s_b for a miss. Exact for a straight prism."""
-    v0 = base[b, 0] + shift
-    v1 = base[b, 1] + shift
-    v2 = base[b, 2] + shift
-    d0 = direction[b, 0]
-    d1 = direction[b, 1]
-    d2 = direction[b, 2]
-    dbar = ends[b, 2]
-    w = wp.cross(v, dbar)
+    v0 = c.v0 + shift
+    v1 = c.v1 + shift
+    v2 = c.v2 + shift
+    d0 = c.d0
+    d1 = c.d1
+    d2 = c.d2
+    w = wp.cross(v, c.dbar)
     s_a = float(-1.0e30)
     s_b = float(1.0e30)
     if wp.length(w) < PARALLEL_COS:
@@ -1332,13 +1360,13 @@ def scan_chord(
         q1 = v1 + (wp.dot(o - v1, n_p) / den1) * d1 - o
         q2 = v2 + (wp.dot(o - v2, n_p) / den2) * d2 - o
         a = wp.vec3(wp.dot(q0, v), wp.dot(q1, v), wp.dot(q2, v))
-        c = wp.vec3(wp.dot(q0, e2), wp.dot(q1, e2), wp.dot(q2, e2))
+        h = wp.vec3(wp.dot(q0, e2), wp.dot(q1, e2), wp.dot(q2, e2))
         lo = float(1.0e30)
         hi = float(-1.0e30)
         for i in range(3):
             j = (i + 1) % 3
-            if (c[i] >= 0.0) != (c[j] >= 0.0):
-                s = a[i] + (a[j] - a[i]) * c[i] / (c[i] - c[j])
+            if (h[i] >= 0.0) != (h[j] >= 0.0):
+                s = a[i] + (a[j] - a[i]) * h[i] / (h[i] - h[j])
                 lo = wp.min(lo, s)
                 hi = wp.max(hi, s)
         if lo > hi:
@@ -1346,13 +1374,82 @@ def scan_chord(
         s_a = lo
         s_b = hi
     # Base plane: keep the side the beam goes to.
-    nb = ends[b, 3]
+    nb = c.base_normal
     s_a, s_b = clip_halfspace(s_a, s_b, wp.dot(o - v0, nb), wp.dot(v, nb))
-    e0 = ends[b, 0]
-    ne = ends[b, 1]
-    e0 = e0 + shift
+    e0 = c.end_point + shift
+    ne = c.end_normal
     s_a, s_b = clip_halfspace(s_a, s_b, -wp.dot(o - e0, ne), -wp.dot(v, ne))
     return s_a, s_b
+
+
+@wp.func
+def chord_radiance(
+    corners: BeamCorners,
+    b: int,
+    shift: wp.vec3,
+    o: wp.vec3,
+    v: wp.vec3,
+    s_max: float,
+    j: int,
+    i: int,
+    weight: wp.array[wp.float32],
+    transmit: wp.array2d[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    base: wp.array2d[wp.vec3],
+    quads: int,
+    lattice_wraps: int,
+    smooth: int,
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    scattering_per_m: wp.array[wp.float32],
+    phase_kind: int,
+    hg_g: float,
+    angles_rad: wp.array[wp.float32],
+    log_phase: wp.array[wp.float32],
+    cone_phase: float,
+    radiance: wp.array3d[wp.float32],
+) -> int:
+    """Add to pixel (j, i) the radiance scattered into its ray o + s v (cut at the receiver,
+    s_max) by beam b moved by ``shift``: ``Σ Δs σ_s p(cos θ) E⊥(x_m) exp(−c (ℓ(x_m) + s_m))`` over
+    up to MAX_CHORD_PIECES midpoint pieces of the scan-plane chord. Returns 1 if the ray has a
+    chord through the beam, else 0."""
+    s_a, s_b = scan_chord(corners, shift, o, v)
+    s_a = wp.max(s_a, 0.0)
+    s_b = wp.min(s_b, s_max)
+    if s_b <= s_a:
+        return 0
+    ds = s_b - s_a
+    mid = o + (0.5 * (s_a + s_b)) * v - shift
+    width = wp.sqrt(safe_area(corners.coef, mid[2], corners.v0[2]))
+    pieces = wp.clamp(int(ds / wp.max(width, 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
+    piece = ds / float(pieces)
+    g = b / beams_per_group
+    for n in range(pieces):
+        s_m = s_a + (float(n) + 0.5) * piece
+        x = o + s_m * v - shift
+        smp = clamped_sample(corners, x)
+        if smp.beyond_end_m > shadow_slack(smp.area):
+            continue
+        cos_theta = -wp.dot(smp.d, v)
+        phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, cos_theta)
+        density = flux_density(weight, transmit, area_coef, base, b, smp, x[2], quads, lattice_wraps, smooth)
+        e_perp = density / wp.abs(smp.d[2])
+        f = piece * phase * e_perp
+        for jj in range(wavelengths_per_group):
+            k = g * wavelengths_per_group + jj
+            c = attenuation_per_m[k]
+            radiance[k, j, i] = radiance[k, j, i] + f * scattering_per_m[k] * sun_irradiance[k] * wp.exp(
+                -c * (smp.path_m + s_m)
+            )
+    return 1
+
+
+@wp.func
+def outside_box(q: wp.vec2, lo: wp.vec2, hi: wp.vec2) -> bool:
+    """Whether a pixel centre q (in the box's frame) is outside the oriented box [lo, hi]."""
+    return q[0] < lo[0] - 1.0e-3 or q[0] > hi[0] + 1.0e-3 or q[1] < lo[1] - 1.0e-3 or q[1] > hi[1] + 1.0e-3
 
 
 @wp.kernel
@@ -1363,6 +1460,7 @@ def scan_plane_radiance(
     tile_items: wp.array[wp.int32],
     tile_pixels: int,
     cam: PinholeCamera,
+    rays: wp.array2d[wp.vec3],
     depth: wp.array2d[wp.float32],
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
@@ -1391,14 +1489,14 @@ def scan_plane_radiance(
     pairs: wp.array[wp.int32],
 ):
     """Single-scattered radiance of the beams along each pixel's ray (K, H, W) [W m^-2 sr^-1
-    nm^-1]: ``Σ Δs σ_s p(cos θ) E⊥(x_m) exp(−c (ℓ(x_m) + s_m))`` over the chords of the pixel tile's
-    beam copies, each chord cut at the receiver the pixel sees and split into up to
-    MAX_CHORD_PIECES midpoint pieces. ``pairs`` counts (pixel, beam copy) pairs: [0] in the tile
-    lists, [1] inside the oriented box (scan plane computed), [2] with a chord."""
+    nm^-1], a thread per pixel (the GPU's form): the chords (:func:`chord_radiance`) of the beam
+    copies in the pixel's tile list whose oriented box holds the pixel centre. ``pairs`` counts
+    (pixel, beam copy) pairs: [0] in the tile lists, [1] inside the oriented box (scan plane
+    computed), [2] with a chord."""
     j, i = wp.tid()
     for k in range(radiance.shape[0]):
         radiance[k, j, i] = 0.0
-    v = pixel_ray(cam, i, j)
+    v = rays[j, i]
     o = cam.position
     s_max = depth[j, i]
     t = tile_index(grid, i / tile_pixels, j / tile_pixels)
@@ -1413,45 +1511,147 @@ def scan_plane_radiance(
     chords = int(0)
     for item in range(count):
         bc = tile_items[start + item]
-        q = in_frame(centre, box_axis[bc])
-        lo = box_lo[bc]
-        hi = box_hi[bc]
-        if q[0] < lo[0] - 1.0e-3 or q[0] > hi[0] + 1.0e-3 or q[1] < lo[1] - 1.0e-3 or q[1] > hi[1] + 1.0e-3:
+        if outside_box(in_frame(centre, box_axis[bc]), box_lo[bc], box_hi[bc]):
             continue  # the ray passes outside the beam's hull
         boxed += 1
         b = bc / per_beam
-        shift = copy_offset(bc % per_beam, copies, extent_m)
-        s_a, s_b = scan_chord(base, direction, ends, b, shift, o, v)
-        s_a = wp.max(s_a, 0.0)
-        s_b = wp.min(s_b, s_max)
-        if s_b <= s_a:
-            continue
-        chords += 1
-        ds = s_b - s_a
-        mid = o + (0.5 * (s_a + s_b)) * v - shift
-        width = wp.sqrt(safe_area(area_coef[b], mid[2], base[b, 0][2]))
-        pieces = wp.clamp(int(ds / wp.max(width, 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
-        piece = ds / float(pieces)
-        g = b / beams_per_group
-        for n in range(pieces):
-            s_m = s_a + (float(n) + 0.5) * piece
-            x = o + s_m * v - shift
-            smp = clamped_sample(base, direction, transmit, ends, area_coef, b, x)
-            if smp.beyond_end_m > shadow_slack(smp.area):
-                continue
-            cos_theta = -wp.dot(smp.d, v)
-            phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, cos_theta)
-            density = flux_density(
-                weight, transmit, area_coef, base, b, smp, x[2], quads, lattice_wraps, smooth
-            )
-            e_perp = density / wp.abs(smp.d[2])
-            f = piece * phase * e_perp
-            for jj in range(wavelengths_per_group):
-                k = g * wavelengths_per_group + jj
-                c = attenuation_per_m[k]
-                radiance[k, j, i] = radiance[k, j, i] + f * scattering_per_m[k] * sun_irradiance[k] * wp.exp(
-                    -c * (smp.path_m + s_m)
-                )
+        corners = load_corners(base, direction, transmit, ends, area_coef, b)
+        chords += chord_radiance(
+            corners, b, copy_offset(bc % per_beam, copies, extent_m), o, v, s_max, j, i,
+            weight, transmit, area_coef, base, quads, lattice_wraps, smooth, beams_per_group,
+            wavelengths_per_group, sun_irradiance, attenuation_per_m, scattering_per_m,
+            phase_kind, hg_g, angles_rad, log_phase, cone_phase, radiance,
+        )
     wp.atomic_add(pairs, 0, count)
+    wp.atomic_add(pairs, 1, boxed)
+    wp.atomic_add(pairs, 2, chords)
+
+
+@wp.func
+def box_rows(axis: wp.vec2, lo: wp.vec2, hi: wp.vec2, y0: int, y1: int):
+    """Rows [r0, r1) of [y0, y1) whose pixel centres may meet the oriented box [lo, hi] in the frame
+    (axis, perp(axis)): the heights of the box's corners, widened by a pixel against rounding."""
+    ya = float(1.0e30)
+    yb = float(-1.0e30)
+    for c in range(4):
+        u = lo[0]
+        w = lo[1]
+        if c % 2 == 1:
+            u = hi[0]
+        if c >= 2:
+            w = hi[1]
+        y = u * axis[1] + w * axis[0]  # the corner u axis + w perp(axis)
+        ya = wp.min(ya, y)
+        yb = wp.max(yb, y)
+    r0 = int(wp.floor(wp.clamp(ya - 0.5, -1.0e6, 1.0e6))) - 1
+    r1 = int(wp.floor(wp.clamp(yb - 0.5, -1.0e6, 1.0e6))) + 2
+    return wp.max(r0, y0), wp.min(r1, y1)
+
+
+@wp.func
+def slab_span(a: float, c: float, lo: float, hi: float, x0: int, x1: int):
+    """Pixels [i0, i1) of [x0, x1) whose centres x may satisfy lo <= a x + c <= hi, widened by a
+    pixel against rounding."""
+    if wp.abs(a) < 1.0e-6:
+        if c < lo - 1.0 or c > hi + 1.0:
+            return 0, 0
+        return x0, x1
+    xa = (lo - c) / a
+    xb = (hi - c) / a
+    if a < 0.0:
+        t = xa
+        xa = xb
+        xb = t
+    i0 = int(wp.floor(wp.clamp(xa - 0.5, -1.0e6, 1.0e6))) - 1
+    i1 = int(wp.floor(wp.clamp(xb - 0.5, -1.0e6, 1.0e6))) + 2
+    return wp.max(i0, x0), wp.min(i1, x1)
+
+
+@wp.kernel
+def scan_plane_radiance_tiles(
+    grid: TileGrid,
+    tile_start: wp.array[wp.int32],
+    tile_count: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+    tile_pixels: int,
+    cam: PinholeCamera,
+    rays: wp.array2d[wp.vec3],
+    depth: wp.array2d[wp.float32],
+    base: wp.array2d[wp.vec3],
+    direction: wp.array2d[wp.vec3],
+    transmit: wp.array2d[wp.float32],
+    ends: wp.array2d[wp.vec3],
+    weight: wp.array[wp.float32],
+    area_coef: wp.array[wp.vec3],
+    copies: int,
+    extent_m: float,
+    quads: int,
+    smooth: int,
+    box_axis: wp.array[wp.vec2],
+    box_lo: wp.array[wp.vec2],
+    box_hi: wp.array[wp.vec2],
+    beams_per_group: int,
+    wavelengths_per_group: int,
+    sun_irradiance: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    scattering_per_m: wp.array[wp.float32],
+    phase_kind: int,
+    hg_g: float,
+    angles_rad: wp.array[wp.float32],
+    log_phase: wp.array[wp.float32],
+    cone_phase: float,
+    radiance: wp.array3d[wp.float32],
+    pairs: wp.array[wp.int32],
+):
+    """:func:`scan_plane_radiance` with a thread per tile (the CPU's form, same result to the bit):
+    the tile's list is walked once, not once per pixel, and each beam copy visits only the rows and
+    pixels its oriented box can reach. Every pixel still adds its beams in list order."""
+    tj, ti = wp.tid()
+    x0 = ti * tile_pixels
+    y0 = tj * tile_pixels
+    x1 = wp.min(x0 + tile_pixels, radiance.shape[2])
+    y1 = wp.min(y0 + tile_pixels, radiance.shape[1])
+    for j in range(y0, y1):
+        for i in range(x0, x1):
+            for k in range(radiance.shape[0]):
+                radiance[k, j, i] = 0.0
+    o = cam.position
+    t = tile_index(grid, ti, tj)
+    start = tile_start[t]
+    per_beam = copies * copies
+    lattice_wraps = int(0)
+    if copies > 1:
+        lattice_wraps = 1  # a periodic sea
+    count = tile_count[t]
+    boxed = int(0)
+    chords = int(0)
+    for item in range(count):
+        bc = tile_items[start + item]
+        axis = box_axis[bc]
+        lo = box_lo[bc]
+        hi = box_hi[bc]
+        r0, r1 = box_rows(axis, lo, hi, y0, y1)
+        if r0 >= r1:
+            continue
+        b = bc / per_beam
+        shift = copy_offset(bc % per_beam, copies, extent_m)
+        corners = load_corners(base, direction, transmit, ends, area_coef, b)
+        for j in range(r0, r1):
+            yc = float(j) + 0.5
+            # The pixels whose centres can be in the box: in_frame(centre, axis) is
+            # (x a0 + y a1, −x a1 + y a0) for axis (a0, a1).
+            a0, a1 = slab_span(axis[0], yc * axis[1], lo[0] - 1.0e-3, hi[0] + 1.0e-3, x0, x1)
+            c0, c1 = slab_span(-axis[1], yc * axis[0], lo[1] - 1.0e-3, hi[1] + 1.0e-3, a0, a1)
+            for i in range(c0, c1):
+                if outside_box(in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
+                    continue
+                boxed += 1
+                chords += chord_radiance(
+                    corners, b, shift, o, rays[j, i], depth[j, i], j, i,
+                    weight, transmit, area_coef, base, quads, lattice_wraps, smooth, beams_per_group,
+                    wavelengths_per_group, sun_irradiance, attenuation_per_m, scattering_per_m,
+                    phase_kind, hg_g, angles_rad, log_phase, cone_phase, radiance,
+                )
+    wp.atomic_add(pairs, 0, count * (x1 - x0) * (y1 - y0))
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)

@@ -94,13 +94,16 @@ def gbuffer(
     receiver: wp.array2d[wp.int32],
     inv_footprint: wp.array2d[wp.float32],
     depth_slack: wp.array2d[wp.float32],
+    rays: wp.array2d[wp.vec3],
 ):
     """First receiver along each pixel's ray: position, normal facing the camera, distance,
-    receiver id (−1 and depth 1e30 for none) and 1 / the pixel's footprint area there [m^-2].
+    receiver id (−1 and depth 1e30 for none) and 1 / the pixel's footprint area there [m^-2]; and
+    the unit ray itself (what the volume pass marches).
     ``depth_slack``: how much the distance of points on the receiver within the pixel's footprint
     can differ from the centre ray's, 1.5 · r · (pixel angle) · tan(incidence) [m]."""
     j, i = wp.tid()
     ray = pixel_ray(cam, i, j)
+    rays[j, i] = ray
     q = wp.mesh_query_ray(mesh, cam.position, ray, 1.0e5)
     if q.result:
         n = q.normal

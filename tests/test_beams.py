@@ -165,7 +165,18 @@ def _chords(
 ):
     i = wp.tid()
     beam_kernels.fill_ends(base, direction, end_m, i, ends)
-    a, b = beam_kernels.scan_chord(base, direction, ends, i, wp.vec3(0.0), origins[i], rays[i])
+    corners = beam_kernels.BeamCorners()
+    corners.v0 = base[i, 0]
+    corners.v1 = base[i, 1]
+    corners.v2 = base[i, 2]
+    corners.d0 = direction[i, 0]
+    corners.d1 = direction[i, 1]
+    corners.d2 = direction[i, 2]
+    corners.end_point = ends[i, 0]
+    corners.end_normal = ends[i, 1]
+    corners.dbar = ends[i, 2]
+    corners.base_normal = ends[i, 3]
+    a, b = beam_kernels.scan_chord(corners, wp.vec3(0.0), origins[i], rays[i])
     out[i] = wp.vec2(a, b)
 
 
@@ -306,6 +317,47 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform():
     assert seen.sum() > 4000
     measured = result.camera_radiance[:, seen] * np.pi / 0.5 / e[:, None]
     np.testing.assert_allclose(measured, 1.0, atol=1e-4)
+
+
+@pytest.mark.parametrize(
+    "config, overrides",
+    [
+        ("configs/ocean_floor.toml", {"water.resolution": 32}),
+        (
+            "configs/pool.toml",
+            {
+                "water.resolution": 32,
+                "camera.enabled": True,
+                "camera.position_m": [-1.5, -1.5, -0.6],
+                "camera.look_at_m": [1.0, 0.5, -1.4],
+                "optics.water_type": "coastal_ocean",
+            },
+        ),
+    ],
+    ids=["periodic-sea", "walled-pool"],
+)
+def test_the_cpu_tile_walk_gives_the_per_pixel_shafts_to_the_bit(config, overrides):
+    """The volume pass's two thread layouts (a thread per pixel for the GPU, per 8×8 tile for the
+    CPU, which walks a tile's beam list once and visits only the pixels a beam's box can reach)
+    give the same radiance to the bit and test the same (pixel, beam) pairs, on a periodic sea
+    (3×3 copies) and in a walled pool, with a frame whose sides are not whole tiles."""
+    scene = wc.load_scene(
+        config,
+        {**BEAMS, **overrides, "caustics.shafts": True, "optics.wavelengths": "rgb", "camera.width": 60,
+         "camera.height": 44, "caustics.map_resolution": 32},
+    )
+    renderer = wc.Renderer(scene, "cpu")
+    renderer.render(0.0)
+    camera = renderer.camera
+    assert camera.shaft_threads == "tile"
+    tiles = camera.shafts.numpy().copy()
+    tile_fill = camera.beam_fill()
+    camera.shaft_threads = "pixel"
+    camera.render_beams(renderer.beams, True)
+    pixels = camera.shafts.numpy()
+    assert tile_fill == camera.beam_fill()
+    assert tile_fill["inside_pairs"] > 1000 and (pixels > 0).mean() > 0.3
+    np.testing.assert_array_equal(tiles, pixels)
 
 
 def test_grazing_sun_folds_and_degenerate_beams_stay_finite():

@@ -51,7 +51,8 @@ def pyramid_pixels(width: int, height: int) -> int:
 def camera_bytes(cfg: CameraConfig, k: int) -> int:
     """Device memory of the camera buffers [bytes]."""
     pixels = cfg.width * cfg.height
-    return pixels * (12 + 12 + 4 + 4 + 4 + 4 * k * 4) + 4 * k * pyramid_pixels(cfg.width, cfg.height)
+    # position, normal, ray; depth, receiver, footprint, depth slack; caustic, shafts, raw shafts, radiance
+    return pixels * (3 * 12 + 4 * 4 + 4 * k * 4) + 4 * k * pyramid_pixels(cfg.width, cfg.height)
 
 
 class UnderwaterCamera:
@@ -81,6 +82,7 @@ class UnderwaterCamera:
         self.receiver = wp.empty((h, w), dtype=wp.int32, device=device)
         self.inv_footprint = wp.empty((h, w), dtype=wp.float32, device=device)
         self.depth_slack = wp.empty((h, w), dtype=wp.float32, device=device)
+        self.rays = wp.empty((h, w), dtype=wp.vec3, device=device)
         self.caustic = wp.empty((k, h, w), dtype=wp.float32, device=device)
         """Irradiance on the receiver seen in each pixel (K, H, W) [W m^-2 nm^-1]."""
         self.shafts = wp.empty((k, h, w), dtype=wp.float32, device=device)
@@ -88,6 +90,9 @@ class UnderwaterCamera:
         self.pyramid = wp.empty((k, pyramid_pixels(w, h)), dtype=wp.float32, device=device)
         self.radiance = wp.empty((k, h, w), dtype=wp.float32, device=device)
         self._gbuffer: dict[str, np.ndarray] | None = None
+        self.shaft_threads = "tile" if wp.get_device(device).is_cpu else "pixel"
+        """How the beams' volume pass is split: a thread per ``"pixel"`` (the GPU's form) or per
+        ``"tile"`` (the CPU's: each tile's beam list is walked once). Same result to the bit."""
         wp.launch(
             camera_kernels.gbuffer,
             dim=(h, w),
@@ -99,6 +104,7 @@ class UnderwaterCamera:
                 self.receiver,
                 self.inv_footprint,
                 self.depth_slack,
+                self.rays,
             ],
             device=device,
         )
@@ -236,12 +242,15 @@ class UnderwaterCamera:
             bins.bin()
             self._pairs.zero_()
             ph = self.phase
+            kernel, dim = beam_kernels.scan_plane_radiance, (h, w)
+            if self.shaft_threads == "tile":
+                kernel, dim = beam_kernels.scan_plane_radiance_tiles, (bins.grid.ny, bins.grid.nx)
             wp.launch(
-                beam_kernels.scan_plane_radiance,
-                dim=(h, w),
-                inputs=[*bins.inputs(), SCREEN_TILE_PIXELS, self.cam, self.depth, beams.base, beams.direction,
-                        beams.transmit, beams.ends, beams.weight, beams.area_coef, copies, beams.extent_m,
-                        beams.quads, int(beams.smooth),
+                kernel,
+                dim=dim,
+                inputs=[*bins.inputs(), SCREEN_TILE_PIXELS, self.cam, self.rays, self.depth, beams.base,
+                        beams.direction, beams.transmit, beams.ends, beams.weight, beams.area_coef, copies,
+                        beams.extent_m, beams.quads, int(beams.smooth),
                         bins.box_axis, bins.box_lo, bins.box_hi, beams.beams_per_group, k // beams.groups,
                         beams.sun_irradiance, beams.attenuation_per_m, self.scattering_per_m, ph.kind, ph.g,
                         ph.angles_rad, ph.log_phase, ph.cone_phase],
