@@ -242,6 +242,11 @@ def main(argv: list[str] | None = None) -> int:
 
     sweeps = sweep_bench.run(args.quick, args.device)
 
+    # Device memory of large scenes, from the estimate renders check (benchmarks/memory.py).
+    from benchmarks import memory as memory_bench
+
+    memory = memory_bench.run()
+
     record = {
         "benchmark": "ocean_frame_floor_caustics",
         "command": "python -m benchmarks.run" + (" --quick" if args.quick else "")
@@ -262,6 +267,7 @@ def main(argv: list[str] | None = None) -> int:
         "sun_disk": sun_disk,
         "multiple": multiple,
         "sweep": sweeps,
+        "memory": memory,
     }
     save_record(record, args.out, "ocean_frame", args.quick, args.device)
     return 0
