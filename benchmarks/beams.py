@@ -243,32 +243,33 @@ def numpy_volume(
     return out.reshape(beams["k"], h, w)
 
 
-def _volume_chunk(
-    out, beams, query, item, ii, jj, cam, depth, copies, extent_m, boxes, scattering, g
-) -> None:
-    h, w = depth.shape
-    px, py = ii[query] + 0.5, jj[query] + 0.5
-    axis, lo, hi = boxes[0][item], boxes[1][item], boxes[2][item]
-    u = px * axis[:, 0] + py * axis[:, 1]
-    vv = -px * axis[:, 1] + py * axis[:, 0]
-    keep = (u >= lo[:, 0] - 1e-3) & (u <= hi[:, 0] + 1e-3) & (vv >= lo[:, 1] - 1e-3) & (vv <= hi[:, 1] + 1e-3)
-    query, item = query[keep], item[keep]
-    # Pixel rays (kernels/camera.py pixel_ray).
-    x = 2.0 * (ii[query] + 0.5) / w - 1.0
-    y = 1.0 - 2.0 * (jj[query] + 0.5) / h
+def pixel_rays(cam: dict, i: np.ndarray, j: np.ndarray, w: int, h: int) -> np.ndarray:
+    """Unit rays through the centres of pixels (j, i) (kernels/camera.py pixel_ray) in float64."""
+    x = 2.0 * (i + 0.5) / w - 1.0
+    y = 1.0 - 2.0 * (j + 0.5) / h
     ray = (
         cam["forward"]
         + (x * cam["tan"] * cam["aspect"])[:, None] * cam["right"]
         + (y * cam["tan"])[:, None] * cam["up"]
     )
-    ray /= np.linalg.norm(ray, axis=-1, keepdims=True)
-    o = cam["position"]
-    b = item // (copies * copies)
-    c = item % (copies * copies)
-    r = copies // 2
-    shift = np.stack([(c % copies - r) * extent_m, (c // copies - r) * extent_m, np.zeros(len(c))], axis=1)
-    v = beams["base"][b] + shift[:, None]
-    d = beams["direction"][b]
+    return ray / np.linalg.norm(ray, axis=-1, keepdims=True)
+
+
+def camera_dict(cam) -> dict:
+    """A PinholeCamera's fields in float64, as the numpy twins take them."""
+    return {
+        "position": np.array(cam.position, np.float64),
+        "right": np.array(cam.right, np.float64),
+        "up": np.array(cam.up, np.float64),
+        "forward": np.array(cam.forward, np.float64),
+        "tan": float(cam.tan_half_fov),
+        "aspect": float(cam.aspect),
+    }
+
+
+def scan_chords(o: np.ndarray, ray: np.ndarray, v: np.ndarray, d: np.ndarray, end_m: np.ndarray):
+    """(s_a, s_b) of rays o + s·ray through beams with base vertices v (B, 3, 3), unit edge directions
+    d and edge lengths end_m: ``kernels/beams.py scan_chord`` in float64 (s_a > s_b for a miss)."""
     dbar = d.sum(axis=1)
     dbar /= np.linalg.norm(dbar, axis=-1, keepdims=True)
     wv = np.cross(ray, dbar)
@@ -282,8 +283,8 @@ def _volume_chunk(
     q = v + t[..., None] * d - o
     a = (q * ray[:, None]).sum(-1)
     cc = (q * e2[:, None]).sum(-1)
-    s_a = np.full(len(b), np.inf)
-    s_b = np.full(len(b), -np.inf)
+    s_a = np.full(len(v), np.inf)
+    s_b = np.full(len(v), -np.inf)
     for i in range(3):
         j = (i + 1) % 3
         cross = (cc[:, i] >= 0) != (cc[:, j] >= 0)
@@ -303,8 +304,8 @@ def _volume_chunk(
     s_a = np.where(ok | parallel, s_a, np.inf)
     nb /= np.linalg.norm(nb, axis=-1, keepdims=True)
     nb *= np.where((nb * dbar).sum(-1) < 0, -1.0, 1.0)[:, None]
-    e0, ne = _end_planes(v - shift[:, None], d, beams["end_m"][b])
-    for p0, nrm, sign in ((v[:, 0], nb, 1.0), (e0 + shift, ne, -1.0)):
+    e0, ne = _end_planes(v, d, end_m)
+    for p0, nrm, sign in ((v[:, 0], nb, 1.0), (e0, ne, -1.0)):
         a0 = sign * ((o - p0) * nrm).sum(-1)
         k = sign * (ray * nrm).sum(-1)
         flat = np.abs(k) < 1e-20
@@ -312,6 +313,27 @@ def _volume_chunk(
         s_a = np.where(~flat & (k > 0), np.maximum(s_a, root), s_a)
         s_b = np.where(~flat & (k < 0), np.minimum(s_b, root), s_b)
         s_a = np.where(flat & (a0 < 0), np.inf, s_a)
+    return s_a, s_b
+
+
+def _volume_chunk(
+    out, beams, query, item, ii, jj, cam, depth, copies, extent_m, boxes, scattering, g
+) -> None:
+    h, w = depth.shape
+    px, py = ii[query] + 0.5, jj[query] + 0.5
+    axis, lo, hi = boxes[0][item], boxes[1][item], boxes[2][item]
+    u = px * axis[:, 0] + py * axis[:, 1]
+    vv = -px * axis[:, 1] + py * axis[:, 0]
+    keep = (u >= lo[:, 0] - 1e-3) & (u <= hi[:, 0] + 1e-3) & (vv >= lo[:, 1] - 1e-3) & (vv <= hi[:, 1] + 1e-3)
+    query, item = query[keep], item[keep]
+    ray = pixel_rays(cam, ii[query], jj[query], w, h)
+    o = cam["position"]
+    b = item // (copies * copies)
+    c = item % (copies * copies)
+    r = copies // 2
+    shift = np.stack([(c % copies - r) * extent_m, (c // copies - r) * extent_m, np.zeros(len(c))], axis=1)
+    v = beams["base"][b] + shift[:, None]
+    s_a, s_b = scan_chords(o, ray, v, beams["direction"][b], beams["end_m"][b])
     s_a = np.maximum(s_a, 0.0)
     s_b = np.minimum(s_b, depth.ravel()[query])
     hit = s_b > s_a
@@ -507,7 +529,9 @@ def prism_ends(v: np.ndarray, d: np.ndarray, ends: np.ndarray) -> np.ndarray:
 def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dict:
     """Pixels a rasteriser would touch for the beams' bounding volumes, on a sample of the beam copies
     wholly in front of the camera: the tight hull (convex hull of base and end vertices) against a
-    bounding prism in Ernst's manner (:func:`prism_ends`), each projected and clipped to the frame."""
+    bounding prism in Ernst's manner (:func:`prism_ends`), each projected and clipped to the frame;
+    and the pixels where the beam really is, whose centre ray has a scan-plane chord through it in
+    front of the camera (:func:`scan_chords`, float64; receivers not considered)."""
     cam = camera.cam
     pos = np.array(cam.position, np.float64)
     right, up, fwd = (np.array(a, np.float64) for a in (cam.right, cam.up, cam.forward))
@@ -537,7 +561,7 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
     hp, hz = project(hull)
     pp, pz = project(prism)
     good = np.all(hz > 1e-3, axis=1) & np.all(pz > 1e-3, axis=1) & np.all(np.isfinite(pp), axis=(1, 2))
-    hull_px, prism_px, counted = 0.0, 0.0, 0
+    hull_px, prism_px, used = 0.0, 0.0, []
     for i in np.flatnonzero(good):
         a_hull = _convex_area_on_screen(hp[i], w, h)
         a_prism = _convex_area_on_screen(pp[i], w, h)
@@ -545,11 +569,28 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
             continue
         hull_px += a_hull
         prism_px += a_prism
-        counted += 1
-        if counted >= samples:
+        used.append(i)
+        if len(used) >= samples:
             break
-    return {"beams_measured": counted, "hull_pixels": hull_px, "prism_pixels": prism_px,
-            "hull_over_prism": hull_px / max(prism_px, 1e-300)}
+    # Where the beams are: every pixel of each hull's screen box, tested by its centre ray.
+    used = np.array(used, np.int64)
+    lo = np.clip(np.floor(hp[used].min(axis=1)), 0, [w, h]).astype(np.int64)
+    hi = np.clip(np.ceil(hp[used].max(axis=1)), 0, [w, h]).astype(np.int64)
+    size = hi - lo
+    count = size[:, 0] * size[:, 1]
+    beam = np.repeat(np.arange(len(used)), count)
+    k = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    px = lo[beam, 0] + k % np.maximum(size[beam, 0], 1)
+    py = lo[beam, 1] + k // np.maximum(size[beam, 0], 1)
+    inside = 0
+    for part in np.array_split(np.arange(len(beam)), max(1, len(beam) // CHUNK_PAIRS + 1)):
+        q = used[beam[part]]
+        s_a, s_b = scan_chords(pos, pixel_rays(camera_dict(cam), px[part], py[part], w, h), vb[q], d[b[q]],
+                               ends[b[q]])
+        inside += int(np.count_nonzero(s_b > np.maximum(s_a, 0.0)))
+    return {"beams_measured": len(used), "hull_pixels": hull_px, "prism_pixels": prism_px,
+            "hull_over_prism": hull_px / max(prism_px, 1e-300), "beam_pixels": inside,
+            "hull_fill": inside / max(hull_px, 1e-300), "prism_fill": inside / max(prism_px, 1e-300)}
 
 
 def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, numpy_repeats: int) -> dict:
@@ -589,15 +630,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     fill = camera.beam_fill()
     fill.update(fill_measure(stage, camera, 3 if stage.periodic else 1, samples=3000))
     bins = camera._screen_bins
-    cam = camera.cam
-    cam_np = {
-        "position": np.array(cam.position, np.float64),
-        "right": np.array(cam.right, np.float64),
-        "up": np.array(cam.up, np.float64),
-        "forward": np.array(cam.forward, np.float64),
-        "tan": float(cam.tan_half_fov),
-        "aspect": float(cam.aspect),
-    }
+    cam_np = camera_dict(camera.cam)
     depth = camera.depth.numpy().astype(np.float64)
     boxes = tuple(a.numpy().astype(np.float64) for a in (bins.box_axis, bins.box_lo, bins.box_hi))
     beams = _beam_arrays(stage)
@@ -720,7 +753,8 @@ def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str) -> list[d
         floor = result.floor_irradiance[1].astype(np.float64)
         rows.append({"floor_depth_m": depth, "contrast": float(floor.std() / floor.mean()), **fill})
         print(f"beams        fill at floor depth {depth:5.1f} m (contrast {rows[-1]['contrast']:.2f}): "
-              f"hull/prism {fill['hull_over_prism']:.3f} on {fill['beams_measured']} beams", flush=True)
+              f"hull/prism {fill['hull_over_prism']:.3f} on {fill['beams_measured']} beams; fill (beam "
+              f"pixels / touched) hull {fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}", flush=True)
     return rows
 
 
@@ -757,7 +791,8 @@ def run(quick: bool, device: str) -> dict:
           f"chord {fill['inside_pairs']:.3g}", flush=True)
     print(f"beams        bounding volumes on {fill['beams_measured']} beams in view: tight hull "
           f"{fill['hull_pixels']:.4g} px, Ernst-style prism {fill['prism_pixels']:.4g} px, hull/prism "
-          f"{fill['hull_over_prism']:.2f}", flush=True)
+          f"{fill['hull_over_prism']:.2f}; where the beams are {fill['beam_pixels']} px: fill hull "
+          f"{fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}", flush=True)
     by_n = [_stage_time(n, sizes["scaling_m"][1], device, warp_repeats) for n in sizes["scaling_n"]]
     by_m = [_stage_time(sizes["scaling_n"][1], m, device, warp_repeats) for m in sizes["scaling_m"]]
     for rows, key in ((by_n, "beams"), (by_m, "map_m")):

@@ -896,9 +896,10 @@ def point_irradiance(
 
 @wp.struct
 class BeamCorners:
-    """What the volume pass reads of beam b, read once per (pixel, beam) pair: base vertices v_i,
-    unit edge directions d_i, per-vertex transmittance, A(z)'s coefficients, the base centroid's
-    height, and ``ends[b]`` (end plane point and normal, d̄, base plane normal)."""
+    """What the volume pass reads of beam b, once per beam a thread meets (per pixel on the GPU, per
+    tile on the CPU): base vertices v_i, unit edge directions d_i, per-vertex transmittance, A(z)'s
+    coefficients, the base centroid's height, and ``ends[b]`` (end plane point and normal, d̄, base
+    plane normal)."""
 
     v0: wp.vec3
     v1: wp.vec3
