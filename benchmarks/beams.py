@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -769,7 +769,8 @@ def run(quick: bool, device: str) -> dict:
 
     sizes = QUICK if quick else FULL
     warp_repeats, numpy_repeats = (2, 1) if quick else (5, 3)
-    wp_name = str(wp.get_device(device).name)
+    record = device_record(device)
+    wp_name = record["device_name"]
     print(f"beams        warp {wp.__version__} [{device}: {wp_name}] | cpu {_cpu_name()} | numpy twins "
           "float64, same beams and tile lists", flush=True)
     gather = _gather_case(sizes["gather_n"], sizes["gather_m"], device, warp_repeats, numpy_repeats)
@@ -818,9 +819,7 @@ def run(quick: bool, device: str) -> dict:
         "adaptive_vs_uniform": adaptive,
         "fill_vs_depth": fill_rows,
         "benchmark": "beam_rasteriser",
-        "device": device,
-        "device_name": wp_name,
-        "warp_version": wp.__version__,
+        **record,
         "wavelengths": WAVELENGTHS,
         "warp_repeats": warp_repeats,
         "numpy_repeats": numpy_repeats,

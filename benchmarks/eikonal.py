@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import time
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 FULL = [64, 128, 256]
 QUICK = [64]
@@ -86,7 +86,8 @@ def run(quick: bool, device: str) -> dict:
     from benchmarks.run import _cpu_name
 
     repeats = 1 if quick else 3
-    wp_name = str(wp.get_device(device).name)
+    record = device_record(device)
+    wp_name = record["device_name"]
     print(f"eikonal      configs/mercier_pool.toml t={TIME_S} s | warp {wp.__version__} "
           f"[{device}: {wp_name}] | cpu {_cpu_name()}", flush=True)
     rows = []
@@ -105,8 +106,8 @@ def run(quick: bool, device: str) -> dict:
               f"({row['wave_ns_per_node_update']:5.1f} ns/node update) | Mercier's published wave "
               f"{row['mercier_published_wave_s']} s | {row['wave_device_bytes'] / 2**20:7.1f} MiB",
               flush=True)
-    return {"benchmark": "eikonal_and_wave_textures", "device": device, "device_name": wp_name,
-            "warp_version": wp.__version__, "repeats": repeats, "scene": "configs/mercier_pool.toml",
+    return {"benchmark": "eikonal_and_wave_textures", **record, "repeats": repeats,
+            "scene": "configs/mercier_pool.toml",
             "time_s": TIME_S, "published": "Mercier 2013, Table 1 (quoted, not measured here)",
             "results": rows}
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -324,7 +324,8 @@ def run(quick: bool, device: str) -> dict:
 
     n, s, m = QUICK if quick else FULL
     warp_repeats, numpy_repeats = (2, 1) if quick else (5, 3)
-    wp_name = str(wp.get_device(device).name)
+    record = device_record(device)
+    wp_name = record["device_name"]
     print(f"photons      ocean N={n} s={s} M={m} wavelengths={WAVELENGTHS} | warp {wp.__version__} "
           f"[{device}: {wp_name}] | cpu {_cpu_name()} | numpy exact = analytic ray/plane (no BVH)",
           flush=True)
@@ -359,8 +360,8 @@ def run(quick: bool, device: str) -> dict:
               f"{row['relative_flux_diff_numpy_vs_warp']:.1e})",
               flush=True)
     return {"benchmark": "photon_splatting", "water_n": n, "photon_subdivisions": s, "map_m": m,
-            "wavelengths": WAVELENGTHS, "device": device, "device_name": wp_name,
-            "warp_version": wp.__version__, "warp_repeats": warp_repeats, "numpy_repeats": numpy_repeats,
+            "wavelengths": WAVELENGTHS, **record, "warp_repeats": warp_repeats,
+            "numpy_repeats": numpy_repeats,
             "timing": "median wall time of PhotonCaustics.run after one warm-up call, device synchronised; "
                       "light view (newton) built once per scene, outside the timing, on both sides",
             "numpy_exact_is": "analytic ray/plane intersection (numpy has no BVH; Warp queries its BVH)",

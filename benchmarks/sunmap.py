@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import median_time, point_sun_scene
+from benchmarks.run import device_record, median_time, point_sun_scene
 
 FULL = [(256, 512), (512, 1024)]
 QUICK = [(128, 256)]
@@ -68,7 +68,8 @@ def run(quick: bool, device: str) -> dict:
     from benchmarks.run import _cpu_name
 
     repeats = 2 if quick else 5
-    wp_name = str(wp.get_device(device).name)
+    record = device_record(device)
+    wp_name = record["device_name"]
     print(f"sunmap       warp {wp.__version__} [{device}: {wp_name}] | cpu {_cpu_name()}", flush=True)
     rows = []
     for config in SCENES:
@@ -80,8 +81,7 @@ def run(quick: bool, device: str) -> dict:
                   f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | L1 vs flux ratio "
                   f"{row['relative_l1_sunmap_vs_fluxratio']:.2f}, correlation "
                   f"{row['correlation_sunmap_vs_fluxratio']:.2f}", flush=True)
-    return {"benchmark": "sunmap_vs_fluxratio", "device": device, "device_name": wp_name,
-            "warp_version": wp.__version__, "repeats": repeats,
+    return {"benchmark": "sunmap_vs_fluxratio", **record, "repeats": repeats,
             "timing": "median wall time of each floor-map stage on one surface, after a warm-up frame, "
                       "device synchronised",
             "results": rows}
