@@ -225,11 +225,16 @@ def fft2(data: wp.array2d, scratch: wp.array2d | None = None) -> wp.array2d:
 
 
 def fft_block_dim(n: int, device) -> int:
-    """Threads per row transform: 1 (the sequential path) on the CPU; on CUDA a power of two
-    that divides N and leaves each thread at least two elements, as cuFFTDx and Warp's scalar
-    GPU path require."""
+    """Threads per row transform: 1 (the sequential path) on the CPU, :func:`cuda_fft_block_dim`
+    on CUDA."""
     if not wp.get_device(device).is_cuda:
         return 1
+    return cuda_fft_block_dim(n)
+
+
+def cuda_fft_block_dim(n: int) -> int:
+    """Threads per row transform on CUDA: a power of two that divides N and leaves each thread at
+    least two elements, as cuFFTDx and Warp's scalar GPU path require."""
     return max(1, min(64, n // 2))
 
 
