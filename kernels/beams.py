@@ -1552,9 +1552,12 @@ def box_rows(axis: wp.vec2, lo: wp.vec2, hi: wp.vec2, y0: int, y1: int):
 @wp.func
 def slab_span(a: float, c: float, lo: float, hi: float, x0: int, x1: int):
     """Pixels [i0, i1) of [x0, x1) whose centres x may satisfy lo <= a x + c <= hi, widened by a
-    pixel against rounding."""
-    if wp.abs(a) < 1.0e-6:
-        if c < lo - 1.0 or c > hi + 1.0:
+    pixel against rounding. Where a x + c moves by less than half a unit across the run, its value
+    mid-run decides for the whole run (dividing by a tiny a would blow float32 rounding up by 1/a);
+    otherwise |a| >= 1 / (2 · run), and the division's rounding stays far below the pixel's margin."""
+    if wp.abs(a) * float(x1 - x0) < 0.5:
+        m = c + a * (0.5 * float(x0 + x1))
+        if m < lo - 1.0 or m > hi + 1.0:
             return 0, 0
         return x0, x1
     xa = (lo - c) / a
