@@ -917,6 +917,26 @@ class BeamCorners:
 
 
 @wp.func
+def edge_corners(
+    base: wp.array2d[wp.vec3], direction: wp.array2d[wp.vec3], ends: wp.array2d[wp.vec3], b: int
+) -> BeamCorners:
+    """The geometry of beam b (all :func:`scan_chord` reads): vertices, edges and ``ends[b]``."""
+    c = BeamCorners()
+    c.v0 = base[b, 0]
+    c.v1 = base[b, 1]
+    c.v2 = base[b, 2]
+    c.d0 = direction[b, 0]
+    c.d1 = direction[b, 1]
+    c.d2 = direction[b, 2]
+    c.base_z = (c.v0[2] + c.v1[2] + c.v2[2]) / 3.0
+    c.end_point = ends[b, 0]
+    c.end_normal = ends[b, 1]
+    c.dbar = ends[b, 2]
+    c.base_normal = ends[b, 3]
+    return c
+
+
+@wp.func
 def load_corners(
     base: wp.array2d[wp.vec3],
     direction: wp.array2d[wp.vec3],
@@ -925,20 +945,9 @@ def load_corners(
     area_coef: wp.array[wp.vec3],
     b: int,
 ) -> BeamCorners:
-    c = BeamCorners()
-    c.v0 = base[b, 0]
-    c.v1 = base[b, 1]
-    c.v2 = base[b, 2]
-    c.d0 = direction[b, 0]
-    c.d1 = direction[b, 1]
-    c.d2 = direction[b, 2]
+    c = edge_corners(base, direction, ends, b)
     c.transmit = wp.vec3(transmit[b, 0], transmit[b, 1], transmit[b, 2])
     c.coef = area_coef[b]
-    c.base_z = (c.v0[2] + c.v1[2] + c.v2[2]) / 3.0
-    c.end_point = ends[b, 0]
-    c.end_normal = ends[b, 1]
-    c.dbar = ends[b, 2]
-    c.base_normal = ends[b, 3]
     return c
 
 
@@ -1383,8 +1392,39 @@ def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
     return s_a, s_b
 
 
+@wp.struct
+class ShaftBeams:
+    """What the volume pass reads besides the camera and the tile lists: the beams (see the module
+    docstring; ``copies`` × ``copies`` periodic copies ``extent_m`` apart, ``quads`` per side of
+    the uniform grid for ``smooth`` interpolation), their index groups, and the medium: the sun's
+    irradiance, attenuation and scattering per band [1/m], the phase function (kind 0:
+    Henyey–Greenstein with ``hg_g``; 1: the table)."""
+
+    base: wp.array2d[wp.vec3]
+    direction: wp.array2d[wp.vec3]
+    transmit: wp.array2d[wp.float32]
+    ends: wp.array2d[wp.vec3]
+    weight: wp.array[wp.float32]
+    area_coef: wp.array[wp.vec3]
+    copies: int
+    extent_m: float
+    quads: int
+    smooth: int
+    beams_per_group: int
+    wavelengths_per_group: int
+    sun_irradiance: wp.array[wp.float32]
+    attenuation_per_m: wp.array[wp.float32]
+    scattering_per_m: wp.array[wp.float32]
+    phase_kind: int
+    hg_g: float
+    angles_rad: wp.array[wp.float32]
+    log_phase: wp.array[wp.float32]
+    cone_phase: float
+
+
 @wp.func
 def chord_radiance(
+    sb: ShaftBeams,
     corners: BeamCorners,
     b: int,
     shift: wp.vec3,
@@ -1393,23 +1433,6 @@ def chord_radiance(
     s_max: float,
     j: int,
     i: int,
-    weight: wp.array[wp.float32],
-    transmit: wp.array2d[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    base: wp.array2d[wp.vec3],
-    quads: int,
-    lattice_wraps: int,
-    smooth: int,
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    scattering_per_m: wp.array[wp.float32],
-    phase_kind: int,
-    hg_g: float,
-    angles_rad: wp.array[wp.float32],
-    log_phase: wp.array[wp.float32],
-    cone_phase: float,
     radiance: wp.array3d[wp.float32],
 ) -> int:
     """Add to pixel (j, i) the radiance scattered into its ray o + s v (cut at the receiver,
@@ -1426,7 +1449,10 @@ def chord_radiance(
     width = wp.sqrt(safe_area(corners.coef, mid[2], corners.v0[2]))
     pieces = wp.clamp(int(ds / wp.max(width, 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
     piece = ds / float(pieces)
-    g = b / beams_per_group
+    g = b / sb.beams_per_group
+    lattice_wraps = int(0)
+    if sb.copies > 1:
+        lattice_wraps = 1  # a periodic sea
     for n in range(pieces):
         s_m = s_a + (float(n) + 0.5) * piece
         x = o + s_m * v - shift
@@ -1434,17 +1460,28 @@ def chord_radiance(
         if smp.beyond_end_m > shadow_slack(smp.area):
             continue
         cos_theta = -wp.dot(smp.d, v)
-        phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, cos_theta)
-        density = flux_density(weight, transmit, area_coef, base, b, smp, x[2], quads, lattice_wraps, smooth)
+        phase = phase_value(sb.phase_kind, sb.hg_g, sb.angles_rad, sb.log_phase, sb.cone_phase, cos_theta)
+        density = flux_density(
+            sb.weight, sb.transmit, sb.area_coef, sb.base, b, smp, x[2], sb.quads, lattice_wraps, sb.smooth
+        )
         e_perp = density / wp.abs(smp.d[2])
         f = piece * phase * e_perp
-        for jj in range(wavelengths_per_group):
-            k = g * wavelengths_per_group + jj
-            c = attenuation_per_m[k]
-            radiance[k, j, i] = radiance[k, j, i] + f * scattering_per_m[k] * sun_irradiance[k] * wp.exp(
-                -c * (smp.path_m + s_m)
+        for jj in range(sb.wavelengths_per_group):
+            k = g * sb.wavelengths_per_group + jj
+            scattered = f * sb.scattering_per_m[k]
+            radiance[k, j, i] = radiance[k, j, i] + scattered * sb.sun_irradiance[k] * wp.exp(
+                -sb.attenuation_per_m[k] * (smp.path_m + s_m)
             )
     return 1
+
+
+@wp.func
+def copy_corners(sb: ShaftBeams, bc: int):
+    """Beam copy ``bc = b · copies² + c``: the beam b, its shift and its corners."""
+    per_beam = sb.copies * sb.copies
+    b = bc / per_beam
+    corners = load_corners(sb.base, sb.direction, sb.transmit, sb.ends, sb.area_coef, b)
+    return b, copy_offset(bc % per_beam, sb.copies, sb.extent_m), corners
 
 
 @wp.func
@@ -1463,29 +1500,10 @@ def scan_plane_radiance(
     cam: PinholeCamera,
     rays: wp.array2d[wp.vec3],
     depth: wp.array2d[wp.float32],
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    weight: wp.array[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    copies: int,
-    extent_m: float,
-    quads: int,
-    smooth: int,
+    sb: ShaftBeams,
     box_axis: wp.array[wp.vec2],
     box_lo: wp.array[wp.vec2],
     box_hi: wp.array[wp.vec2],
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    scattering_per_m: wp.array[wp.float32],
-    phase_kind: int,
-    hg_g: float,
-    angles_rad: wp.array[wp.float32],
-    log_phase: wp.array[wp.float32],
-    cone_phase: float,
     radiance: wp.array3d[wp.float32],
     pairs: wp.array[wp.int32],
 ):
@@ -1502,11 +1520,7 @@ def scan_plane_radiance(
     s_max = depth[j, i]
     t = tile_index(grid, i / tile_pixels, j / tile_pixels)
     start = tile_start[t]
-    per_beam = copies * copies
     centre = wp.vec2(float(i) + 0.5, float(j) + 0.5)
-    lattice_wraps = int(0)
-    if copies > 1:
-        lattice_wraps = 1  # a periodic sea
     count = tile_count[t]
     boxed = int(0)
     chords = int(0)
@@ -1515,14 +1529,8 @@ def scan_plane_radiance(
         if outside_box(in_frame(centre, box_axis[bc]), box_lo[bc], box_hi[bc]):
             continue  # the ray passes outside the beam's hull
         boxed += 1
-        b = bc / per_beam
-        corners = load_corners(base, direction, transmit, ends, area_coef, b)
-        chords += chord_radiance(
-            corners, b, copy_offset(bc % per_beam, copies, extent_m), o, v, s_max, j, i,
-            weight, transmit, area_coef, base, quads, lattice_wraps, smooth, beams_per_group,
-            wavelengths_per_group, sun_irradiance, attenuation_per_m, scattering_per_m,
-            phase_kind, hg_g, angles_rad, log_phase, cone_phase, radiance,
-        )
+        b, shift, corners = copy_corners(sb, bc)
+        chords += chord_radiance(sb, corners, b, shift, o, v, s_max, j, i, radiance)
     wp.atomic_add(pairs, 0, count)
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)
@@ -1581,29 +1589,10 @@ def scan_plane_radiance_tiles(
     cam: PinholeCamera,
     rays: wp.array2d[wp.vec3],
     depth: wp.array2d[wp.float32],
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    weight: wp.array[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    copies: int,
-    extent_m: float,
-    quads: int,
-    smooth: int,
+    sb: ShaftBeams,
     box_axis: wp.array[wp.vec2],
     box_lo: wp.array[wp.vec2],
     box_hi: wp.array[wp.vec2],
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    scattering_per_m: wp.array[wp.float32],
-    phase_kind: int,
-    hg_g: float,
-    angles_rad: wp.array[wp.float32],
-    log_phase: wp.array[wp.float32],
-    cone_phase: float,
     radiance: wp.array3d[wp.float32],
     pairs: wp.array[wp.int32],
 ):
@@ -1622,10 +1611,6 @@ def scan_plane_radiance_tiles(
     o = cam.position
     t = tile_index(grid, ti, tj)
     start = tile_start[t]
-    per_beam = copies * copies
-    lattice_wraps = int(0)
-    if copies > 1:
-        lattice_wraps = 1  # a periodic sea
     count = tile_count[t]
     boxed = int(0)
     chords = int(0)
@@ -1637,9 +1622,7 @@ def scan_plane_radiance_tiles(
         r0, r1 = box_rows(axis, lo, hi, y0, y1)
         if r0 >= r1:
             continue
-        b = bc / per_beam
-        shift = copy_offset(bc % per_beam, copies, extent_m)
-        corners = load_corners(base, direction, transmit, ends, area_coef, b)
+        b, shift, corners = copy_corners(sb, bc)
         for j in range(r0, r1):
             yc = float(j) + 0.5
             # The pixels whose centres can be in the box: in_frame(centre, axis) is
@@ -1650,12 +1633,7 @@ def scan_plane_radiance_tiles(
                 if outside_box(in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
                     continue
                 boxed += 1
-                chords += chord_radiance(
-                    corners, b, shift, o, rays[j, i], depth[j, i], j, i,
-                    weight, transmit, area_coef, base, quads, lattice_wraps, smooth, beams_per_group,
-                    wavelengths_per_group, sun_irradiance, attenuation_per_m, scattering_per_m,
-                    phase_kind, hg_g, angles_rad, log_phase, cone_phase, radiance,
-                )
+                chords += chord_radiance(sb, corners, b, shift, o, rays[j, i], depth[j, i], j, i, radiance)
     wp.atomic_add(pairs, 0, count * (x1 - x0) * (y1 - y0))
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)

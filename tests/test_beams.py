@@ -165,17 +165,7 @@ def _chords(
 ):
     i = wp.tid()
     beam_kernels.fill_ends(base, direction, end_m, i, ends)
-    corners = beam_kernels.BeamCorners()
-    corners.v0 = base[i, 0]
-    corners.v1 = base[i, 1]
-    corners.v2 = base[i, 2]
-    corners.d0 = direction[i, 0]
-    corners.d1 = direction[i, 1]
-    corners.d2 = direction[i, 2]
-    corners.end_point = ends[i, 0]
-    corners.end_normal = ends[i, 1]
-    corners.dbar = ends[i, 2]
-    corners.base_normal = ends[i, 3]
+    corners = beam_kernels.edge_corners(base, direction, ends, i)
     a, b = beam_kernels.scan_chord(corners, wp.vec3(0.0), origins[i], rays[i])
     out[i] = wp.vec2(a, b)
 
