@@ -583,10 +583,10 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
     px = lo[beam, 0] + k % np.maximum(size[beam, 0], 1)
     py = lo[beam, 1] + k // np.maximum(size[beam, 0], 1)
     inside = 0
+    cam_np = camera_dict(cam)
     for part in np.array_split(np.arange(len(beam)), max(1, len(beam) // CHUNK_PAIRS + 1)):
         q = used[beam[part]]
-        s_a, s_b = scan_chords(pos, pixel_rays(camera_dict(cam), px[part], py[part], w, h), vb[q], d[b[q]],
-                               ends[b[q]])
+        s_a, s_b = scan_chords(pos, pixel_rays(cam_np, px[part], py[part], w, h), vb[q], d[b[q]], ends[b[q]])
         inside += int(np.count_nonzero(s_b > np.maximum(s_a, 0.0)))
     return {"beams_measured": len(used), "hull_pixels": hull_px, "prism_pixels": prism_px,
             "hull_over_prism": hull_px / max(prism_px, 1e-300), "beam_pixels": inside,
