@@ -41,14 +41,16 @@ def numpy_step(h, u, v, depth, dt, cell, nu):
     jy, ix = np.meshgrid(np.arange(n + 1), np.arange(n), indexing="ij")
     v_adv = _sample(v, ix - _sample(u, ix + 0.5, jy - 0.5) * k, jy - v * k)
     eta = h - depth
+    gravity_k = np.float32(np.float32(G * dt) / cell)  # as the kernels: g dt/Δ and ν dt/Δ² in float32
+    viscous_k = np.float32(np.float32(nu * dt) / np.float32(cell * cell))
     u_new = np.zeros_like(u)
     v_new = np.zeros_like(v)
     wet_x = (h[:, :-1] > 0) & (h[:, 1:] > 0)
-    u_new[:, 1:-1] = np.where(wet_x, u_adv[:, 1:-1] + dt * (-G * np.diff(eta, axis=1) / cell
-                                                            + nu * _laplacian(u_adv)[:, 1:-1] / cell**2), 0)
+    u_new[:, 1:-1] = np.where(wet_x, u_adv[:, 1:-1] - gravity_k * np.diff(eta, axis=1)
+                              + viscous_k * _laplacian(u_adv)[:, 1:-1], 0)
     wet_y = (h[:-1] > 0) & (h[1:] > 0)
-    v_new[1:-1] = np.where(wet_y, v_adv[1:-1] + dt * (-G * np.diff(eta, axis=0) / cell
-                                                      + nu * _laplacian(v_adv)[1:-1] / cell**2), 0)
+    v_new[1:-1] = np.where(wet_y, v_adv[1:-1] - gravity_k * np.diff(eta, axis=0)
+                           + viscous_k * _laplacian(v_adv)[1:-1], 0)
     fx = np.where(u_new[:, 1:-1] > 0, u_new[:, 1:-1] * h[:, :-1], u_new[:, 1:-1] * h[:, 1:])
     fy = np.where(v_new[1:-1] > 0, v_new[1:-1] * h[:-1], v_new[1:-1] * h[1:])
     flux_x = np.pad(fx, ((0, 0), (1, 1)))

@@ -7,10 +7,17 @@ by rounding; walls are faces with zero normal velocity. Momentum: semi-Lagrangia
 gravity from the surface slope and an explicit viscous Laplacian (symplectic Euler: velocities
 first, then depths with the new velocities).
 
-The substep's kernels take ``span`` consecutive cells of a row per thread (launch dimension
-(rows, ⌈columns/span⌉)): one cell per thread on the GPU, a whole row per thread on the CPU, where
-Warp runs threads one after another and a thread's own fixed cost would otherwise be paid per cell.
-The arithmetic per cell is the same either way.
+The substep's kernels take ``span`` consecutive cells of a row per thread (a one-dimensional
+launch over rows × ⌈columns/span⌉ runs, ``cell_run``): one cell per thread on the GPU, a whole row
+per thread on the CPU, where Warp runs threads one after another and a thread's own fixed cost
+would otherwise be paid per cell. The arithmetic per cell is the same either way. For the CPU's
+sake the runs are ``while`` loops whose array indices are affine in the loop counter (walls and
+the first and last column are done outside the loop, with their clamped neighbours): that lets
+the C++ compiler vectorise the force and depth updates. Measured on a 2-core Xeon at 512²
+(same process, interleaved): accelerate_u 2.9×, accelerate_v 2.6×, update_depth 2.3× faster than
+with a ``range`` loop, a two-dimensional launch and clamped indices in the loop, which it did not
+vectorise. The advection's bilinear sample reads where the velocity points, which no compiler
+vectorises; it stays a scalar loop.
 """
 
 import warp as wp
@@ -38,111 +45,182 @@ def sample_faces(field: wp.array2d[wp.float32], fx: float, fy: float) -> float:
 
 
 @wp.func
-def span_end(chunk: int, span: int, cols: int) -> int:
-    """End (exclusive) of the ``chunk``-th run of ``span`` cells in a row of ``cols``."""
-    return wp.min((chunk + 1) * span, cols)
+def cell_run(thread: int, span: int, cols: int) -> wp.vec3i:
+    """(row, first cell, end cell) of a thread's run of ``span`` cells in rows of ``cols`` cells:
+    the launch is one-dimensional over rows × ⌈cols/span⌉ runs."""
+    runs = (cols + span - 1) // span
+    row = thread // runs
+    start = (thread - row * runs) * span
+    return wp.vec3i(row, start, wp.min(start + span, cols))
 
 
 @wp.kernel
 def advect_u(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float, span: int,
              u_out: wp.array2d[wp.float32]):
     """Semi-Lagrangian advection of u (face (iy, jx) sits at cell coordinates (jx, iy + 0.5))."""
-    iy, chunk = wp.tid()
-    for jx in range(chunk * span, span_end(chunk, span, u.shape[1])):
+    run = cell_run(wp.tid(), span, u.shape[1])
+    iy = run[0]
+    last = v.shape[1] - 1
+    jx = run[1]
+    end = run[2]
+    while jx < end:
         vel_u = u[iy, jx]
         # v at this u-face: mean of the four surrounding v-faces (v-grid index (ix, jy)), the
         # nearest column's two at the walls. Bit for bit the bilinear sample at (jx − ½, iy + ½)
         # (weights ½ scale exactly), without its clamps and conversions.
         ia = wp.max(jx - 1, 0)
-        ib = wp.min(jx, v.shape[1] - 1)
+        ib = wp.min(jx, last)
         vel_v = 0.25 * ((v[iy, ia] + v[iy, ib]) + (v[iy + 1, ia] + v[iy + 1, ib]))
         u_out[iy, jx] = sample_faces(u, float(jx) - vel_u * dt_over_cell, float(iy) - vel_v * dt_over_cell)
+        jx += 1
 
 
 @wp.kernel
 def advect_v(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell: float, span: int,
              v_out: wp.array2d[wp.float32]):
     """Semi-Lagrangian advection of v (face (jy, ix) sits at cell coordinates (ix + 0.5, jy))."""
-    jy, chunk = wp.tid()
-    for ix in range(chunk * span, span_end(chunk, span, v.shape[1])):
+    run = cell_run(wp.tid(), span, v.shape[1])
+    jy = run[0]
+    # u at this v-face: mean of the four surrounding u-faces (as vel_v in advect_u).
+    ja = wp.max(jy - 1, 0)
+    jb = wp.min(jy, u.shape[0] - 1)
+    ix = run[1]
+    end = run[2]
+    while ix < end:
         vel_v = v[jy, ix]
-        # u at this v-face: mean of the four surrounding u-faces (as vel_v in advect_u).
-        ja = wp.max(jy - 1, 0)
-        jb = wp.min(jy, u.shape[0] - 1)
         vel_u = 0.25 * ((u[ja, ix] + u[ja, ix + 1]) + (u[jb, ix] + u[jb, ix + 1]))
         v_out[jy, ix] = sample_faces(v, float(ix) - vel_u * dt_over_cell, float(jy) - vel_v * dt_over_cell)
+        ix += 1
 
 
 @wp.func
-def laplacian(f: wp.array2d[wp.float32], j: int, i: int) -> float:
-    """5-point Laplacian (in index units) with zero-gradient ends."""
-    rows = f.shape[0]
-    cols = f.shape[1]
-    c = f[j, i]
-    return (f[j, wp.max(i - 1, 0)] + f[j, wp.min(i + 1, cols - 1)] + f[wp.max(j - 1, 0), i]
-            + f[wp.min(j + 1, rows - 1), i] - 4.0 * c)
+def accelerated(c: float, rise: float, lap: float, wet: bool, gravity_k: float, viscous_k: float) -> float:
+    """A face's velocity after gravity and viscosity: c − g dt/Δ · Δη + ν dt/Δ² · ∇²c, or rest if dry."""
+    return wp.where(wet, c - gravity_k * rise + viscous_k * lap, 0.0)
 
 
 @wp.kernel
 def accelerate_u(u_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
                  floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float, span: int,
                  u: wp.array2d[wp.float32]):
-    """u += dt (−g ∂η/∂x + ν ∇²u); walls (first and last face) and dry faces stay at rest."""
-    iy, chunk = wp.tid()
+    """u += dt (−g ∂η/∂x + ν ∇²u); walls (first and last face) and dry faces stay at rest. The
+    Laplacian has zero-gradient ends (the nearest row's face beyond the first and last row)."""
+    run = cell_run(wp.tid(), span, u.shape[1])
+    iy = run[0]
     n = h.shape[1]
-    for jx in range(chunk * span, span_end(chunk, span, u.shape[1])):
-        if jx == 0 or jx == n or h[iy, jx - 1] <= 0.0 or h[iy, jx] <= 0.0:
-            u[iy, jx] = 0.0
-        else:
-            slope = ((h[iy, jx] - floor_depth[iy, jx]) - (h[iy, jx - 1] - floor_depth[iy, jx - 1])) / cell
-            u[iy, jx] = u_adv[iy, jx] + dt * (
-                -GRAVITY * slope + viscosity * laplacian(u_adv, iy, jx) / (cell * cell))
+    up = wp.max(iy - 1, 0)
+    down = wp.min(iy + 1, n - 1)
+    gravity_k = GRAVITY * dt / cell
+    viscous_k = viscosity * dt / (cell * cell)
+    if run[1] == 0:  # the west wall
+        u[iy, 0] = 0.0
+    if run[2] == n + 1:  # the east wall
+        u[iy, n] = 0.0
+    # Between the walls every index below is affine in jx, so the compiler can vectorise the loop.
+    jx = wp.max(run[1], 1)
+    end = wp.min(run[2], n)
+    while jx < end:
+        h_w = h[iy, jx - 1]
+        h_e = h[iy, jx]
+        c = u_adv[iy, jx]
+        lap = u_adv[iy, jx - 1] + u_adv[iy, jx + 1] + u_adv[up, jx] + u_adv[down, jx] - 4.0 * c
+        rise = (h_e - floor_depth[iy, jx]) - (h_w - floor_depth[iy, jx - 1])
+        u[iy, jx] = accelerated(c, rise, lap, h_w > 0.0 and h_e > 0.0, gravity_k, viscous_k)
+        jx += 1
+
+
+@wp.func
+def accelerated_v(v_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
+                  floor_depth: wp.array2d[wp.float32], jy: int, ix: int, west: int, east: int,
+                  gravity_k: float, viscous_k: float) -> float:
+    """accelerate_v at the face (jy, ix) of an inner row; ``west``, ``east``: the columns of the
+    Laplacian's side neighbours (the face's own at the first and last column)."""
+    h_s = h[jy - 1, ix]
+    h_n = h[jy, ix]
+    c = v_adv[jy, ix]
+    lap = v_adv[jy, west] + v_adv[jy, east] + v_adv[jy - 1, ix] + v_adv[jy + 1, ix] - 4.0 * c
+    rise = (h_n - floor_depth[jy, ix]) - (h_s - floor_depth[jy - 1, ix])
+    return accelerated(c, rise, lap, h_s > 0.0 and h_n > 0.0, gravity_k, viscous_k)
 
 
 @wp.kernel
 def accelerate_v(v_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
                  floor_depth: wp.array2d[wp.float32], dt: float, cell: float, viscosity: float, span: int,
                  v: wp.array2d[wp.float32]):
-    """v += dt (−g ∂η/∂y + ν ∇²v); walls and dry faces stay at rest."""
-    jy, chunk = wp.tid()
+    """v += dt (−g ∂η/∂y + ν ∇²v); walls (first and last row of faces) and dry faces stay at rest."""
+    run = cell_run(wp.tid(), span, v.shape[1])
+    jy = run[0]
     n = h.shape[0]
-    for ix in range(chunk * span, span_end(chunk, span, v.shape[1])):
-        if jy == 0 or jy == n or h[jy - 1, ix] <= 0.0 or h[jy, ix] <= 0.0:
+    ix = run[1]
+    end = run[2]
+    if jy == 0 or jy == n:  # the south and north walls
+        while ix < end:
             v[jy, ix] = 0.0
-        else:
-            slope = ((h[jy, ix] - floor_depth[jy, ix]) - (h[jy - 1, ix] - floor_depth[jy - 1, ix])) / cell
-            v[jy, ix] = v_adv[jy, ix] + dt * (
-                -GRAVITY * slope + viscosity * laplacian(v_adv, jy, ix) / (cell * cell))
+            ix += 1
+        return
+    gravity_k = GRAVITY * dt / cell
+    viscous_k = viscosity * dt / (cell * cell)
+    last = n - 1
+    if ix == 0:
+        v[jy, 0] = accelerated_v(v_adv, h, floor_depth, jy, 0, 0, wp.min(1, last), gravity_k, viscous_k)
+    if end == n and last > 0:
+        v[jy, last] = accelerated_v(v_adv, h, floor_depth, jy, last, last - 1, last, gravity_k, viscous_k)
+    # Between the first and last column every index is affine in ix: the loop vectorises.
+    ix = wp.max(ix, 1)
+    end = wp.min(end, last)
+    while ix < end:
+        v[jy, ix] = accelerated_v(v_adv, h, floor_depth, jy, ix, ix - 1, ix + 1, gravity_k, viscous_k)
+        ix += 1
 
 
 @wp.func
 def upwind_flux(vel: float, h_minus: float, h_plus: float) -> float:
     """Mass flux through a face: velocity × depth of the cell the water comes from."""
-    if vel > 0.0:
-        return vel * h_minus
-    return vel * h_plus
+    return vel * wp.where(vel > 0.0, h_minus, h_plus)
+
+
+@wp.func
+def net_outflow(h: wp.array2d[wp.float32], u: wp.array2d[wp.float32], v: wp.array2d[wp.float32],
+                iy: int, ix: int, west: int, east: int, south: int, north: int,
+                open_w: bool, open_e: bool, open_s: bool, open_n: bool) -> float:
+    """Flux out − flux in over the cell's four faces; a face that is a wall (not open) carries none.
+    ``west`` … ``north``: the neighbour cells' indices (any valid index behind a wall)."""
+    c = h[iy, ix]
+    flux_w = wp.where(open_w, upwind_flux(u[iy, ix], h[iy, west], c), 0.0)
+    flux_e = wp.where(open_e, upwind_flux(u[iy, ix + 1], c, h[iy, east]), 0.0)
+    flux_s = wp.where(open_s, upwind_flux(v[iy, ix], h[south, ix], c), 0.0)
+    flux_n = wp.where(open_n, upwind_flux(v[iy + 1, ix], c, h[north, ix]), 0.0)
+    return flux_e - flux_w + flux_n - flux_s
 
 
 @wp.kernel
 def update_depth(h: wp.array2d[wp.float32], u: wp.array2d[wp.float32], v: wp.array2d[wp.float32],
                  dt_over_cell: float, span: int, h_out: wp.array2d[wp.float32]):
-    """h −= dt/Δ · (flux out − flux in) over the four faces (conservative form)."""
-    iy, chunk = wp.tid()
+    """h −= dt/Δ · (flux out − flux in) over the four faces (conservative form); no flux through
+    the walls."""
     n = h.shape[0]
-    for ix in range(chunk * span, span_end(chunk, span, n)):
-        west = float(0.0)
-        east = float(0.0)
-        south = float(0.0)
-        north = float(0.0)
-        if ix > 0:
-            west = upwind_flux(u[iy, ix], h[iy, ix - 1], h[iy, ix])
-        if ix < n - 1:
-            east = upwind_flux(u[iy, ix + 1], h[iy, ix], h[iy, ix + 1])
-        if iy > 0:
-            south = upwind_flux(v[iy, ix], h[iy - 1, ix], h[iy, ix])
-        if iy < n - 1:
-            north = upwind_flux(v[iy + 1, ix], h[iy, ix], h[iy + 1, ix])
-        h_out[iy, ix] = h[iy, ix] - dt_over_cell * (east - west + north - south)
+    run = cell_run(wp.tid(), span, n)
+    iy = run[0]
+    south = wp.max(iy - 1, 0)
+    north = wp.min(iy + 1, n - 1)
+    open_s = iy > 0
+    open_n = iy < n - 1
+    ix = run[1]
+    end = run[2]
+    last = n - 1
+    if ix == 0:
+        h_out[iy, 0] = h[iy, 0] - dt_over_cell * net_outflow(h, u, v, iy, 0, 0, wp.min(1, last), south, north,
+                                                             False, last > 0, open_s, open_n)
+    if end == n and last > 0:
+        h_out[iy, last] = h[iy, last] - dt_over_cell * net_outflow(h, u, v, iy, last, last - 1, last, south,
+                                                                   north, True, False, open_s, open_n)
+    # Between the first and last column every index is affine in ix: the loop vectorises.
+    ix = wp.max(ix, 1)
+    end = wp.min(end, last)
+    while ix < end:
+        h_out[iy, ix] = h[iy, ix] - dt_over_cell * net_outflow(h, u, v, iy, ix, ix - 1, ix + 1, south, north,
+                                                               True, True, open_s, open_n)
+        ix += 1
 
 
 @wp.kernel

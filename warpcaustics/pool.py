@@ -184,8 +184,8 @@ class ShallowWaterPool(WalledPool):
             dev = self.device
             span = self._span
 
-            def rows(rows: int, cols: int) -> tuple[int, int]:  # (rows, runs of `span` cells per row)
-                return rows, -(-cols // span)
+            def rows(rows: int, cols: int) -> int:  # rows × runs of `span` cells per row, one thread each
+                return rows * -(-cols // span)
 
             def record(kernel, dim, inputs, outputs):
                 return wp.launch(kernel, dim=dim, inputs=inputs, outputs=outputs, device=dev, record_cmd=True)
