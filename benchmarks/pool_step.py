@@ -9,7 +9,6 @@ update of the depths. Both start from the same state (a pool sloshing after drop
 from __future__ import annotations
 
 import sys
-import time
 
 import numpy as np
 
@@ -75,43 +74,37 @@ def _dt(pool) -> float:
     return pool.cfl * pool.cell_m / pool.max_wave_speed()
 
 
-def measure_warp(n: int, device: str, repeats: int) -> dict:
-    import warp as wp
-
+def warp_stepper(n: int, device: str):
+    """One Warp substep of the sloshing pool, and how many to time together (enough to dwarf the
+    launch overhead at small N)."""
     pool = _pool(n, device)
     dt = _dt(pool)
-    pool.step(dt)  # warm-up
-    wp.synchronize_device(device)
-    steps = max(1, 4096 // n)  # enough substeps per timing to dwarf the launch overhead
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            pool.step(dt)
-        wp.synchronize_device(device)
-        times.append((time.perf_counter() - t0) / steps)
-    return {"step_s": float(np.median(times))}
+    return (lambda: pool.step(dt)), max(1, 4096 // n)
 
 
-def measure_numpy(n: int, repeats: int) -> dict:
+def numpy_stepper(n: int):
+    """One numpy substep from the same sloshing state, and the check of its agreement with the
+    kernels: the largest depth difference after one substep [m]."""
     pool = _pool(n, "cpu")
     dt = _dt(pool)
     # .copy(): on the CPU device .numpy() is a view of the arrays the step overwrites.
     h, u, v = pool.h.numpy().copy(), pool.u.numpy().copy(), pool.v.numpy().copy()
     depth = pool.floor_depth.numpy().copy()
-    pool.step(dt)
-    h_ref = pool.h.numpy()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        h1, _, _ = numpy_step(h, u, v, depth, dt, pool.cell_m, pool.viscosity)
-        times.append(time.perf_counter() - t0)
-    return {"step_s": float(np.median(times)), "max_abs_depth_diff_m": float(np.abs(h1 - h_ref).max())}
+
+    def step():
+        return numpy_step(h, u, v, depth, dt, pool.cell_m, pool.viscosity)
+
+    def check() -> dict:
+        h1, _, _ = step()
+        pool.step(dt)
+        return {"max_abs_depth_diff_m": float(np.abs(h1 - pool.h.numpy()).max())}
+
+    return step, check
 
 
 def run(quick: bool, device: str) -> dict:
-    """The substep at each size, Warp and numpy, each in its own process, with the log-log slopes
-    and, in the full run, the plot."""
+    """The substep at each size, Warp and numpy timed in turn, with the log-log slopes and, in the
+    full run, the plot."""
     from benchmarks.run import run_steps
 
     return run_steps("pool_step", "pool_substep", quick, device)

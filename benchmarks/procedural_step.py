@@ -7,8 +7,6 @@ difference from the kernel.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 TIME_S = 0.7
@@ -47,29 +45,23 @@ def _water(n: int, device: str):
     return ProceduralWater.from_config(scene.config, device), scene.config.water.extent_m
 
 
-def measure_warp(n: int, device: str, repeats: int) -> dict:
-    import warp as wp
-
+def warp_stepper(n: int, device: str):
+    """One Warp evaluation of the surface, and how many to time together."""
     water, _ = _water(n, device)
-    water.at(TIME_S)  # warm-up (module load)
-    wp.synchronize_device(device)
-    steps = max(1, 8192 // n)
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            water.at(TIME_S)
-        wp.synchronize_device(device)
-        times.append((time.perf_counter() - t0) / steps)
-    return {"step_s": float(np.median(times))}
+    return (lambda: water.at(TIME_S)), max(1, 8192 // n)
 
 
-def measure_numpy(n: int, repeats: int) -> dict:
+def numpy_stepper(n: int):
+    """One numpy evaluation, and the check of its agreement with the kernel: the largest height
+    difference [m]."""
     water, extent = _water(n, "cpu")
-    ref = water.at(TIME_S).positions.numpy()[..., 2].copy()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        height, _ = numpy_surface(n, extent, water.waves)
-        times.append(time.perf_counter() - t0)
-    return {"step_s": float(np.median(times)), "max_abs_height_diff_m": float(np.abs(height - ref).max())}
+
+    def step():
+        return numpy_surface(n, extent, water.waves)
+
+    def check() -> dict:
+        height, _ = step()
+        kernel_height = water.at(TIME_S).positions.numpy()[..., 2]
+        return {"max_abs_height_diff_m": float(np.abs(height - kernel_height).max())}
+
+    return step, check

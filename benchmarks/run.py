@@ -94,17 +94,46 @@ def _call(module, func_name, args):
     return getattr(importlib.import_module(f"benchmarks.{module}"), func_name)(*args)
 
 
+def measure_interleaved(module: str, n: int, device: str, repeats: int) -> dict:
+    """One size of step benchmark ``module`` in this process: its Warp step and its numpy twin
+    (``warp_stepper`` and ``numpy_stepper`` of benchmarks/<module>.py), each warmed up once, then
+    timed in turn for ``repeats`` rounds, alternating which goes first, so both see the same
+    machine (a shared or virtual machine's speed drifts over seconds, and timing one side after the
+    other moved the ratio by up to 2x here). Medians per step [s], and the module's agreement check."""
+    import importlib
+
+    import warp as wp
+
+    bench = importlib.import_module(f"benchmarks.{module}")
+    warp_step, calls = bench.warp_stepper(n, device)
+    numpy_step, check = bench.numpy_stepper(n)
+
+    def timed(step, count: int) -> float:
+        t0 = time.perf_counter()
+        for _ in range(count):
+            step()
+        wp.synchronize_device(device)
+        return (time.perf_counter() - t0) / count
+
+    timed(warp_step, 1)  # warm-up: module loads and first launches excluded
+    timed(numpy_step, 1)
+    times: dict[str, list[float]] = {"warp": [], "numpy": []}
+    sides = [("warp", warp_step, calls), ("numpy", numpy_step, 1)]
+    for r in range(repeats):
+        for side, step, count in sides if r % 2 == 0 else sides[::-1]:
+            times[side].append(timed(step, count))
+    return {"warp_step_s": float(np.median(times["warp"])), "numpy_step_s": float(np.median(times["numpy"])),
+            **check()}
+
+
 def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dict]:
     rows = []
     for n in sizes:
-        w = _in_child("measure_warp", n, device, repeats, module=module)
-        npy = _in_child("measure_numpy", n, repeats, module=module)
-        row = {"water_n": n, "warp_step_s": w["step_s"], "numpy_step_s": npy["step_s"],
-               "speedup_warp_vs_numpy": npy["step_s"] / w["step_s"]}
-        row.update({key: val for key, val in npy.items() if key != "step_s"})
+        row = {"water_n": n, **_in_child("measure_interleaved", module, n, device, repeats, module="run")}
+        row["speedup_warp_vs_numpy"] = row["numpy_step_s"] / row["warp_step_s"]
         rows.append(row)
-        print(f"{module:11s}  N={n:5d} | warp[{device}] {w['step_s'] * 1e3:9.3f} ms | "
-              f"numpy {npy['step_s'] * 1e3:9.3f} ms | ratio {row['speedup_warp_vs_numpy']:6.1f}x",
+        print(f"{module:11s}  N={n:5d} | warp[{device}] {row['warp_step_s'] * 1e3:9.3f} ms | "
+              f"numpy {row['numpy_step_s'] * 1e3:9.3f} ms | ratio {row['speedup_warp_vs_numpy']:6.1f}x",
               flush=True)
     if len(rows) >= 2:
         n = np.log([r["water_n"] for r in rows])
@@ -117,8 +146,8 @@ def _steps(module: str, sizes: list[int], device: str, repeats: int) -> list[dic
 
 
 def _step_rows(module: str, quick: bool, device: str, repeats: int) -> list[dict]:
-    """Step benchmark ``module`` at each of its sizes, Warp and numpy in their own processes, with
-    the log-log slopes and, in the full run, the plot in docs/images/."""
+    """Step benchmark ``module`` at each of its sizes, Warp and numpy timed in turn in one process
+    per size, with the log-log slopes and, in the full run, the plot in docs/images/."""
     title, = [t for name, t, _, _ in STEPS if name == module]
     rows = _steps(module, step_sizes(module, quick, device), device, repeats)
     if not quick:
