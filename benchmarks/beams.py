@@ -20,12 +20,11 @@ whole beam stage (build, bin, flat-floor map) against the beam count and the map
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import device_record, interleaved_times, median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -54,15 +53,10 @@ MIN_AREA_FRACTION = 1.0e-6  # as kernels/beams.py
 MAX_CHORD_PIECES = 16
 
 
-def _timed_runs(func, repeats: int):
-    """(first result, median wall time over ``repeats`` calls): numpy needs no warm-up."""
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        result = func()
-        times.append(time.perf_counter() - t0)
-        out = result if out is None else out
-    return out, float(np.median(times))
+def _warp_calls(warp_repeats: int, numpy_repeats: int) -> int:
+    """Warp calls per round of :func:`benchmarks.run.interleaved_times`, so the Warp side is timed
+    about ``warp_repeats`` times over the ``numpy_repeats`` rounds the slow numpy twin sets."""
+    return max(1, round(warp_repeats / numpy_repeats))
 
 
 def _beam_arrays(stage) -> dict:
@@ -424,10 +418,9 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
 
     def warp_run():
         stage.points(*args)
-        wp.synchronize_device(device)
 
     warp_run()
-    warp_s = median_time(warp_run, warp_repeats)
+    wp.synchronize_device(device)
     warp_out = args[3].numpy().astype(np.float64)
     beams = _beam_arrays(stage)
     bins = stage.point_bins
@@ -440,10 +433,15 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
     points = args[0].numpy().astype(np.float64)
     normals = args[1].numpy().astype(np.float64)
 
-    def numpy_run():
-        return numpy_points(beams, tiles, grid, points, normals, stage.extent_m, stage.periodic)
+    numpy_out = []
 
-    numpy_out, numpy_s = _timed_runs(numpy_run, numpy_repeats)
+    def numpy_run():
+        numpy_out[:] = [numpy_points(beams, tiles, grid, points, normals, stage.extent_m, stage.periodic)]
+
+    times = interleaved_times({"warp": (warp_run, _warp_calls(warp_repeats, numpy_repeats)),
+                               "numpy": (numpy_run, 1)}, numpy_repeats, device)
+    warp_s, numpy_s = (float(np.median(times[side])) for side in ("warp", "numpy"))
+    numpy_out = numpy_out[0]
     pairs = int(tiles[1][horizontal_tile(points, grid, stage.periodic)].sum())
     return {
         "water_n": n,
@@ -614,18 +612,8 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     renderer.render(0.0)  # warm-up
     camera, stage = renderer.camera, renderer.beams
 
-    def warp_run():
-        camera.render_beams(stage, True)
-        wp.synchronize_device(device)
-
-    warp_run()
-    warp_s = median_time(warp_run, warp_repeats)
-    # The shafts alone: render_beams also gathers the G-buffer points and shades; time them apart.
-    t_surface = median_time(
-        lambda: (camera.render_beams(stage, False), wp.synchronize_device(device)), warp_repeats
-    )
-    warp_volume_s = max(warp_s - t_surface, 1e-9)
     camera.render_beams(stage, True)
+    wp.synchronize_device(device)
     warp_out = camera.shafts.numpy().astype(np.float64)
     fill = camera.beam_fill()
     fill.update(fill_measure(stage, camera, 3 if stage.periodic else 1, samples=3000))
@@ -637,21 +625,22 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     tiles = _tile_lists(bins)
     copies = 3 if stage.periodic else 1
 
-    def numpy_run():
-        return numpy_volume(
-            beams,
-            tiles,
-            cam_np,
-            depth,
-            copies,
-            stage.extent_m,
-            boxes,
-            camera.scattering_per_m.numpy().astype(np.float64),
-            float(camera.phase.g),
-            SCREEN_TILE_PIXELS,
-        )
+    scattering_per_m = camera.scattering_per_m.numpy().astype(np.float64)
+    numpy_out = []
 
-    numpy_out, numpy_s = _timed_runs(numpy_run, numpy_repeats)
+    def numpy_run():
+        numpy_out[:] = [numpy_volume(beams, tiles, cam_np, depth, copies, stage.extent_m, boxes,
+                                     scattering_per_m, float(camera.phase.g), SCREEN_TILE_PIXELS)]
+
+    # The shafts alone: render_beams also gathers the G-buffer points and shades, so each round
+    # times it with and without the shafts and takes the difference.
+    calls = _warp_calls(warp_repeats, numpy_repeats)
+    times = interleaved_times({"with shafts": (lambda: camera.render_beams(stage, True), calls),
+                               "without": (lambda: camera.render_beams(stage, False), calls),
+                               "numpy": (numpy_run, 1)}, numpy_repeats, device)
+    warp_volume_s = max(float(np.median(np.subtract(times["with shafts"], times["without"]))), 1e-9)
+    numpy_s = float(np.median(times["numpy"]))
+    numpy_out = numpy_out[0]
     pixels = size[0] * size[1]
     return {
         "water_n": n,
@@ -823,8 +812,9 @@ def run(quick: bool, device: str) -> dict:
         "wavelengths": WAVELENGTHS,
         "warp_repeats": warp_repeats,
         "numpy_repeats": numpy_repeats,
-        "timing": "median wall time after a warm-up frame, device synchronised; beams and tile lists built "
-        "by Warp once and shared with numpy",
+        "timing": "median wall time after a warm-up frame, device synchronised; the gather and volume "
+        "passes time Warp and numpy in turn, round by round (benchmarks.run.interleaved_times); beams and "
+        "tile lists built by Warp once and shared with numpy",
         "surface_gather": gather,
         "volume_scan_planes": volume,
         "stage_vs_beams": by_n,

@@ -94,34 +94,43 @@ def _call(module, func_name, args):
     return getattr(importlib.import_module(f"benchmarks.{module}"), func_name)(*args)
 
 
+def interleaved_times(sides: dict, rounds: int, device: str | None = None) -> dict[str, list[float]]:
+    """Wall time [s] per call of each side, timed in turn: ``sides`` maps a name to (func, calls);
+    every round times each side once (``calls`` calls, averaged), in an order rotated round by
+    round, so all sides see the same machine (a shared or virtual machine's speed drifts over
+    seconds, and timing one side after the other moved ratios by up to 2x here). With ``device``,
+    each timing ends by synchronising it. Returns the ``rounds`` times of each side."""
+    import warp as wp
+
+    def timed(func, calls: int) -> float:
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            func()
+        if device is not None:
+            wp.synchronize_device(device)
+        return (time.perf_counter() - t0) / calls
+
+    names = list(sides)
+    times: dict[str, list[float]] = {name: [] for name in names}
+    for r in range(rounds):
+        for name in names[r % len(names):] + names[:r % len(names)]:
+            times[name].append(timed(*sides[name]))
+    return times
+
+
 def measure_interleaved(module: str, n: int, device: str, repeats: int) -> dict:
     """One size of step benchmark ``module`` in this process: its Warp step and its numpy twin
     (``warp_stepper`` and ``numpy_stepper`` of benchmarks/<module>.py), each warmed up once, then
-    timed in turn for ``repeats`` rounds, alternating which goes first, so both see the same
-    machine (a shared or virtual machine's speed drifts over seconds, and timing one side after the
-    other moved the ratio by up to 2x here). Medians per step [s], and the module's agreement check."""
+    timed in turn for ``repeats`` rounds (:func:`interleaved_times`). Medians per step [s], and the
+    module's agreement check."""
     import importlib
-
-    import warp as wp
 
     bench = importlib.import_module(f"benchmarks.{module}")
     warp_step, calls = bench.warp_stepper(n, device)
     numpy_step, check = bench.numpy_stepper(n)
-
-    def timed(step, count: int) -> float:
-        t0 = time.perf_counter()
-        for _ in range(count):
-            step()
-        wp.synchronize_device(device)
-        return (time.perf_counter() - t0) / count
-
-    timed(warp_step, 1)  # warm-up: module loads and first launches excluded
-    timed(numpy_step, 1)
-    times: dict[str, list[float]] = {"warp": [], "numpy": []}
-    sides = [("warp", warp_step, calls), ("numpy", numpy_step, 1)]
-    for r in range(repeats):
-        for side, step, count in sides if r % 2 == 0 else sides[::-1]:
-            times[side].append(timed(step, count))
+    # Warm-up (module loads and first launches excluded), then the rounds.
+    interleaved_times({"warp": (warp_step, 1), "numpy": (numpy_step, 1)}, 1, device)
+    times = interleaved_times({"warp": (warp_step, calls), "numpy": (numpy_step, 1)}, repeats, device)
     return {"warp_step_s": float(np.median(times["warp"])), "numpy_step_s": float(np.median(times["numpy"])),
             **check()}
 
