@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import warp as wp
@@ -10,6 +12,16 @@ wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
 wp.init()
 
 _CUDA = wp.get_cuda_device_count() > 0
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _run_from_the_repository_root():
+    """Tests and the benchmarks they import open ``configs/…`` by relative path: run the session
+    from the repository root, wherever pytest was started (a test may still chdir elsewhere)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(ROOT)
+        yield
 
 
 @pytest.fixture(params=["cpu", "cuda:0"])
