@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import device_record, interleaved_times, median_time, point_sun_scene
+from benchmarks.run import calls_per_round, device_record, interleaved_times, median_time, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -51,12 +51,6 @@ QUICK = {
 WAVELENGTHS = "rgb"
 MIN_AREA_FRACTION = 1.0e-6  # as kernels/beams.py
 MAX_CHORD_PIECES = 16
-
-
-def _warp_calls(warp_repeats: int, numpy_repeats: int) -> int:
-    """Warp calls per round of :func:`benchmarks.run.interleaved_times`, so the Warp side is timed
-    about ``warp_repeats`` times over the ``numpy_repeats`` rounds the slow numpy twin sets."""
-    return max(1, round(warp_repeats / numpy_repeats))
 
 
 def _beam_arrays(stage) -> dict:
@@ -438,7 +432,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
     def numpy_run():
         numpy_out[:] = [numpy_points(beams, tiles, grid, points, normals, stage.extent_m, stage.periodic)]
 
-    times = interleaved_times({"warp": (warp_run, _warp_calls(warp_repeats, numpy_repeats)),
+    times = interleaved_times({"warp": (warp_run, calls_per_round(warp_repeats, numpy_repeats)),
                                "numpy": (numpy_run, 1)}, numpy_repeats, device)
     warp_s, numpy_s = (float(np.median(times[side])) for side in ("warp", "numpy"))
     numpy_out = numpy_out[0]
@@ -634,7 +628,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
 
     # The shafts alone: render_beams also gathers the G-buffer points and shades, so each round
     # times it with and without the shafts and takes the difference.
-    calls = _warp_calls(warp_repeats, numpy_repeats)
+    calls = calls_per_round(warp_repeats, numpy_repeats)
     times = interleaved_times({"with shafts": (lambda: camera.render_beams(stage, True), calls),
                                "without": (lambda: camera.render_beams(stage, False), calls),
                                "numpy": (numpy_run, 1)}, numpy_repeats, device)

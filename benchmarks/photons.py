@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import calls_per_round, device_record, interleaved_times, point_sun_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -333,10 +333,13 @@ def run(quick: bool, device: str) -> dict:
     for intersection in ("exact", "newton"):
         case = PhotonCase(n, s, m, intersection, device)
         warp_map = case.run_warp()  # warm-up: JIT compile, first launch
-        warp_s = median_time(case.run_warp, warp_repeats)
         inputs = case.numpy_inputs()
         numpy_map = numpy_photons(**inputs)
-        numpy_s = median_time(lambda inputs=inputs: numpy_photons(**inputs), numpy_repeats)
+        # Timed in turn, round by round, so both sides see the same machine.
+        times = interleaved_times({"warp": (case.run_warp, calls_per_round(warp_repeats, numpy_repeats)),
+                                   "numpy": (lambda inputs=inputs: numpy_photons(**inputs), 1)},
+                                  numpy_repeats, device)
+        warp_s, numpy_s = (float(np.median(times[side])) for side in ("warp", "numpy"))
         count = case.photon_count
         stats = vars(case.renderer.photons.stats())
         row = {"photons": count, "photon_stats": stats, "warp_s": warp_s, "numpy_s": numpy_s,

@@ -118,6 +118,12 @@ def interleaved_times(sides: dict, rounds: int, device: str | None = None) -> di
     return times
 
 
+def calls_per_round(warp_repeats: int, numpy_repeats: int) -> int:
+    """Warp calls per round of :func:`interleaved_times`, so that the Warp side is timed about
+    ``warp_repeats`` times over the ``numpy_repeats`` rounds a slow numpy twin sets."""
+    return max(1, round(warp_repeats / numpy_repeats))
+
+
 def measure_interleaved(module: str, n: int, device: str, repeats: int) -> dict:
     """One size of step benchmark ``module`` in this process: its Warp step and its numpy twin
     (``warp_stepper`` and ``numpy_stepper`` of benchmarks/<module>.py), each warmed up once, then
