@@ -40,8 +40,10 @@ def numpy_step(h, u, v, depth, dt, cell, nu):
     jy, ix = np.meshgrid(np.arange(n + 1), np.arange(n), indexing="ij")
     v_adv = _sample(v, ix - _sample(u, ix + 0.5, jy - 0.5) * k, jy - v * k)
     eta = h - depth
-    gravity_k = np.float32(np.float32(G * dt) / cell)  # as the kernels: g dt/Δ and ν dt/Δ² in float32
-    viscous_k = np.float32(np.float32(nu * dt) / np.float32(cell * cell))
+    # g dt/Δ and ν dt/Δ² formed in float32 in the kernels' order
+    dt32, cell32 = np.float32(dt), np.float32(cell)
+    gravity_k = np.float32(G) * dt32 / cell32
+    viscous_k = np.float32(nu) * dt32 / (cell32 * cell32)
     u_new = np.zeros_like(u)
     v_new = np.zeros_like(v)
     wet_x = (h[:, :-1] > 0) & (h[:, 1:] > 0)

@@ -18,7 +18,8 @@ two-dimensional one made the same loop 1.6× slower, for reasons the assembly di
 accelerate_u ran 2.9×, accelerate_v 2.6× and update_depth 2.3× faster at 512² on a 2-core Xeon
 (same process, interleaved) than with ``range`` loops, a two-dimensional launch and clamps and
 tests in the loop. That is leaner scalar code, not SIMD: compiled with vectorisation off they run
-as fast. The advection's bilinear sample reads where the velocity points; it stays as it was.
+as fast. The advection's bilinear sample reads where the velocity points; its arithmetic stays as it was
+(the loop and launch alone made it about 1.1× faster).
 """
 
 import warp as wp
@@ -96,7 +97,9 @@ def advect_v(u: wp.array2d[wp.float32], v: wp.array2d[wp.float32], dt_over_cell:
 
 @wp.func
 def accelerated(c: float, rise: float, lap: float, wet: bool, gravity_k: float, viscous_k: float) -> float:
-    """A face's velocity after gravity and viscosity: c − g dt/Δ · Δη + ν dt/Δ² · ∇²c, or rest if dry."""
+    """A face's velocity after gravity and viscosity: c − g dt/Δ · Δη + ν dt/Δ² · ∇²c, or rest if dry
+    (a face counts as wet unless a neighbouring depth is ≤ 0, so a NaN depth stays NaN and the CFL
+    check sees it)."""
     return wp.where(wet, c - gravity_k * rise + viscous_k * lap, 0.0)
 
 
@@ -126,7 +129,7 @@ def accelerate_u(u_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
         c = u_adv[iy, jx]
         lap = u_adv[iy, jx - 1] + u_adv[iy, jx + 1] + u_adv[up, jx] + u_adv[down, jx] - 4.0 * c
         rise = (h_e - floor_depth[iy, jx]) - (h_w - floor_depth[iy, jx - 1])
-        u[iy, jx] = accelerated(c, rise, lap, h_w > 0.0 and h_e > 0.0, gravity_k, viscous_k)
+        u[iy, jx] = accelerated(c, rise, lap, not (h_w <= 0.0 or h_e <= 0.0), gravity_k, viscous_k)
         jx += 1
 
 
@@ -141,7 +144,7 @@ def accelerated_v(v_adv: wp.array2d[wp.float32], h: wp.array2d[wp.float32],
     c = v_adv[jy, ix]
     lap = v_adv[jy, west] + v_adv[jy, east] + v_adv[jy - 1, ix] + v_adv[jy + 1, ix] - 4.0 * c
     rise = (h_n - floor_depth[jy, ix]) - (h_s - floor_depth[jy - 1, ix])
-    return accelerated(c, rise, lap, h_s > 0.0 and h_n > 0.0, gravity_k, viscous_k)
+    return accelerated(c, rise, lap, not (h_s <= 0.0 or h_n <= 0.0), gravity_k, viscous_k)
 
 
 @wp.kernel
@@ -247,10 +250,14 @@ def add_bump(eta: wp.array2d[wp.float32], extent_m: float, x_m: float, y_m: floa
 @wp.kernel
 def wave_speed(h: wp.array2d[wp.float32], u: wp.array2d[wp.float32], v: wp.array2d[wp.float32],
                speed: wp.array[wp.float32]):
-    """speed[0] = max over cells of |u| + |v| + √(g h) (atomic max; initialise to 0)."""
+    """speed[0] = max over cells of |u| + |v| + √(g h) (atomic max; initialise to 0); infinite where
+    a depth or velocity is not finite, which max() would otherwise pass over (a blow-up)."""
     iy, ix = wp.tid()
     vel = wp.max(wp.abs(u[iy, ix]), wp.abs(u[iy, ix + 1])) + wp.max(wp.abs(v[iy, ix]), wp.abs(v[iy + 1, ix]))
-    wp.atomic_max(speed, 0, vel + wp.sqrt(GRAVITY * wp.max(h[iy, ix], 0.0)))
+    cell_speed = vel + wp.sqrt(GRAVITY * wp.max(h[iy, ix], 0.0))
+    if not wp.isfinite(h[iy, ix] + u[iy, ix] + u[iy, ix + 1] + v[iy, ix] + v[iy + 1, ix]):
+        cell_speed = wp.inf
+    wp.atomic_max(speed, 0, cell_speed)
 
 
 @wp.kernel

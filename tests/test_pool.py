@@ -55,6 +55,25 @@ def test_big_drop_stays_finite(device):
     assert np.all(np.isfinite(surface.normals.numpy()))
 
 
+def test_a_blown_up_pool_is_reported_not_carried_on(device):
+    """A NaN in the state (what an unstable step leaves) makes the CFL speed infinite, so the next
+    advance stops with a one-line error instead of stepping on: max() alone passes NaN over."""
+    pool = ShallowWaterPool(16, 4.0, DEPTH_M, device)
+    pool.advance(0.05)
+    h = pool.h.numpy().copy()
+    h[5, 7] = np.nan
+    pool.h.assign(h)
+    assert not np.isfinite(pool.max_wave_speed())
+    with pytest.raises(wc.WarpcausticsError, match="the pool became unstable at t = 0.05 s"):
+        pool.advance(0.1)
+
+
+def test_a_pool_needs_two_cells_a_side():
+    """One cell has no faces between walls to step; the error names the config key."""
+    with pytest.raises(wc.WarpcausticsError, match="raise water.resolution"):
+        ShallowWaterPool(1, 4.0, DEPTH_M, "cpu")
+
+
 def test_pool_is_stateful_and_renders(device):
     """Frames step forward from the previous state; going back in time is refused; a still pool
     under an overhead sun lights its floor with E·T(0)·exp(−cD) away from the walls."""
@@ -267,21 +286,23 @@ def test_pool_refuses_a_floor_that_reaches_the_water():
 
 def test_cells_per_thread_do_not_change_the_substep(device):
     """The substep's kernels take a run of cells per thread (a whole row on the CPU, one cell on the
-    GPU): the same pool stepped with one cell per thread, with runs of 6 (which start and end
-    inside rows; u's last run holds just the east wall), and with whole rows is the same, bit for
-    bit, after drops and 50 substeps."""
+    GPU): the same pool stepped with one cell per thread, with runs that start and end inside rows
+    (3, 5, 6, 47: among them runs holding just the east wall face, and just the last cell of an h
+    or v row), and with whole rows is the same, bit for bit, after drops and 50 substeps; on the
+    smallest pool the config allows (4²) and on 48²."""
     drops = (DropConfig(time_s=0.0, x_m=0.3, y_m=-0.2, radius_m=0.2, height_m=0.3),)
-    spans = (1, 6, 49)
-    pools = [ShallowWaterPool(48, 4.0, 1.5, device, drops=drops) for _ in spans]
-    for pool, span in zip(pools, spans):
-        pool._span = span
-        pool.advance(0.02)
-        for _ in range(50):
-            pool.step(0.004)
-    for pool in pools[1:]:
-        for name in ("h", "u", "v"):
-            np.testing.assert_array_equal(getattr(pools[0], name).numpy(), getattr(pool, name).numpy())
-    assert np.abs(pools[0].h.numpy() - 1.5).max() > 1e-3  # the water moved
+    for n in (4, 48):
+        spans = (1, 3, 5, 6, 47, n + 1)
+        pools = [ShallowWaterPool(n, 4.0, 1.5, device, drops=drops) for _ in spans]
+        for pool, span in zip(pools, spans):
+            pool._span = span
+            pool.advance(0.02)
+            for _ in range(50):
+                pool.step(0.004)
+        for pool in pools[1:]:
+            for name in ("h", "u", "v"):
+                np.testing.assert_array_equal(getattr(pools[0], name).numpy(), getattr(pool, name).numpy())
+        assert np.abs(pools[0].h.numpy() - 1.5).max() > 1e-3  # the water moved
 
 
 def test_substep_is_the_numpy_baseline_scheme():

@@ -116,6 +116,9 @@ class ShallowWaterPool(WalledPool):
     def __init__(self, n: int, extent_m: float, floor_depth_m: np.ndarray | float, device: str, *,
                  viscosity_m2_s: float = 1e-4, cfl: float = 0.4, drops: tuple[DropConfig, ...] = (),
                  body: BodyConfig | None = None):
+        if n < 2:
+            raise WarpcausticsError(f"a shallow-water pool needs at least 2×2 cells (got n = {n}); "
+                                    "raise water.resolution")
         self.device = device
         self.extent_m = float(extent_m)
         self.cell_m = self.extent_m / n
@@ -184,7 +187,7 @@ class ShallowWaterPool(WalledPool):
             dev = self.device
             span = self._span
 
-            def rows(rows: int, cols: int) -> int:  # rows × runs of `span` cells per row, one thread each
+            def threads(rows: int, cols: int) -> int:  # rows × runs of `span` cells per row, one thread each
                 return rows * -(-cols // span)
 
             def record(kernel, dim, inputs, outputs):
@@ -192,12 +195,12 @@ class ShallowWaterPool(WalledPool):
 
             args = [self.h, self.floor_depth, 0.0, self.cell_m, self.viscosity, span]
             forces = [
-                record(pool_kernels.advect_u, rows(n, n + 1), [self.u, self.v, 0.0, span], [self._u_adv]),
-                record(pool_kernels.advect_v, rows(n + 1, n), [self.u, self.v, 0.0, span], [self._v_adv]),
-                record(pool_kernels.accelerate_u, rows(n, n + 1), [self._u_adv, *args], [self.u]),
-                record(pool_kernels.accelerate_v, rows(n + 1, n), [self._v_adv, *args], [self.v]),
+                record(pool_kernels.advect_u, threads(n, n + 1), [self.u, self.v, 0.0, span], [self._u_adv]),
+                record(pool_kernels.advect_v, threads(n + 1, n), [self.u, self.v, 0.0, span], [self._v_adv]),
+                record(pool_kernels.accelerate_u, threads(n, n + 1), [self._u_adv, *args], [self.u]),
+                record(pool_kernels.accelerate_v, threads(n + 1, n), [self._v_adv, *args], [self.v]),
             ]
-            depth = record(pool_kernels.update_depth, rows(n, n), [self.h, self.u, self.v, 0.0, span],
+            depth = record(pool_kernels.update_depth, threads(n, n), [self.h, self.u, self.v, 0.0, span],
                            [self._h_next])
             self._launches[key] = (forces, depth)
         return self._launches[key]
