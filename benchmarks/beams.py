@@ -805,10 +805,12 @@ def run(quick: bool, device: str) -> dict:
         **record,
         "wavelengths": WAVELENGTHS,
         "warp_repeats": warp_repeats,
-        "numpy_repeats": numpy_repeats,
+        "interleaved_rounds": numpy_repeats,
+        "warp_calls_per_round": calls_per_round(warp_repeats, numpy_repeats),
         "timing": "median wall time after a warm-up frame, device synchronised; the gather and volume "
-        "passes time Warp and numpy in turn, round by round (benchmarks.run.interleaved_times); beams and "
-        "tile lists built by Warp once and shared with numpy",
+        "passes time Warp and numpy in turn, interleaved_rounds rounds of warp_calls_per_round Warp calls "
+        "(averaged) and one numpy call (benchmarks.run.interleaved_times); the stage and adaptive rows "
+        "take the median of warp_repeats; beams and tile lists built by Warp once and shared with numpy",
         "surface_gather": gather,
         "volume_scan_planes": volume,
         "stage_vs_beams": by_n,

@@ -363,9 +363,10 @@ def run(quick: bool, device: str) -> dict:
               f"{row['relative_flux_diff_numpy_vs_warp']:.1e})",
               flush=True)
     return {"benchmark": "photon_splatting", "water_n": n, "photon_subdivisions": s, "map_m": m,
-            "wavelengths": WAVELENGTHS, **record, "warp_repeats": warp_repeats,
-            "numpy_repeats": numpy_repeats,
+            "wavelengths": WAVELENGTHS, **record, "rounds": numpy_repeats,
+            "warp_calls_per_round": calls_per_round(warp_repeats, numpy_repeats),
             "timing": "median wall time of PhotonCaustics.run after one warm-up call, device synchronised; "
+                      "Warp and numpy timed in turn, round by round (benchmarks.run.interleaved_times); "
                       "light view (newton) built once per scene, outside the timing, on both sides",
             "numpy_exact_is": "analytic ray/plane intersection (numpy has no BVH; Warp queries its BVH)",
             "cases": cases, "camera_frames": _camera_frames(quick, device)}

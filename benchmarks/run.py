@@ -96,10 +96,11 @@ def _call(module, func_name, args):
 
 def interleaved_times(sides: dict, rounds: int, device: str | None = None) -> dict[str, list[float]]:
     """Wall time [s] per call of each side, timed in turn: ``sides`` maps a name to (func, calls);
-    every round times each side once (``calls`` calls, averaged), in an order rotated round by
-    round, so all sides see the same machine (a shared or virtual machine's speed drifts over
-    seconds, and timing one side after the other moved ratios by up to 2x here). With ``device``,
-    each timing ends by synchronising it. Returns the ``rounds`` times of each side."""
+    every round times each side once (``calls`` calls, averaged), in the given order and in the
+    reverse order by turns, so all sides see the same machine (a shared or virtual machine's speed
+    drifts over seconds, and timing one side after the other moved ratios by up to 2x here) and
+    sides given next to each other stay next to each other. With ``device``, each timing ends by
+    synchronising it. Returns the ``rounds`` times of each side."""
     import warp as wp
 
     def timed(func, calls: int) -> float:
@@ -113,7 +114,7 @@ def interleaved_times(sides: dict, rounds: int, device: str | None = None) -> di
     names = list(sides)
     times: dict[str, list[float]] = {name: [] for name in names}
     for r in range(rounds):
-        for name in names[r % len(names):] + names[:r % len(names)]:
+        for name in names if r % 2 == 0 else names[::-1]:
             times[name].append(timed(*sides[name]))
     return times
 
@@ -300,7 +301,8 @@ def main(argv: list[str] | None = None) -> int:
                     "python": platform.python_version()},
         "versions": {d: metadata.version(d) for d in ("warp-lang", "numpy")},
         "repeats": repeats,
-        "timing": "median wall time; Warp after one warm-up frame, device synchronised",
+        "timing": "median wall time; Warp after one warm-up frame, device synchronised; the step, photon "
+                  "and beam benchmarks time Warp and numpy in turn, round by round (interleaved_times)",
         "results": rows,
         "steps": steps,
         "bins": bins_rows,
