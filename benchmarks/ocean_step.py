@@ -52,12 +52,13 @@ def numpy_step(h0, h0m, omega, k, choppiness, extent_m, t):
     return positions, normals, jxx * jyy - jxy * jxy
 
 
-def numpy_stepper(n: int):
-    """One numpy step from the same initial spectrum, each call at a later time, and the check of
-    its agreement with the kernels: the largest vertex position difference at t = 0.5 s [m]."""
+def numpy_stepper(n: int, device: str):
+    """One numpy step from the same initial spectrum (drawn on ``device``), each call at a later
+    time, and the check of its agreement with the kernels there: the largest vertex position
+    difference at t = 0.5 s [m]."""
     from warpcaustics.water import from_vec2
 
-    ocean = _ocean(n, "cpu")
+    ocean = _ocean(n, device)
     h0, h0m = from_vec2(ocean.h0), from_vec2(ocean.h0_minus_conj)
     omega = ocean.omega.numpy().astype(np.float64)
     k = ocean.k_axis.numpy().astype(np.float64)

@@ -84,10 +84,11 @@ def warp_stepper(n: int, device: str):
     return (lambda: pool.step(dt)), max(1, 4096 // n)
 
 
-def numpy_stepper(n: int):
-    """One numpy substep from the same sloshing state, and the check of its agreement with the
-    kernels: the largest depth difference after one substep [m]."""
-    pool = _pool(n, "cpu")
+def numpy_stepper(n: int, device: str):
+    """One numpy substep from the same sloshing state (made by the kernels on ``device``: on a GPU
+    that spares making it again on the CPU), and the check of its agreement with the kernels there:
+    the largest depth difference after one substep [m]."""
+    pool = _pool(n, device)
     dt = _dt(pool)
     # .copy(): on the CPU device .numpy() is a view of the arrays the step overwrites.
     h, u, v = pool.h.numpy().copy(), pool.u.numpy().copy(), pool.v.numpy().copy()

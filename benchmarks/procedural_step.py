@@ -51,10 +51,10 @@ def warp_stepper(n: int, device: str):
     return (lambda: water.at(TIME_S)), max(1, 8192 // n)
 
 
-def numpy_stepper(n: int):
-    """One numpy evaluation, and the check of its agreement with the kernel: the largest height
-    difference [m]."""
-    water, extent = _water(n, "cpu")
+def numpy_stepper(n: int, device: str):
+    """One numpy evaluation, and the check of its agreement with the kernel on ``device``: the
+    largest height difference [m]."""
+    water, extent = _water(n, device)
 
     def step():
         return numpy_surface(n, extent, water.waves)

@@ -134,7 +134,7 @@ def measure_interleaved(module: str, n: int, device: str, repeats: int) -> dict:
 
     bench = importlib.import_module(f"benchmarks.{module}")
     warp_step, calls = bench.warp_stepper(n, device)
-    numpy_step, check = bench.numpy_stepper(n)
+    numpy_step, check = bench.numpy_stepper(n, device)
     # Warm-up (module loads and first launches excluded), then the rounds.
     interleaved_times({"warp": (warp_step, 1), "numpy": (numpy_step, 1)}, 1, device)
     times = interleaved_times({"warp": (warp_step, calls), "numpy": (numpy_step, 1)}, repeats, device)
