@@ -21,7 +21,7 @@ def _sample(field, fx, fy):
     y = np.clip(fy, 0.0, rows - 1)
     i0 = np.minimum(x.astype(np.int64), cols - 2)
     j0 = np.minimum(y.astype(np.int64), rows - 2)
-    tx, ty = x - i0, y - j0
+    tx, ty = x - i0.astype(np.float32), y - j0.astype(np.float32)
     return ((1 - ty) * ((1 - tx) * field[j0, i0] + tx * field[j0, i0 + 1])
             + ty * ((1 - tx) * field[j0 + 1, i0] + tx * field[j0 + 1, i0 + 1]))
 
@@ -32,12 +32,14 @@ def _laplacian(f):
 
 
 def numpy_step(h, u, v, depth, dt, cell, nu):
-    """The pool substep in numpy (float32 like the kernels); returns new (h, u, v)."""
+    """The pool substep in numpy, float32 throughout and in the kernels' order of operations;
+    returns new (h, u, v)."""
     n = h.shape[0]
-    k = dt / cell
-    iy, jx = np.meshgrid(np.arange(n), np.arange(n + 1), indexing="ij")
+    k = np.float32(dt / cell)
+    index = np.arange(n + 1, dtype=np.float32)
+    iy, jx = np.meshgrid(index[:n], index, indexing="ij")
     u_adv = _sample(u, jx - u * k, iy - _sample(v, jx - 0.5, iy + 0.5) * k)
-    jy, ix = np.meshgrid(np.arange(n + 1), np.arange(n), indexing="ij")
+    jy, ix = np.meshgrid(index, index[:n], indexing="ij")
     v_adv = _sample(v, ix - _sample(u, ix + 0.5, jy - 0.5) * k, jy - v * k)
     eta = h - depth
     # g dt/Δ and ν dt/Δ² formed in float32 in the kernels' order
@@ -56,7 +58,7 @@ def numpy_step(h, u, v, depth, dt, cell, nu):
     fy = np.where(v_new[1:-1] > 0, v_new[1:-1] * h[:-1], v_new[1:-1] * h[1:])
     flux_x = np.pad(fx, ((0, 0), (1, 1)))
     flux_y = np.pad(fy, ((1, 1), (0, 0)))
-    h_new = h - k * (np.diff(flux_x, axis=1) + np.diff(flux_y, axis=0))
+    h_new = h - k * ((np.diff(flux_x, axis=1) + flux_y[1:]) - flux_y[:-1])
     return h_new.astype(np.float32), u_new.astype(np.float32), v_new.astype(np.float32)
 
 

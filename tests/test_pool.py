@@ -306,19 +306,17 @@ def test_cells_per_thread_do_not_change_the_substep(device):
 
 
 def test_substep_is_the_numpy_baseline_scheme():
-    """The benchmark's numpy substep (benchmarks/pool_step.py, vectorised float32) and the kernels do
-    the same scheme: from a sloshing state one substep gives the same depths to 2 float32 ulps at
-    1.5 m and the same velocities to 1e-5 of their largest (measured 1.2e-7 m and 1.2e-6). A
-    cross-velocity averaged over two faces instead of four is off by 7e-5 of the largest."""
+    """The benchmark's numpy substep (benchmarks/pool_step.py: vectorised, float32 throughout, in the
+    kernels' order of operations) and the kernels do the same scheme: from a sloshing state, one
+    substep gives the same depths and velocities to the bit, at 64² and at 96²."""
     from benchmarks.pool_step import _dt, _pool, numpy_step
 
-    pool = _pool(64, "cpu")
-    dt = _dt(pool)
-    h, u, v = (a.numpy().copy() for a in (pool.h, pool.u, pool.v))
-    h1, u1, v1 = numpy_step(h, u, v, pool.floor_depth.numpy(), dt, pool.cell_m, pool.viscosity)
-    pool.step(dt)
-    assert np.abs(pool.h.numpy() - h1).max() <= 2.4e-7
-    scale = max(np.abs(u1).max(), np.abs(v1).max())
-    assert scale > 1e-3  # the water moves
-    assert np.abs(pool.u.numpy() - u1).max() <= 1e-5 * scale
-    assert np.abs(pool.v.numpy() - v1).max() <= 1e-5 * scale
+    for n in (64, 96):
+        pool = _pool(n, "cpu")
+        dt = _dt(pool)
+        h, u, v = (a.numpy().copy() for a in (pool.h, pool.u, pool.v))
+        h1, u1, v1 = numpy_step(h, u, v, pool.floor_depth.numpy(), dt, pool.cell_m, pool.viscosity)
+        pool.step(dt)
+        assert max(np.abs(u1).max(), np.abs(v1).max()) > 1e-3  # the water moves
+        for name, ref in (("h", h1), ("u", u1), ("v", v1)):
+            np.testing.assert_array_equal(getattr(pool, name).numpy(), ref, err_msg=f"{name} at {n}²")
