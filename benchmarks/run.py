@@ -63,16 +63,7 @@ def device_record(device: str) -> dict:
 def median_time(func, repeats: int, device: str | None = None) -> float:
     """Median wall time [s] of ``repeats`` calls of ``func``; with ``device``, each call ends by
     synchronising it (Warp launches are asynchronous on CUDA)."""
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        func()
-        if device is not None:
-            import warp as wp
-
-            wp.synchronize_device(device)
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+    return float(np.median(interleaved_times({"func": (func, 1)}, repeats, device)["func"]))
 
 
 def _in_child(func_name: str, *args, module: str = "frame"):
@@ -101,13 +92,13 @@ def interleaved_times(sides: dict, rounds: int, device: str | None = None) -> di
     drifts over seconds, and timing one side after the other moved ratios by up to 2x here) and
     sides given next to each other stay next to each other. With ``device``, each timing ends by
     synchronising it. Returns the ``rounds`` times of each side."""
-    import warp as wp
-
     def timed(func, calls: int) -> float:
         t0 = time.perf_counter()
         for _ in range(calls):
             func()
         if device is not None:
+            import warp as wp
+
             wp.synchronize_device(device)
         return (time.perf_counter() - t0) / calls
 

@@ -1579,6 +1579,15 @@ def slab_span(a: float, c: float, lo: float, hi: float, x0: int, x1: int):
     return wp.max(i0, x0), wp.min(i1, x1)
 
 
+@wp.func
+def row_span(axis: wp.vec2, lo: wp.vec2, hi: wp.vec2, yc: float, x0: int, x1: int):
+    """Pixels [c0, c1) of [x0, x1) in the row of pixel centres at height yc that may be in the
+    oriented box [lo, hi] (frame (axis, perp(axis))): the run inside both of the box's slabs, as
+    in_frame(centre, axis) is (x a0 + y a1, −x a1 + y a0) for axis (a0, a1)."""
+    a0, a1 = slab_span(axis[0], yc * axis[1], lo[0] - 1.0e-3, hi[0] + 1.0e-3, x0, x1)
+    return slab_span(-axis[1], yc * axis[0], lo[1] - 1.0e-3, hi[1] + 1.0e-3, a0, a1)
+
+
 @wp.kernel
 def scan_plane_radiance_tiles(
     grid: TileGrid,
@@ -1625,10 +1634,7 @@ def scan_plane_radiance_tiles(
         b, shift, corners = copy_corners(sb, bc)
         for j in range(r0, r1):
             yc = float(j) + 0.5
-            # The pixels whose centres can be in the box: in_frame(centre, axis) is
-            # (x a0 + y a1, −x a1 + y a0) for axis (a0, a1).
-            a0, a1 = slab_span(axis[0], yc * axis[1], lo[0] - 1.0e-3, hi[0] + 1.0e-3, x0, x1)
-            c0, c1 = slab_span(-axis[1], yc * axis[0], lo[1] - 1.0e-3, hi[1] + 1.0e-3, a0, a1)
+            c0, c1 = row_span(axis, lo, hi, yc, x0, x1)
             for i in range(c0, c1):
                 if outside_box(in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
                     continue

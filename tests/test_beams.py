@@ -335,8 +335,7 @@ def _tile_misses(
         c0 = int(0)  # noqa: UP018 (a dynamic Warp local, not a constant)
         c1 = int(0)  # noqa: UP018
         if j >= r0 and j < r1:
-            a0, a1 = beam_kernels.slab_span(axis[0], yc * axis[1], lo[0] - 1.0e-3, hi[0] + 1.0e-3, x0, x1)
-            c0, c1 = beam_kernels.slab_span(-axis[1], yc * axis[0], lo[1] - 1.0e-3, hi[1] + 1.0e-3, a0, a1)
+            c0, c1 = beam_kernels.row_span(axis, lo, hi, yc, x0, x1)
         for i in range(x0, x1):
             if not beam_kernels.outside_box(beam_kernels.in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
                 wp.atomic_add(inside, n, 1)
