@@ -11,7 +11,7 @@ from warpcaustics.kernels import heightfield as hf_kernels
 @pytest.mark.parametrize("n", [64, 256])
 @pytest.mark.parametrize("direction", ["forward", "inverse"])
 def test_warp_fft_matches_numpy(device, n, direction, rng):
-    """2-D Warp FFT (wp.tile_fft rows + transposes) equals numpy.fft, ‖Δ‖/‖ref‖ ≤ 1e-4."""
+    """2-D Warp FFT (wp.tile_fft rows, then columns) equals numpy.fft, ‖Δ‖/‖ref‖ ≤ 1e-4."""
     x = rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))
     data = water.to_vec2(x, device)
     if direction == "forward":
@@ -128,6 +128,44 @@ def test_ocean_matches_its_fourier_series(device):
     expected_n = np.stack([-hx.real, -hy.real, np.ones_like(h.real)], axis=-1)
     expected_n /= np.linalg.norm(expected_n, axis=-1, keepdims=True)
     np.testing.assert_allclose(nrm, expected_n, atol=1e-5)
+
+
+def test_negligible_amplitudes_become_zero_not_subnormal(device):
+    """``ocean.toml`` at 512²: its h̃0 in float32 would hold subnormal numbers (slow on x86 CPUs);
+    the ocean's has none, and its heights and slopes still equal a float64 numpy.fft synthesis of
+    the whole, unzeroed spectrum to float32 accuracy."""
+    import warpcaustics as wc
+
+    n = 512
+    cfg = wc.load_scene("configs/ocean.toml", {"water.resolution": n}).config
+    k = water.wavenumbers(n, cfg.water.extent_m)
+    kx, ky = np.meshgrid(k, k)
+    h0 = water.initial_spectrum(water.ocean_spectrum(cfg, kx, ky), cfg.water.extent_m, seed=cfg.water.seed)
+    tiny = np.finfo(np.float32).tiny
+
+    def subnormal(a):
+        return np.count_nonzero((np.abs(a) < tiny) & (a != 0))
+
+    assert subnormal(h0.astype(np.complex64).view(np.float32)) > 0.01 * n * n  # what is avoided
+    ocean = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device)
+    for arr in (ocean.h0, ocean.h0_minus_conj):
+        assert subnormal(arr.numpy()) == 0
+    t = 1.7
+    surface = ocean.at(t)
+    # float64 synthesis of the raw spectrum (h̃0 travels along +k: Tessendorf eq. 26, t → −t)
+    neg = (-np.arange(n)) % n
+    omega = water.dispersion(np.hypot(kx, ky), cfg.floor.depth_m)
+    x0 = -0.5 * cfg.water.extent_m + 0.5 * cfg.water.extent_m / n
+    ht = (h0 * np.exp(-1j * omega * t) + np.conj(h0[neg][:, neg]) * np.exp(1j * omega * t)) \
+        * np.exp(1j * (kx + ky) * x0)
+    h = np.fft.ifft2(ht).real * n * n
+    hx = np.fft.ifft2(1j * kx * ht).real * n * n
+    hy = np.fft.ifft2(1j * ky * ht).real * n * n
+    heights = surface.positions.numpy()[..., 2].astype(np.float64)
+    assert np.abs(heights - h).max() <= 1e-5 * np.abs(h).max()
+    expected = np.stack([-hx, -hy, np.ones_like(h)], -1)
+    expected /= np.linalg.norm(expected, axis=-1, keepdims=True)
+    np.testing.assert_allclose(surface.normals.numpy(), expected, atol=1e-5)
 
 
 def test_heightfield_normals_and_bilinear_sampling(device, rng):
