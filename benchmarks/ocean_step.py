@@ -30,7 +30,9 @@ def warp_stepper(n: int, device: str):
 
 
 def numpy_step(h0, h0m, omega, k, choppiness, extent_m, t):
-    """The same step in numpy (complex128 spectra, numpy.fft.ifft2)."""
+    """The same step in numpy, in single precision like the kernels: complex64 spectra and
+    numpy.fft.ifft2, which transforms complex64 in single precision (numpy ≥ 2.0). Inputs must be
+    complex64 / float32; Python scalars keep that precision (NEP 50)."""
     n = len(k)
     kx, ky = np.meshgrid(k, k)
     kk = np.hypot(kx, ky)
@@ -41,7 +43,7 @@ def numpy_step(h0, h0m, omega, k, choppiness, extent_m, t):
     b = f(1j * ky * h + 1j * (1j * kx * inv_k * h))
     c = f(1j * ky * inv_k * h + 1j * (-kx * kx * inv_k * h))
     d = f(-ky * ky * inv_k * h + 1j * (-kx * ky * inv_k * h))
-    x = (np.arange(n) + 0.5) * extent_m / n - extent_m / 2
+    x = (np.arange(n, dtype=np.float32) + 0.5) * (extent_m / n) - extent_m / 2
     xs, ys = np.meshgrid(x, x)
     jxx, jyy, jxy = 1 + choppiness * c.imag, 1 + choppiness * d.real, choppiness * d.imag
     positions = np.stack([xs + choppiness * b.imag, ys + choppiness * c.real, a.real], -1)
@@ -59,9 +61,10 @@ def numpy_stepper(n: int, device: str):
     from warpcaustics.water import from_vec2
 
     ocean = _ocean(n, device)
-    h0, h0m = from_vec2(ocean.h0), from_vec2(ocean.h0_minus_conj)
-    omega = ocean.omega.numpy().astype(np.float64)
-    k = ocean.k_axis.numpy().astype(np.float64)
+    h0 = from_vec2(ocean.h0).astype(np.complex64)
+    h0m = from_vec2(ocean.h0_minus_conj).astype(np.complex64)
+    omega = ocean.omega.numpy()
+    k = ocean.k_axis.numpy()
     clock = itertools.count(1)
 
     def at(t: float):
