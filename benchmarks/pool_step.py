@@ -12,7 +12,8 @@ import sys
 
 import numpy as np
 
-G = 9.81
+from warpcaustics.kernels.pool import GRAVITY as G
+from warpcaustics.kernels.pool import REST_SPEED
 
 
 def _sample(field, fx, fy):
@@ -29,6 +30,11 @@ def _sample(field, fx, fy):
 def _laplacian(f):
     p = np.pad(f, 1, mode="edge")
     return p[1:-1, :-2] + p[1:-1, 2:] + p[:-2, 1:-1] + p[2:, 1:-1] - 4 * f
+
+
+def _at_rest_if_slow(wet, velocity):
+    """kernels/pool.py:accelerated: zero where dry or slower than REST_SPEED (NaN kept)."""
+    return np.where(wet & ~(np.abs(velocity) < np.float32(REST_SPEED)), velocity, np.float32(0))
 
 
 def numpy_step(h, u, v, depth, dt, cell, nu):
@@ -49,11 +55,11 @@ def numpy_step(h, u, v, depth, dt, cell, nu):
     u_new = np.zeros_like(u)
     v_new = np.zeros_like(v)
     wet_x = (h[:, :-1] > 0) & (h[:, 1:] > 0)
-    u_new[:, 1:-1] = np.where(wet_x, u_adv[:, 1:-1] - gravity_k * np.diff(eta, axis=1)
-                              + viscous_k * _laplacian(u_adv)[:, 1:-1], 0)
+    u_new[:, 1:-1] = _at_rest_if_slow(wet_x, u_adv[:, 1:-1] - gravity_k * np.diff(eta, axis=1)
+                                      + viscous_k * _laplacian(u_adv)[:, 1:-1])
     wet_y = (h[:-1] > 0) & (h[1:] > 0)
-    v_new[1:-1] = np.where(wet_y, v_adv[1:-1] - gravity_k * np.diff(eta, axis=0)
-                           + viscous_k * _laplacian(v_adv)[1:-1], 0)
+    v_new[1:-1] = _at_rest_if_slow(wet_y, v_adv[1:-1] - gravity_k * np.diff(eta, axis=0)
+                                   + viscous_k * _laplacian(v_adv)[1:-1])
     fx = np.where(u_new[:, 1:-1] > 0, u_new[:, 1:-1] * h[:, :-1], u_new[:, 1:-1] * h[:, 1:])
     fy = np.where(v_new[1:-1] > 0, v_new[1:-1] * h[:-1], v_new[1:-1] * h[1:])
     flux_x = np.pad(fx, ((0, 0), (1, 1)))
