@@ -12,6 +12,7 @@ import sys
 
 import numpy as np
 
+# the kernels' own constants (importing warp here does not initialise it)
 from warpcaustics.kernels.pool import GRAVITY as G
 from warpcaustics.kernels.pool import REST_SPEED
 

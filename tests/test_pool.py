@@ -352,3 +352,24 @@ def test_slow_faces_rest_instead_of_going_subnormal(monkeypatch):
     np.testing.assert_array_equal(pool.h.numpy(), h)
     assert np.abs(pool.u.numpy() - u).max() < 10 * REST_SPEED
     assert np.abs(pool.v.numpy() - v).max() < 10 * REST_SPEED
+
+
+def test_a_nan_velocity_stays_nan_and_slow_faces_rest(device):
+    """The force kernel keeps a NaN velocity NaN (so the CFL check sees a blow-up), sets a face
+    slower than REST_SPEED to rest, and keeps one just above it."""
+    from warpcaustics.kernels import pool as pool_kernels
+
+    n = 8
+    u_adv = np.zeros((n, n + 1), np.float32)
+    u_adv[1, 2] = np.nan
+    u_adv[5, 3] = 0.5 * pool_kernels.REST_SPEED
+    u_adv[6, 6] = 2.0 * pool_kernels.REST_SPEED
+    flat = wp.array(np.ones((n, n), np.float32), dtype=wp.float32, device=device)
+    out = wp.empty((n, n + 1), dtype=wp.float32, device=device)
+    wp.launch(pool_kernels.accelerate_u, dim=n, device=device,
+              inputs=[wp.array(u_adv, dtype=wp.float32, device=device), flat, flat, 0.01, 0.1, 0.0, n + 1],
+              outputs=[out])
+    u = out.numpy()
+    assert np.isnan(u[1, 2])
+    assert u[5, 3] == 0.0
+    assert u[6, 6] == np.float32(2.0 * pool_kernels.REST_SPEED)

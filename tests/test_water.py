@@ -130,10 +130,11 @@ def test_ocean_matches_its_fourier_series(device):
     np.testing.assert_allclose(nrm, expected_n, atol=1e-5)
 
 
-def test_negligible_amplitudes_become_zero_not_subnormal(device):
+def test_negligible_amplitudes_become_zero_not_subnormal(device, monkeypatch):
     """``ocean.toml`` at 512²: its h̃0 in float32 would hold subnormal numbers (slow on x86 CPUs);
-    the ocean's has none, and its heights and slopes still equal a float64 numpy.fft synthesis of
-    the whole, unzeroed spectrum to float32 accuracy."""
+    the ocean's has none, its heights and slopes still equal a float64 numpy.fft synthesis of the
+    whole, unzeroed spectrum to float32 accuracy, and its choppy surface is the same to the bit as
+    that of an ocean built from the unzeroed spectrum."""
     import warpcaustics as wc
 
     n = 512
@@ -166,6 +167,14 @@ def test_negligible_amplitudes_become_zero_not_subnormal(device):
     expected = np.stack([-hx, -hy, np.ones_like(h)], -1)
     expected /= np.linalg.norm(expected, axis=-1, keepdims=True)
     np.testing.assert_allclose(surface.normals.numpy(), expected, atol=1e-5)
+
+    choppy = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device, choppiness=1.0).at(t)
+    monkeypatch.setattr(water, "negligible_to_zero", lambda h: h)
+    unzeroed = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device, choppiness=1.0)
+    assert subnormal(unzeroed.h0.numpy()) > 0
+    raw = unzeroed.at(t)
+    for name in ("positions", "normals", "jacobian"):
+        np.testing.assert_array_equal(getattr(choppy, name).numpy(), getattr(raw, name).numpy(), err_msg=name)
 
 
 def test_heightfield_normals_and_bilinear_sampling(device, rng):
