@@ -717,9 +717,11 @@ def _adaptive_rows(config: str, overrides: dict, levels: int, device: str, repea
     return rows
 
 
-def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str) -> list[dict]:
-    """Hull / prism fill as the light focuses: ocean_floor.toml over a flat floor at several depths
-    (floor caustic contrast std/mean beside it), the camera aimed at the floor."""
+def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str,
+                   overrides: dict | None = None) -> list[dict]:
+    """Hull / prism fill as the light focuses: ocean_floor.toml (with ``overrides``, e.g. a steeper
+    sea) over a flat floor at several depths (floor caustic contrast std/mean beside it), the camera
+    aimed at the floor."""
     import warpcaustics as wc
 
     rows = []
@@ -729,7 +731,7 @@ def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str) -> list[d
             "floor.depth_m": depth,
             "camera.width": size[0], "camera.height": size[1], "caustics.shafts": False,
             "optics.wavelengths": WAVELENGTHS, "camera.position_m": [0.0, -6.0, -1.0],
-            "camera.look_at_m": [0.0, 0.0, -0.6 * depth]})
+            "camera.look_at_m": [0.0, 0.0, -0.6 * depth], **(overrides or {})})
         renderer = wc.Renderer(scene, device)
         result = renderer.render(0.0)
         fill = fill_measure(renderer.beams, renderer.camera, 3, samples=2000)
