@@ -914,6 +914,7 @@ class BeamCorners:
     end_normal: wp.vec3
     dbar: wp.vec3
     base_normal: wp.vec3
+    inv_dz: wp.vec3
 
 
 @wp.func
@@ -933,6 +934,7 @@ def edge_corners(
     c.end_normal = ends[b, 1]
     c.dbar = ends[b, 2]
     c.base_normal = ends[b, 3]
+    c.inv_dz = wp.vec3(1.0 / c.d0[2], 1.0 / c.d1[2], 1.0 / c.d2[2])
     return c
 
 
@@ -958,21 +960,33 @@ def clamped_sample(c: BeamCorners, p: wp.vec3) -> BeamSample:
     follows the edge lines' plane cut rather than the horizontal sections exactly."""
     z = p[2]
     # Distances along the edges to height z: the section's vertices and the path length share them.
-    l0 = (z - c.v0[2]) / c.d0[2]
-    l1 = (z - c.v1[2]) / c.d1[2]
-    l2 = (z - c.v2[2]) / c.d2[2]
-    lam = barycentrics(xy(c.v0) + l0 * xy(c.d0), xy(c.v1) + l1 * xy(c.d1), xy(c.v2) + l2 * xy(c.d2), xy(p))
-    lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
-    total = lam[0] + lam[1] + lam[2]
-    if total <= 0.0:
-        lam = wp.vec3(1.0 / 3.0)
-    else:
-        lam = lam / total
+    l0 = (z - c.v0[2]) * c.inv_dz[0]
+    l1 = (z - c.v1[2]) * c.inv_dz[1]
+    l2 = (z - c.v2[2]) * c.inv_dz[2]
+    # Barycentrics times the section's signed doubled area: the renormalisation below divides the
+    # area out, so only its sign is needed (and a degenerate section takes the centroid).
+    a = xy(c.v0) + l0 * xy(c.d0)
+    ab = xy(c.v1) + l1 * xy(c.d1) - a
+    ac = xy(c.v2) + l2 * xy(c.d2) - a
+    ap = xy(p) - a
+    det = cross2(ab, ac)
+    lam = wp.vec3(1.0 / 3.0)
+    if det != 0.0:
+        e1 = cross2(ap, ac)
+        e2 = cross2(ab, ap)
+        lam = wp.vec3(det - e1 - e2, e1, e2) * wp.sign(det)
+        lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
+        total = lam[0] + lam[1] + lam[2]
+        if total <= 0.0:
+            lam = wp.vec3(1.0 / 3.0)
+        else:
+            lam = lam * (1.0 / total)
     out = BeamSample()
     out.inside = 1
     out.lam = lam
     out.path_m = lam[0] * l0 + lam[1] * l1 + lam[2] * l2
-    out.d = wp.normalize(lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2)
+    d = lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2
+    out.d = d * (1.0 / wp.length(d))
     out.transmit = lam[0] * c.transmit[0] + lam[1] * c.transmit[1] + lam[2] * c.transmit[2]
     out.area = safe_area(c.coef, z, c.base_z)
     out.beyond_end_m = wp.dot(p - c.end_point, c.end_normal)
@@ -1333,23 +1347,86 @@ def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
     return s_a, wp.min(s_b, root)
 
 
+@wp.struct
+class ChordFrame:
+    """What :func:`scan_chord` needs of a beam copy for rays from one origin o, formed once per beam
+    copy (per tile on the CPU): with p_i = v_i + shift − o and d̄ the mean edge direction,
+    ``p_dbar[i]`` = p_i·d̄, ``d_dbar[i]`` = d_i·d̄, ``dbar_p{i}`` = d̄ × p_i, ``dbar_d{i}`` = d̄ × d_i,
+    and the base and end planes' signed distances of o, (v_0 + shift − o)·n_b and
+    (e + shift − o)·n_e."""
+
+    p0: wp.vec3
+    p1: wp.vec3
+    p2: wp.vec3
+    p_dbar: wp.vec3
+    d_dbar: wp.vec3
+    dbar_p0: wp.vec3
+    dbar_p1: wp.vec3
+    dbar_p2: wp.vec3
+    dbar_d0: wp.vec3
+    dbar_d1: wp.vec3
+    dbar_d2: wp.vec3
+    base_offset: float
+    end_offset: float
+
+
+@wp.func
+def chord_frame(c: BeamCorners, shift: wp.vec3, o: wp.vec3) -> ChordFrame:
+    """The :class:`ChordFrame` of beam copy (c, shift) for rays from o."""
+    f = ChordFrame()
+    f.p0 = c.v0 + shift - o
+    f.p1 = c.v1 + shift - o
+    f.p2 = c.v2 + shift - o
+    f.p_dbar = wp.vec3(wp.dot(f.p0, c.dbar), wp.dot(f.p1, c.dbar), wp.dot(f.p2, c.dbar))
+    f.d_dbar = wp.vec3(wp.dot(c.d0, c.dbar), wp.dot(c.d1, c.dbar), wp.dot(c.d2, c.dbar))
+    f.dbar_p0 = wp.cross(c.dbar, f.p0)
+    f.dbar_p1 = wp.cross(c.dbar, f.p1)
+    f.dbar_p2 = wp.cross(c.dbar, f.p2)
+    f.dbar_d0 = wp.cross(c.dbar, c.d0)
+    f.dbar_d1 = wp.cross(c.dbar, c.d1)
+    f.dbar_d2 = wp.cross(c.dbar, c.d2)
+    f.base_offset = wp.dot(f.p0, c.base_normal)
+    f.end_offset = wp.dot(c.end_point + shift - o, c.end_normal)
+    return f
+
+
+@wp.func
+def edge_cut(p: wp.vec3, d: wp.vec3, p_dbar: float, d_dbar: float, dbar_p: wp.vec3, dbar_d: wp.vec3,
+             v: wp.vec3, cos_beam: float, sin_beam: float):
+    """Where the edge line p + t d (from the ray's origin) meets the scan plane of the ray v:
+    (distance along the ray, distance across it in the plane × sin_beam, ok). The plane's normal
+    is m = d̄ − (v·d̄) v up to its length sin_beam = |v × d̄|, so t = (p·m)/(−d·m), and the cut
+    point's offset across the ray is its component along v × d̄."""
+    pv = wp.dot(p, v)
+    dv = wp.dot(d, v)
+    den = d_dbar - cos_beam * dv
+    if wp.abs(den) < 1.0e-12 * sin_beam:
+        return 0.0, 0.0, False
+    t = (cos_beam * pv - p_dbar) / den
+    return pv + t * dv, wp.dot(v, dbar_p) + t * wp.dot(v, dbar_d), True
+
+
 @wp.func
 def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
     """[s_a, s_b] of the ray o + s v inside beam b moved by ``shift``, by the scan plane (Ernst
     2005, Liktor & Dachsbacher 2011): the plane through the ray most nearly perpendicular to the
     beam cuts the three edge lines in a triangle; the ray's chord through it is clipped to the
     beam's base and end planes. Returns s_a > s_b for a miss. Exact for a straight prism."""
-    v0 = c.v0 + shift
-    v1 = c.v1 + shift
-    v2 = c.v2 + shift
-    d0 = c.d0
-    d1 = c.d1
-    d2 = c.d2
+    return framed_chord(c, chord_frame(c, shift, o), shift, o, v)
+
+
+@wp.func
+def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
+    """:func:`scan_chord` with the beam copy's :class:`ChordFrame` formed already."""
     w = wp.cross(v, c.dbar)
+    sin_beam = wp.length(w)
     s_a = float(-1.0e30)
     s_b = float(1.0e30)
-    if wp.length(w) < PARALLEL_COS:
+    if sin_beam < PARALLEL_COS:
         # Along the beam: inside iff the ray's point on the base plane is in the base triangle.
+        v0 = c.v0 + shift
+        v1 = c.v1 + shift
+        v2 = c.v2 + shift
         nb = wp.cross(v1 - v0, v2 - v0)
         den = wp.dot(v, nb)
         if wp.abs(den) < 1.0e-20:
@@ -1359,18 +1436,24 @@ def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
         if lam[0] < 0.0 or lam[1] < 0.0 or lam[2] < 0.0:
             return 1.0, 0.0
     else:
-        n_p = wp.normalize(wp.cross(v, w))
-        e2 = wp.cross(n_p, v)
-        den0 = wp.dot(d0, n_p)
-        den1 = wp.dot(d1, n_p)
-        den2 = wp.dot(d2, n_p)
-        if wp.abs(den0) < 1.0e-12 or wp.abs(den1) < 1.0e-12 or wp.abs(den2) < 1.0e-12:
+        # The scan plane holds the ray and is most nearly perpendicular to d̄: its normal is
+        # m = d̄ − (v·d̄) v, of length sin_beam. Each edge line's cut: its distance along the ray
+        # (a) and across it in the plane (h, along v × d̄, scaled by sin_beam, which only the
+        # signs and ratios below see).
+        cos_beam = wp.dot(v, c.dbar)
+        a0, h0, ok0 = edge_cut(
+            f.p0, c.d0, f.p_dbar[0], f.d_dbar[0], f.dbar_p0, f.dbar_d0, v, cos_beam, sin_beam
+        )
+        a1, h1, ok1 = edge_cut(
+            f.p1, c.d1, f.p_dbar[1], f.d_dbar[1], f.dbar_p1, f.dbar_d1, v, cos_beam, sin_beam
+        )
+        a2, h2, ok2 = edge_cut(
+            f.p2, c.d2, f.p_dbar[2], f.d_dbar[2], f.dbar_p2, f.dbar_d2, v, cos_beam, sin_beam
+        )
+        if not (ok0 and ok1 and ok2):
             return 1.0, 0.0
-        q0 = v0 + (wp.dot(o - v0, n_p) / den0) * d0 - o
-        q1 = v1 + (wp.dot(o - v1, n_p) / den1) * d1 - o
-        q2 = v2 + (wp.dot(o - v2, n_p) / den2) * d2 - o
-        a = wp.vec3(wp.dot(q0, v), wp.dot(q1, v), wp.dot(q2, v))
-        h = wp.vec3(wp.dot(q0, e2), wp.dot(q1, e2), wp.dot(q2, e2))
+        a = wp.vec3(a0, a1, a2)
+        h = wp.vec3(h0, h1, h2)
         lo = float(1.0e30)
         hi = float(-1.0e30)
         for i in range(3):
@@ -1384,11 +1467,8 @@ def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
         s_a = lo
         s_b = hi
     # Base plane: keep the side the beam goes to.
-    nb = c.base_normal
-    s_a, s_b = clip_halfspace(s_a, s_b, wp.dot(o - v0, nb), wp.dot(v, nb))
-    e0 = c.end_point + shift
-    ne = c.end_normal
-    s_a, s_b = clip_halfspace(s_a, s_b, -wp.dot(o - e0, ne), -wp.dot(v, ne))
+    s_a, s_b = clip_halfspace(s_a, s_b, -f.base_offset, wp.dot(v, c.base_normal))
+    s_a, s_b = clip_halfspace(s_a, s_b, f.end_offset, -wp.dot(v, c.end_normal))
     return s_a, s_b
 
 
@@ -1426,6 +1506,7 @@ class ShaftBeams:
 def chord_radiance(
     sb: ShaftBeams,
     corners: BeamCorners,
+    frame: ChordFrame,
     b: int,
     shift: wp.vec3,
     o: wp.vec3,
@@ -1439,7 +1520,7 @@ def chord_radiance(
     s_max) by beam b moved by ``shift``: ``Σ Δs σ_s p(cos θ) E⊥(x_m) exp(−c (ℓ(x_m) + s_m))`` over
     up to MAX_CHORD_PIECES midpoint pieces of the scan-plane chord. Returns 1 if the ray has a
     chord through the beam, else 0."""
-    s_a, s_b = scan_chord(corners, shift, o, v)
+    s_a, s_b = framed_chord(corners, frame, shift, o, v)
     s_a = wp.max(s_a, 0.0)
     s_b = wp.min(s_b, s_max)
     if s_b <= s_a:
@@ -1530,7 +1611,8 @@ def scan_plane_radiance(
             continue  # the ray passes outside the beam's hull
         boxed += 1
         b, shift, corners = copy_corners(sb, bc)
-        chords += chord_radiance(sb, corners, b, shift, o, v, s_max, j, i, radiance)
+        frame = chord_frame(corners, shift, o)
+        chords += chord_radiance(sb, corners, frame, b, shift, o, v, s_max, j, i, radiance)
     wp.atomic_add(pairs, 0, count)
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)
@@ -1632,6 +1714,7 @@ def scan_plane_radiance_tiles(
         if r0 >= r1:
             continue
         b, shift, corners = copy_corners(sb, bc)
+        frame = chord_frame(corners, shift, o)
         for j in range(r0, r1):
             yc = float(j) + 0.5
             c0, c1 = row_span(axis, lo, hi, yc, x0, x1)
@@ -1639,7 +1722,9 @@ def scan_plane_radiance_tiles(
                 if outside_box(in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
                     continue
                 boxed += 1
-                chords += chord_radiance(sb, corners, b, shift, o, rays[j, i], depth[j, i], j, i, radiance)
+                chords += chord_radiance(
+                    sb, corners, frame, b, shift, o, rays[j, i], depth[j, i], j, i, radiance
+                )
     wp.atomic_add(pairs, 0, count * (x1 - x0) * (y1 - y0))
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)
