@@ -356,7 +356,15 @@ def _camera_floor() -> None:
 def _beams() -> None:
     """Beam caustics: the figures of docs/validation.md's beam section."""
     import warp as wp
-    from test_beams import BEAMS, _chords, _flat, _flat_floor_irradiance, _prism_chord, _sphere_bins
+    from test_beams import (
+        BEAMS,
+        _chords,
+        _flat,
+        _flat_floor_irradiance,
+        _prism_chord,
+        _sphere_bins,
+        near_axis_chord_errors,
+    )
     from test_photons import shaft_block
 
     import warpcaustics as wc
@@ -439,6 +447,9 @@ def _beams() -> None:
             errs.append(max(abs(got[i, 0] - lo), abs(got[i, 1] - hi)))
     print(f"{len(errs)} rays crossing the prism: max |Δs_a|, |Δs_b| = {max(errs) * 1e6:.2f} µm, "
           f"mean {np.mean(errs) * 1e6:.2f} µm")
+    errors, sines = near_axis_chord_errors()
+    print(f"{len(errors)} rays 1°-10° off the axis crossing it: max |Δs| sin θ = "
+          f"{(errors * sines).max() * 1e6:.2f} µm, max |Δs| = {errors.max() * 1e6:.2f} µm")
 
     print("\n## Beam light shafts vs single scattering, sun at the zenith over a still pool (clear_ocean)")
     for n in (32, 64):

@@ -1350,22 +1350,12 @@ def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
 @wp.struct
 class ChordFrame:
     """What :func:`scan_chord` needs of a beam copy for rays from one origin o, formed once per beam
-    copy (per tile on the CPU): with p_i = v_i + shift − o and d̄ the mean edge direction,
-    ``p_dbar[i]`` = p_i·d̄, ``d_dbar[i]`` = d_i·d̄, ``dbar_p{i}`` = d̄ × p_i, ``dbar_d{i}`` = d̄ × d_i,
-    and the base and end planes' signed distances of o, (v_0 + shift − o)·n_b and
-    (e + shift − o)·n_e."""
+    copy (per tile on the CPU): the base vertices from o, p_i = v_i + shift − o, and the signed
+    distances of o from the base and end planes, (v_0 + shift − o)·n_b and (e + shift − o)·n_e."""
 
     p0: wp.vec3
     p1: wp.vec3
     p2: wp.vec3
-    p_dbar: wp.vec3
-    d_dbar: wp.vec3
-    dbar_p0: wp.vec3
-    dbar_p1: wp.vec3
-    dbar_p2: wp.vec3
-    dbar_d0: wp.vec3
-    dbar_d1: wp.vec3
-    dbar_d2: wp.vec3
     base_offset: float
     end_offset: float
 
@@ -1377,33 +1367,22 @@ def chord_frame(c: BeamCorners, shift: wp.vec3, o: wp.vec3) -> ChordFrame:
     f.p0 = c.v0 + shift - o
     f.p1 = c.v1 + shift - o
     f.p2 = c.v2 + shift - o
-    f.p_dbar = wp.vec3(wp.dot(f.p0, c.dbar), wp.dot(f.p1, c.dbar), wp.dot(f.p2, c.dbar))
-    f.d_dbar = wp.vec3(wp.dot(c.d0, c.dbar), wp.dot(c.d1, c.dbar), wp.dot(c.d2, c.dbar))
-    f.dbar_p0 = wp.cross(c.dbar, f.p0)
-    f.dbar_p1 = wp.cross(c.dbar, f.p1)
-    f.dbar_p2 = wp.cross(c.dbar, f.p2)
-    f.dbar_d0 = wp.cross(c.dbar, c.d0)
-    f.dbar_d1 = wp.cross(c.dbar, c.d1)
-    f.dbar_d2 = wp.cross(c.dbar, c.d2)
     f.base_offset = wp.dot(f.p0, c.base_normal)
     f.end_offset = wp.dot(c.end_point + shift - o, c.end_normal)
     return f
 
 
 @wp.func
-def edge_cut(p: wp.vec3, d: wp.vec3, p_dbar: float, d_dbar: float, dbar_p: wp.vec3, dbar_d: wp.vec3,
-             v: wp.vec3, cos_beam: float, sin_beam: float):
-    """Where the edge line p + t d (from the ray's origin) meets the scan plane of the ray v:
-    (distance along the ray, distance across it in the plane × sin_beam, ok). The plane's normal
-    is m = d̄ − (v·d̄) v up to its length sin_beam = |v × d̄|, so t = (p·m)/(−d·m), and the cut
-    point's offset across the ray is its component along v × d̄."""
-    pv = wp.dot(p, v)
-    dv = wp.dot(d, v)
-    den = d_dbar - cos_beam * dv
+def edge_cut(p: wp.vec3, d: wp.vec3, v: wp.vec3, m: wp.vec3, w: wp.vec3, sin_beam: float):
+    """Where the edge line o + p + t d meets the scan plane of the ray v, whose normal is
+    m = (v × d̄) × v = d̄ − (v·d̄) v (of length sin_beam = |w|, w = v × d̄): (distance along the
+    ray, distance across it in the plane × sin_beam, ok): the cut point q = p + t d with
+    t = (p·m)/(−d·m), projected on v and w."""
+    den = wp.dot(d, m)
     if wp.abs(den) < 1.0e-12 * sin_beam:
         return 0.0, 0.0, False
-    t = (cos_beam * pv - p_dbar) / den
-    return pv + t * dv, wp.dot(v, dbar_p) + t * wp.dot(v, dbar_d), True
+    q = p - (wp.dot(p, m) / den) * d
+    return wp.dot(q, v), wp.dot(q, w), True
 
 
 @wp.func
@@ -1437,19 +1416,15 @@ def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: w
             return 1.0, 0.0
     else:
         # The scan plane holds the ray and is most nearly perpendicular to d̄: its normal is
-        # m = d̄ − (v·d̄) v, of length sin_beam. Each edge line's cut: its distance along the ray
-        # (a) and across it in the plane (h, along v × d̄, scaled by sin_beam, which only the
-        # signs and ratios below see).
-        cos_beam = wp.dot(v, c.dbar)
-        a0, h0, ok0 = edge_cut(
-            f.p0, c.d0, f.p_dbar[0], f.d_dbar[0], f.dbar_p0, f.dbar_d0, v, cos_beam, sin_beam
-        )
-        a1, h1, ok1 = edge_cut(
-            f.p1, c.d1, f.p_dbar[1], f.d_dbar[1], f.dbar_p1, f.dbar_d1, v, cos_beam, sin_beam
-        )
-        a2, h2, ok2 = edge_cut(
-            f.p2, c.d2, f.p_dbar[2], f.d_dbar[2], f.dbar_p2, f.dbar_d2, v, cos_beam, sin_beam
-        )
+        # m = w × v, of length sin_beam, formed by cross products so that it stays perpendicular
+        # to v to rounding even for rays nearly along the beam (d̄ − (v·d̄) v would tilt the plane
+        # off the ray by ~1e-7/sin_beam). Each edge line's cut: its distance along the ray (a)
+        # and across it in the plane (h, along w, scaled by sin_beam, which only the signs and
+        # ratios below see).
+        m = wp.cross(w, v)
+        a0, h0, ok0 = edge_cut(f.p0, c.d0, v, m, w, sin_beam)
+        a1, h1, ok1 = edge_cut(f.p1, c.d1, v, m, w, sin_beam)
+        a2, h2, ok2 = edge_cut(f.p2, c.d2, v, m, w, sin_beam)
         if not (ok0 and ok1 and ok2):
             return 1.0, 0.0
         a = wp.vec3(a0, a1, a2)
