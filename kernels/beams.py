@@ -898,8 +898,8 @@ def point_irradiance(
 class BeamCorners:
     """What the volume pass reads of beam b, once per beam a thread meets (per pixel on the GPU, per
     tile on the CPU): base vertices v_i, unit edge directions d_i, per-vertex transmittance, A(z)'s
-    coefficients, the base centroid's height, and ``ends[b]`` (end plane point and normal, d̄, base
-    plane normal)."""
+    coefficients, the base centroid's height, ``ends[b]`` (end plane point and normal, d̄, base
+    plane normal) and 1/d_z of each edge (for :func:`clamped_sample`)."""
 
     v0: wp.vec3
     v1: wp.vec3
@@ -921,7 +921,8 @@ class BeamCorners:
 def edge_corners(
     base: wp.array2d[wp.vec3], direction: wp.array2d[wp.vec3], ends: wp.array2d[wp.vec3], b: int
 ) -> BeamCorners:
-    """The geometry of beam b (all :func:`scan_chord` reads): vertices, edges and ``ends[b]``."""
+    """The geometry of beam b (all :func:`scan_chord` and :func:`clamped_sample`'s geometry reads):
+    vertices, edges, ``ends[b]`` and the edges' 1/d_z."""
     c = BeamCorners()
     c.v0 = base[b, 0]
     c.v1 = base[b, 1]
@@ -977,10 +978,10 @@ def clamped_sample(c: BeamCorners, p: wp.vec3) -> BeamSample:
         lam = wp.vec3(det - e1 - e2, e1, e2) * wp.sign(det)
         lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
         total = lam[0] + lam[1] + lam[2]
-        if total <= 0.0:
-            lam = wp.vec3(1.0 / 3.0)
-        else:
+        if total > 1.0e-30:  # [m²]; 1/total stays finite (a NaN total takes the centroid too)
             lam = lam * (1.0 / total)
+        else:
+            lam = wp.vec3(1.0 / 3.0)
     out = BeamSample()
     out.inside = 1
     out.lam = lam
@@ -1350,8 +1351,9 @@ def clip_halfspace(s_a: float, s_b: float, a: float, k: float):
 @wp.struct
 class ChordFrame:
     """What :func:`scan_chord` needs of a beam copy for rays from one origin o, formed once per beam
-    copy (per tile on the CPU): the base vertices from o, p_i = v_i + shift − o, and the signed
-    distances of o from the base and end planes, (v_0 + shift − o)·n_b and (e + shift − o)·n_e."""
+    copy and tile on the CPU (per pixel and beam copy in the GPU's per-pixel kernel): the base
+    vertices from o, p_i = v_i + shift − o, and the signed distances of o from the base and end
+    planes, (v_0 + shift − o)·n_b and (e + shift − o)·n_e."""
 
     p0: wp.vec3
     p1: wp.vec3
@@ -1373,16 +1375,16 @@ def chord_frame(c: BeamCorners, shift: wp.vec3, o: wp.vec3) -> ChordFrame:
 
 
 @wp.func
-def edge_cut(p: wp.vec3, d: wp.vec3, v: wp.vec3, m: wp.vec3, w: wp.vec3, sin_beam: float):
+def edge_cut(p: wp.vec3, d: wp.vec3, v: wp.vec3, m: wp.vec3, e: wp.vec3, sin_beam: float):
     """Where the edge line o + p + t d meets the scan plane of the ray v, whose normal is
-    m = (v × d̄) × v = d̄ − (v·d̄) v (of length sin_beam = |w|, w = v × d̄): (distance along the
-    ray, distance across it in the plane × sin_beam, ok): the cut point q = p + t d with
-    t = (p·m)/(−d·m), projected on v and w."""
+    m = (v × d̄) × v = d̄ − (v·d̄) v and whose direction across the ray is e = v × m (both of
+    length sin_beam = |v × d̄|): (distance along the ray, distance across it × sin_beam, ok): the
+    cut point q = p + t d with t = (p·m)/(−d·m), projected on v and e."""
     den = wp.dot(d, m)
     if wp.abs(den) < 1.0e-12 * sin_beam:
         return 0.0, 0.0, False
     q = p - (wp.dot(p, m) / den) * d
-    return wp.dot(q, v), wp.dot(q, w), True
+    return wp.dot(q, v), wp.dot(q, e), True
 
 
 @wp.func
@@ -1416,15 +1418,17 @@ def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: w
             return 1.0, 0.0
     else:
         # The scan plane holds the ray and is most nearly perpendicular to d̄: its normal is
-        # m = w × v, of length sin_beam, formed by cross products so that it stays perpendicular
-        # to v to rounding even for rays nearly along the beam (d̄ − (v·d̄) v would tilt the plane
-        # off the ray by ~1e-7/sin_beam). Each edge line's cut: its distance along the ray (a)
-        # and across it in the plane (h, along w, scaled by sin_beam, which only the signs and
-        # ratios below see).
+        # m = w × v, of length sin_beam. Each edge line's cut: its distance along the ray (a)
+        # and across it in the plane (h, along e = v × m, scaled by sin_beam, which only the
+        # signs and ratios below see). m and e are cross products with v, so both stay
+        # perpendicular to the ray to rounding even for rays nearly along the beam: d̄ − (v·d̄) v
+        # for m, or w itself for e (w·v is ~1e-7, not 0), would tilt the plane, or the line
+        # h = 0 in it, off the ray by ~1e-7/sin_beam.
         m = wp.cross(w, v)
-        a0, h0, ok0 = edge_cut(f.p0, c.d0, v, m, w, sin_beam)
-        a1, h1, ok1 = edge_cut(f.p1, c.d1, v, m, w, sin_beam)
-        a2, h2, ok2 = edge_cut(f.p2, c.d2, v, m, w, sin_beam)
+        e = wp.cross(v, m)
+        a0, h0, ok0 = edge_cut(f.p0, c.d0, v, m, e, sin_beam)
+        a1, h1, ok1 = edge_cut(f.p1, c.d1, v, m, e, sin_beam)
+        a2, h2, ok2 = edge_cut(f.p2, c.d2, v, m, e, sin_beam)
         if not (ok0 and ok1 and ok2):
             return 1.0, 0.0
         a = wp.vec3(a0, a1, a2)
