@@ -355,15 +355,16 @@ def _camera_floor() -> None:
 
 def _beams() -> None:
     """Beam caustics: the figures of docs/validation.md's beam section."""
-    import warp as wp
     from test_beams import (
         BEAMS,
         NEAR_AXIS_BEAMS,
-        _chords,
+        PRISM_BASE,
+        PRISM_ENDS,
         _flat,
         _flat_floor_irradiance,
         _prism_chord,
         _sphere_bins,
+        _straight_prism_chords,
         near_axis_chord_errors,
     )
     from test_photons import shaft_block
@@ -425,22 +426,13 @@ def _beams() -> None:
 
     print("\n## Scan-plane chord of a straight prism vs the exact float64 ray-prism chord")
     rng = np.random.default_rng(5)
-    v = np.array([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
+    v, ends = PRISM_BASE, PRISM_ENDS
     d = np.array([0.2, -0.1, -1.0]) / np.linalg.norm([0.2, -0.1, -1.0])
-    ends = np.array([2.0, 2.3, 1.8])
     n = 4000
     origins = rng.uniform(-3.0, 3.0, (n, 3)) + np.array([0.0, 0.0, -1.0])
     targets = v.mean(axis=0) + rng.uniform(-0.5, 0.5, (n, 3)) + d * rng.uniform(0.0, 2.0, (n, 1))
     rays = (targets - origins) / np.linalg.norm(targets - origins, axis=1, keepdims=True)
-    out = wp.zeros(n, dtype=wp.vec2, device="cpu")
-    wp.launch(_chords, dim=n, inputs=[
-        wp.array(np.repeat(v[None], n, axis=0).astype(np.float32), dtype=wp.vec3, device="cpu"),
-        wp.array(np.broadcast_to(d, (n, 3, 3)).astype(np.float32), dtype=wp.vec3, device="cpu"),
-        wp.array(np.repeat(ends[None], n, axis=0).astype(np.float32), dtype=wp.float32, device="cpu"),
-        wp.array(origins.astype(np.float32), dtype=wp.vec3, device="cpu"),
-        wp.array(rays.astype(np.float32), dtype=wp.vec3, device="cpu")],
-        outputs=[wp.zeros((n, 4), dtype=wp.vec3, device="cpu"), out], device="cpu")
-    got = out.numpy().astype(np.float64)
+    got = _straight_prism_chords(v, d, ends, origins, rays)
     errs = []
     for i in range(n):
         lo, hi = _prism_chord(v, d, ends, origins[i], rays[i])

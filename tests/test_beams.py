@@ -205,14 +205,18 @@ def _prism_chord_planes(v, d, ends, o, ray):
     return lo, hi, n_lo, n_hi
 
 
+PRISM_BASE = np.array([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
+PRISM_ENDS = np.array([2.0, 2.3, 1.8])
+"""The straight test beams' base vertices [m] and edge lengths [m] (a tilted end plane)."""
+
+
 def test_scan_plane_chord_of_a_straight_prism_is_exact():
     """A straight (unwarped) beam: the scan-plane chord equals the exact ray–prism chord within
     1e-5 m for rays that cross it obliquely, along it, and that miss it."""
     rng = np.random.default_rng(5)
-    v = np.array([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
+    v, ends = PRISM_BASE, PRISM_ENDS
     d = np.array([0.2, -0.1, -1.0])
     d /= np.linalg.norm(d)
-    ends = np.array([2.0, 2.3, 1.8])  # a tilted end plane
     targets = v.mean(axis=0) + rng.uniform(-0.5, 0.5, (400, 3)) + d * rng.uniform(0.0, 2.0, (400, 1))
     origins = rng.uniform(-3.0, 3.0, (400, 3)) + np.array([0.0, 0.0, -1.0])
     rays = targets - origins
@@ -270,10 +274,10 @@ def near_axis_chord_errors(direction, n: int = 2000, seed: int = 11) -> np.ndarr
         return np.asarray(x, dtype=np.float32).astype(np.float64)
 
     rng = np.random.default_rng(seed)
-    v = f32([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
+    v = f32(PRISM_BASE)
     axis = np.array(direction) / np.linalg.norm(direction)
     d = f32(axis)
-    ends = f32([2.0, 2.3, 1.8])
+    ends = f32(PRISM_ENDS)
     side = np.cross(axis, [1.0, 0.0, 0.0])
     side /= np.linalg.norm(side)
     up = np.cross(axis, side)
