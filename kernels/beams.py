@@ -971,22 +971,24 @@ def clamped_sample(c: BeamCorners, p: wp.vec3) -> BeamSample:
     ac = xy(c.v2) + l2 * xy(c.d2) - a
     ap = xy(p) - a
     det = cross2(ab, ac)
-    lam = wp.vec3(1.0 / 3.0)
+    lam = wp.vec3(1.0)
     if det != 0.0:
         e1 = cross2(ap, ac)
         e2 = cross2(ab, ap)
         lam = wp.vec3(det - e1 - e2, e1, e2) * wp.sign(det)
         lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
-        total = lam[0] + lam[1] + lam[2]
-        if total > 1.0e-30:  # [m²]; 1/total stays finite (a NaN total takes the centroid too)
-            lam = lam * (1.0 / total)
-        else:
-            lam = wp.vec3(1.0 / 3.0)
+    total = lam[0] + lam[1] + lam[2]
+    if not (total > 1.0e-30):  # [m²]; 1/total stays finite (a NaN total takes the centroid too)
+        lam = wp.vec3(1.0)
+        total = 3.0
+    # The direction needs only the barycentrics' ratios, so it is formed from the unnormalised ones:
+    # the division below is then not on the chain the phase function and E⊥ wait for.
+    d = lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2
+    lam = lam * (1.0 / total)
     out = BeamSample()
     out.inside = 1
     out.lam = lam
     out.path_m = lam[0] * l0 + lam[1] * l1 + lam[2] * l2
-    d = lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2
     out.d = d * (1.0 / wp.length(d))
     out.transmit = lam[0] * c.transmit[0] + lam[1] * c.transmit[1] + lam[2] * c.transmit[2]
     out.area = safe_area(c.coef, z, c.base_z)
@@ -1375,13 +1377,14 @@ def chord_frame(c: BeamCorners, shift: wp.vec3, o: wp.vec3) -> ChordFrame:
 
 
 @wp.func
-def edge_cut(p: wp.vec3, d: wp.vec3, v: wp.vec3, m: wp.vec3, e: wp.vec3, sin_beam: float):
+def edge_cut(p: wp.vec3, d: wp.vec3, v: wp.vec3, m: wp.vec3, e: wp.vec3, sin2_beam: float):
     """Where the edge line o + p + t d meets the scan plane of the ray v, whose normal is
     m = (v × d̄) × v = d̄ − (v·d̄) v and whose direction across the ray is e = v × m (both of
-    length sin_beam = |v × d̄|): (distance along the ray, distance across it × sin_beam, ok): the
-    cut point q = p + t d with t = (p·m)/(−d·m), projected on v and e."""
+    length sin_beam = |v × d̄|; ``sin2_beam`` is its square): (distance along the ray, distance
+    across it × sin_beam, ok): the cut point q = p + t d with t = (p·m)/(−d·m), projected on v and
+    e. An edge within 1e-12 (relative) of parallel to the plane is not ok."""
     den = wp.dot(d, m)
-    if wp.abs(den) < 1.0e-12 * sin_beam:
+    if den * den < 1.0e-24 * sin2_beam:
         return 0.0, 0.0, False
     q = p - (wp.dot(p, m) / den) * d
     return wp.dot(q, v), wp.dot(q, e), True
@@ -1400,10 +1403,10 @@ def scan_chord(c: BeamCorners, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
 def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: wp.vec3):
     """:func:`scan_chord` with the beam copy's :class:`ChordFrame` formed already."""
     w = wp.cross(v, c.dbar)
-    sin_beam = wp.length(w)
+    sin2_beam = wp.dot(w, w)  # |v × d̄|²: compared squared, so no square root delays the chord
     s_a = float(-1.0e30)
     s_b = float(1.0e30)
-    if sin_beam < PARALLEL_COS:
+    if sin2_beam < PARALLEL_COS * PARALLEL_COS:
         # Along the beam: inside iff the ray's point on the base plane is in the base triangle.
         v0 = c.v0 + shift
         v1 = c.v1 + shift
@@ -1426,9 +1429,9 @@ def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: w
         # h = 0 in it, off the ray by ~1e-7/sin_beam.
         m = wp.cross(w, v)
         e = wp.cross(v, m)
-        a0, h0, ok0 = edge_cut(f.p0, c.d0, v, m, e, sin_beam)
-        a1, h1, ok1 = edge_cut(f.p1, c.d1, v, m, e, sin_beam)
-        a2, h2, ok2 = edge_cut(f.p2, c.d2, v, m, e, sin_beam)
+        a0, h0, ok0 = edge_cut(f.p0, c.d0, v, m, e, sin2_beam)
+        a1, h1, ok1 = edge_cut(f.p1, c.d1, v, m, e, sin2_beam)
+        a2, h2, ok2 = edge_cut(f.p2, c.d2, v, m, e, sin2_beam)
         if not (ok0 and ok1 and ok2):
             return 1.0, 0.0
         a = wp.vec3(a0, a1, a2)
@@ -1505,10 +1508,16 @@ def chord_radiance(
     if s_b <= s_a:
         return 0
     ds = s_b - s_a
+    # About one piece per beam width √|A| at the chord's midpoint. Most chords are shorter than
+    # that: ds² < |A| finds them without the square root and two divisions that would otherwise
+    # sit on every chord's chain of dependent operations (0.9× the pass's time, same result).
     mid = o + (0.5 * (s_a + s_b)) * v - shift
-    width = wp.sqrt(safe_area(corners.coef, mid[2], corners.v0[2]))
-    pieces = wp.clamp(int(ds / wp.max(width, 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
-    piece = ds / float(pieces)
+    area_mid = safe_area(corners.coef, mid[2], corners.v0[2])
+    pieces = int(1)
+    piece = ds
+    if ds * ds >= area_mid:
+        pieces = wp.clamp(int(ds / wp.max(wp.sqrt(area_mid), 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
+        piece = ds / float(pieces)
     g = b / sb.beams_per_group
     lattice_wraps = int(0)
     if sb.copies > 1:
