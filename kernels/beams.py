@@ -1606,58 +1606,6 @@ def scan_plane_radiance(
     wp.atomic_add(pairs, 2, chords)
 
 
-@wp.func
-def box_rows(axis: wp.vec2, lo: wp.vec2, hi: wp.vec2, y0: int, y1: int):
-    """Rows [r0, r1) of [y0, y1) whose pixel centres may meet the oriented box [lo, hi] in the frame
-    (axis, perp(axis)): the heights of the box's corners, widened by a pixel against rounding."""
-    ya = float(1.0e30)
-    yb = float(-1.0e30)
-    for c in range(4):
-        u = lo[0]
-        w = lo[1]
-        if c % 2 == 1:
-            u = hi[0]
-        if c >= 2:
-            w = hi[1]
-        y = u * axis[1] + w * axis[0]  # the corner u axis + w perp(axis)
-        ya = wp.min(ya, y)
-        yb = wp.max(yb, y)
-    r0 = int(wp.floor(wp.clamp(ya - 0.5, -1.0e6, 1.0e6))) - 1
-    r1 = int(wp.floor(wp.clamp(yb - 0.5, -1.0e6, 1.0e6))) + 2
-    return wp.max(r0, y0), wp.min(r1, y1)
-
-
-@wp.func
-def slab_span(a: float, c: float, lo: float, hi: float, x0: int, x1: int):
-    """Pixels [i0, i1) of [x0, x1) whose centres x may satisfy lo <= a x + c <= hi, widened by a
-    pixel against rounding. Where a x + c moves by less than half a unit across the run, its value
-    mid-run decides for the whole run (dividing by a tiny a would blow float32 rounding up by 1/a);
-    otherwise |a| >= 1 / (2 · run), and the division's rounding stays far below the pixel's margin."""
-    if wp.abs(a) * float(x1 - x0) < 0.5:
-        m = c + a * (0.5 * float(x0 + x1))
-        if m < lo - 1.0 or m > hi + 1.0:
-            return 0, 0
-        return x0, x1
-    xa = (lo - c) / a
-    xb = (hi - c) / a
-    if a < 0.0:
-        t = xa
-        xa = xb
-        xb = t
-    i0 = int(wp.floor(wp.clamp(xa - 0.5, -1.0e6, 1.0e6))) - 1
-    i1 = int(wp.floor(wp.clamp(xb - 0.5, -1.0e6, 1.0e6))) + 2
-    return wp.max(i0, x0), wp.min(i1, x1)
-
-
-@wp.func
-def row_span(axis: wp.vec2, lo: wp.vec2, hi: wp.vec2, yc: float, x0: int, x1: int):
-    """Pixels [c0, c1) of [x0, x1) in the row of pixel centres at height yc that may be in the
-    oriented box [lo, hi] (frame (axis, perp(axis))): the run inside both of the box's slabs, as
-    in_frame(centre, axis) is (x a0 + y a1, −x a1 + y a0) for axis (a0, a1)."""
-    a0, a1 = slab_span(axis[0], yc * axis[1], lo[0] - 1.0e-3, hi[0] + 1.0e-3, x0, x1)
-    return slab_span(-axis[1], yc * axis[0], lo[1] - 1.0e-3, hi[1] + 1.0e-3, a0, a1)
-
-
 @wp.kernel
 def scan_plane_radiance_tiles(
     grid: TileGrid,
@@ -1676,8 +1624,10 @@ def scan_plane_radiance_tiles(
     pairs: wp.array[wp.int32],
 ):
     """:func:`scan_plane_radiance` with a thread per tile (the CPU's form, same result to the bit):
-    the tile's list is walked once, not once per pixel, and each beam copy visits only the rows and
-    pixels its oriented box can reach. Every pixel still adds its beams in list order."""
+    the tile's list is walked once, not once per pixel, and each beam copy's oriented box is tested
+    at the tile's pixel centres. Every pixel still adds its beams in list order. (Narrowing each
+    copy's rows and per-row pixel spans to the box first cost more than the tests it saved: the
+    pass takes 0.94–0.97× the time without it, same shafts.)"""
     tj, ti = wp.tid()
     x0 = ti * tile_pixels
     y0 = tj * tile_pixels
@@ -1698,15 +1648,11 @@ def scan_plane_radiance_tiles(
         axis = box_axis[bc]
         lo = box_lo[bc]
         hi = box_hi[bc]
-        r0, r1 = box_rows(axis, lo, hi, y0, y1)
-        if r0 >= r1:
-            continue
         b, shift, corners = copy_corners(sb, bc)
         frame = chord_frame(corners, shift, o)
-        for j in range(r0, r1):
+        for j in range(y0, y1):
             yc = float(j) + 0.5
-            c0, c1 = row_span(axis, lo, hi, yc, x0, x1)
-            for i in range(c0, c1):
+            for i in range(x0, x1):
                 if outside_box(in_frame(wp.vec2(float(i) + 0.5, yc), axis), lo, hi):
                     continue
                 boxed += 1
