@@ -978,11 +978,13 @@ def clamped_sample(c: BeamCorners, p: wp.vec3) -> BeamSample:
         lam = wp.vec3(det - e1 - e2, e1, e2) * wp.sign(det)
         lam = wp.vec3(wp.max(lam[0], 0.0), wp.max(lam[1], 0.0), wp.max(lam[2], 0.0))
     total = lam[0] + lam[1] + lam[2]
-    if not (total > 1.0e-30):  # [m²]; 1/total stays finite (a NaN total takes the centroid too)
+    # A section narrower than ~1e-8 m (or a NaN total) takes the centroid: 1/total stays finite,
+    # and so does 1/|d| below, as |d|² ~ total² stays a normal float32.
+    if not (total > 1.0e-15):  # [m²]
         lam = wp.vec3(1.0)
         total = 3.0
     # The direction needs only the barycentrics' ratios, so it is formed from the unnormalised ones:
-    # the division below is then not on the chain the phase function and E⊥ wait for.
+    # the phase function's chain of dependent operations then does not wait for the division below.
     d = lam[0] * c.d0 + lam[1] * c.d1 + lam[2] * c.d2
     lam = lam * (1.0 / total)
     out = BeamSample()
@@ -1510,12 +1512,14 @@ def chord_radiance(
     ds = s_b - s_a
     # About one piece per beam width √|A| at the chord's midpoint. Most chords are shorter than
     # that: ds² < |A| finds them without the square root and two divisions that would otherwise
-    # sit on every chord's chain of dependent operations (docs/benchmarks.md).
+    # sit on every chord's chain of dependent operations (docs/benchmarks.md). The test's margin
+    # (a relative 1e-6, far above the rounding of ds² and √|A|) sends every chord the count below
+    # would split to the count, so the two agree exactly.
     mid = o + (0.5 * (s_a + s_b)) * v - shift
     area_mid = safe_area(corners.coef, mid[2], corners.v0[2])
     pieces = int(1)
     piece = ds
-    if ds * ds >= area_mid:
+    if ds * ds >= 0.999999 * area_mid:
         pieces = wp.clamp(int(ds / wp.max(wp.sqrt(area_mid), 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
         piece = ds / float(pieces)
     g = b / sb.beams_per_group

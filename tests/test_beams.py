@@ -401,7 +401,7 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform():
 )
 def test_the_cpu_tile_walk_gives_the_per_pixel_shafts_to_the_bit(config, overrides):
     """The volume pass's two thread layouts (a thread per pixel for the GPU, per 8×8 tile for the
-    CPU, which walks a tile's beam list once and visits only the pixels a beam's box can reach)
+    CPU, which walks a tile's beam list once and tests each beam's box at the tile's pixels)
     give the same radiance to the bit and test the same (pixel, beam) pairs, on a periodic sea
     (3×3 copies) and in a walled pool, with a frame whose sides are not whole tiles."""
     scene = wc.load_scene(
