@@ -297,6 +297,45 @@ def near_axis_chord_errors(direction, n: int = 2000, seed: int = 11) -> np.ndarr
     return np.array(across)
 
 
+@wp.kernel
+def _tiny_section_samples(
+    width_m: wp.array[wp.float32], d_out: wp.array[wp.vec3], path_out: wp.array[wp.float32]
+):
+    """clamped_sample on a straight prism along −z whose base is a right triangle of the given leg
+    length at the origin, sampled at the section's centroid 2 m down."""
+    n = wp.tid()
+    w = width_m[n]
+    c = beam_kernels.BeamCorners()
+    c.v0 = wp.vec3(0.0, 0.0, 0.0)
+    c.v1 = wp.vec3(w, 0.0, 0.0)
+    c.v2 = wp.vec3(0.0, w, 0.0)
+    c.d0 = wp.vec3(0.0, 0.0, -1.0)
+    c.d1 = wp.vec3(0.0, 0.0, -1.0)
+    c.d2 = wp.vec3(0.0, 0.0, -1.0)
+    c.transmit = wp.vec3(1.0)
+    c.coef = wp.vec3(0.5 * w * w, 0.0, 0.0)
+    c.end_point = wp.vec3(0.0, 0.0, -10.0)
+    c.end_normal = wp.vec3(0.0, 0.0, -1.0)
+    c.inv_dz = wp.vec3(-1.0)
+    s = beam_kernels.clamped_sample(c, wp.vec3(w / 3.0, w / 3.0, -2.0))
+    d_out[n] = s.d
+    path_out[n] = s.path_m
+
+
+def test_clamped_sample_stays_finite_in_a_section_narrower_than_float32_can_square():
+    """A sample's direction comes from the unnormalised barycentrics, whose sum is the section's
+    doubled area: for sections down to 1e-30 m wide it still comes out the unit edge direction
+    and the path the 2 m down (a 1e-12 m section once gave an infinite direction, |d|² ~ 1e-48
+    underflowing to 0)."""
+    widths = np.array([1.0, 1e-3, 1e-6, 1e-9, 1e-12, 1e-20, 1e-30], np.float32)
+    d = wp.zeros(len(widths), dtype=wp.vec3, device="cpu")
+    path = wp.zeros(len(widths), dtype=wp.float32, device="cpu")
+    wp.launch(_tiny_section_samples, dim=len(widths), inputs=[wp.array(widths, device="cpu")],
+              outputs=[d, path], device="cpu")
+    np.testing.assert_allclose(d.numpy(), np.tile([0.0, 0.0, -1.0], (len(widths), 1)), atol=1e-7)
+    np.testing.assert_allclose(path.numpy(), 2.0, rtol=1e-7)
+
+
 @pytest.mark.parametrize("beam", NEAR_AXIS_BEAMS)
 def test_scan_plane_chord_stays_exact_for_rays_nearly_along_the_beam(beam):
     """Rays 1°–10° off a straight beam's axis: the scan plane, and the line across the ray in it
