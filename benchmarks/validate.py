@@ -359,6 +359,7 @@ def _beams() -> None:
         BEAMS,
         NEAR_AXIS_BEAMS,
         PRISM_BASE,
+        PRISM_DIRECTION,
         PRISM_ENDS,
         _flat,
         _flat_floor_irradiance,
@@ -426,8 +427,7 @@ def _beams() -> None:
 
     print("\n## Scan-plane chord of a straight prism vs the exact float64 ray-prism chord")
     rng = np.random.default_rng(5)
-    v, ends = PRISM_BASE, PRISM_ENDS
-    d = np.array([0.2, -0.1, -1.0]) / np.linalg.norm([0.2, -0.1, -1.0])
+    v, ends, d = PRISM_BASE, PRISM_ENDS, PRISM_DIRECTION
     n = 4000
     origins = rng.uniform(-3.0, 3.0, (n, 3)) + np.array([0.0, 0.0, -1.0])
     targets = v.mean(axis=0) + rng.uniform(-0.5, 0.5, (n, 3)) + d * rng.uniform(0.0, 2.0, (n, 1))

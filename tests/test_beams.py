@@ -208,15 +208,15 @@ def _prism_chord_planes(v, d, ends, o, ray):
 PRISM_BASE = np.array([[0.0, 0.0, 0.1], [0.6, 0.1, 0.0], [0.2, 0.7, 0.05]])
 PRISM_ENDS = np.array([2.0, 2.3, 1.8])
 """The straight test beams' base vertices [m] and edge lengths [m] (a tilted end plane)."""
+PRISM_DIRECTION = np.array([0.2, -0.1, -1.0]) / np.linalg.norm([0.2, -0.1, -1.0])
+"""The straight test prism's unit edge direction (13° from the vertical)."""
 
 
 def test_scan_plane_chord_of_a_straight_prism_is_exact():
     """A straight (unwarped) beam: the scan-plane chord equals the exact ray–prism chord within
     1e-5 m for rays that cross it obliquely, along it, and that miss it."""
     rng = np.random.default_rng(5)
-    v, ends = PRISM_BASE, PRISM_ENDS
-    d = np.array([0.2, -0.1, -1.0])
-    d /= np.linalg.norm(d)
+    v, ends, d = PRISM_BASE, PRISM_ENDS, PRISM_DIRECTION
     targets = v.mean(axis=0) + rng.uniform(-0.5, 0.5, (400, 3)) + d * rng.uniform(0.0, 2.0, (400, 1))
     origins = rng.uniform(-3.0, 3.0, (400, 3)) + np.array([0.0, 0.0, -1.0])
     rays = targets - origins
@@ -259,7 +259,7 @@ def _straight_prism_chords(v, d, ends, origins, rays) -> np.ndarray:
     return out.numpy().astype(np.float64)
 
 
-NEAR_AXIS_BEAMS = {"13° from the vertical": (0.2, -0.1, -1.0), "47° from the vertical": (0.7, 0.5, -0.8)}
+NEAR_AXIS_BEAMS = {"13° from the vertical": tuple(PRISM_DIRECTION), "47° from the vertical": (0.7, 0.5, -0.8)}
 """Edge directions of the straight beams :func:`near_axis_chord_errors` tries (refracted sunlight
 leaves the surface up to 48.6° from the vertical)."""
 
