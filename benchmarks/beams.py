@@ -393,7 +393,7 @@ def _gather_case(n: int, m: int, device: str, warp_repeats: int, numpy_repeats: 
     # Both sides decide shadows by the beam's end plane (the twin has no BVH for shadow rays).
     stage.occluders = False
     # Receiver points: (m·4)² points on the rippled relief (what a camera's G-buffer would hold).
-    from warpcaustics.receivers import floor_relief_height
+    from warpcaustics.scene.receivers import floor_relief_height
 
     cfg = scene.config
     u = (np.arange(4 * m) + 0.5) * (cfg.water.extent_m / (4 * m)) - 0.5 * cfg.water.extent_m
@@ -589,7 +589,7 @@ def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, 
     import warp as wp
 
     import warpcaustics as wc
-    from warpcaustics.beams import SCREEN_TILE_PIXELS
+    from warpcaustics.caustics.beams import SCREEN_TILE_PIXELS
 
     scene = point_sun_scene(
         ROOT / "configs" / "ocean_floor.toml",

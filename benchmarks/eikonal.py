@@ -27,8 +27,8 @@ MERCIER_TABLE1_S = {64: (0.3, 17.0), 128: (2.5, 21.0), 256: (26.0, 107.0)}
 
 
 def measure(n: int, device: str, repeats: int) -> dict:
+    from warpcaustics.optics.refraction import height_range
     from warpcaustics.pipeline import Renderer
-    from warpcaustics.refraction import height_range
 
     from benchmarks.sunmap import flux_ratio_pass
 
@@ -56,8 +56,8 @@ def _wave(n: int, device: str) -> dict:
     """One wave3d frame at N (timed once: at 256 it takes minutes on a CPU)."""
     import warp as wp
 
+    from warpcaustics.optics.refraction import height_range
     from warpcaustics.pipeline import Renderer
-    from warpcaustics.refraction import height_range
 
     scene = point_sun_scene("configs/mercier_pool.toml", {
         "caustics.method": "wave3d", "caustics.wave3d_resolution": n, "water.resolution": n,

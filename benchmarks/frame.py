@@ -27,8 +27,8 @@ def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
     import numpy as np
     import warp as wp
 
+    from warpcaustics.optics.refraction import height_range, refract_to_floor, sun_visibility
     from warpcaustics.pipeline import Renderer, scene_bytes
-    from warpcaustics.refraction import height_range, refract_to_floor, sun_visibility
 
     scene = _scene(n, m, bins)
     renderer = Renderer(scene, device)

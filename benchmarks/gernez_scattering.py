@@ -28,7 +28,7 @@ ZENITHS_DEG = (20.0, 40.0, 60.0)
 
 def _collected(result, floor) -> np.ndarray:
     """A (K, M, M) floor map summed over its bands and averaged over the config's collector."""
-    from warpcaustics.stats import band_integrated, collector_average
+    from warpcaustics.batch.stats import band_integrated, collector_average
 
     texel = result.map_extent_m / floor.shape[-1]
     return collector_average(band_integrated(floor, result.bin_widths_nm), texel,
@@ -39,7 +39,7 @@ def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple
     """((mean, CV) single, (mean, CV) multiple without photon noise) of one frame, after the
     collector."""
     import warpcaustics as wc
-    from warpcaustics.stats import cv_without_noise
+    from warpcaustics.batch.stats import cv_without_noise
 
     maps = []
     for seed in (1, 2):
@@ -52,9 +52,9 @@ def _cv_pair(overrides: dict, time_s: float) -> tuple[tuple[float, float], tuple
 
 
 def main(argv: list[str] | None = None) -> int:
-    from warpcaustics.field import diffuse_fraction, direct_transmission, pooled_statistics
+    from warpcaustics.batch.field import diffuse_fraction, direct_transmission, pooled_statistics
+    from warpcaustics.optics.spectra import bins_for, water_optics
     from warpcaustics.scene import load_scene
-    from warpcaustics.spectra import bins_for, water_optics
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one zenith, one frame, coarse photons")

@@ -16,8 +16,8 @@ QUICK = [(64, 4)]
 
 
 def measure(n: int, samples: int, device: str, repeats: int) -> dict:
+    from warpcaustics.optics.refraction import height_range
     from warpcaustics.pipeline import Renderer
-    from warpcaustics.refraction import height_range
 
     from benchmarks.sunmap import flux_ratio_pass
 

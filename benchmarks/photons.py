@@ -242,7 +242,7 @@ class PhotonCase:
 
     def __init__(self, n: int, s: int, m: int, intersection: str, device: str):
         import warpcaustics as wc
-        from warpcaustics.refraction import height_range, sun_visibility
+        from warpcaustics.optics.refraction import height_range, sun_visibility
 
         self.scene = photon_scene(n, s, m, intersection)
         self.renderer = r = wc.Renderer(self.scene, device)

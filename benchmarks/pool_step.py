@@ -13,8 +13,8 @@ import sys
 import numpy as np
 
 # the kernels' own constants (importing warp here does not initialise it)
-from warpcaustics.kernels.pool import GRAVITY as G
-from warpcaustics.kernels.pool import REST_SPEED
+from warpcaustics.kernels.water.pool import GRAVITY as G
+from warpcaustics.kernels.water.pool import REST_SPEED
 
 
 def _sample(field, fx, fy):
@@ -71,7 +71,7 @@ def numpy_step(h, u, v, depth, dt, cell, nu):
 
 def _pool(n: int, device: str):
     import warpcaustics as wc
-    from warpcaustics.pool import ShallowWaterPool
+    from warpcaustics.water.pool import ShallowWaterPool
 
     scene = wc.load_scene("configs/pool.toml", {"water.resolution": n})
     pool = ShallowWaterPool.from_config(scene.config, device)

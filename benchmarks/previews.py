@@ -26,14 +26,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _preview(result) -> np.ndarray:
-    from warpcaustics import colour_out
+    from warpcaustics.optics import colour as colour_out
 
     xyz = colour_out.spectral_to_xyz(result.floor_irradiance[:, ::-1, :], result.bins)
     return colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1])
 
 
 def _camera_preview(result) -> np.ndarray:
-    from warpcaustics import colour_out
+    from warpcaustics.optics import colour as colour_out
 
     xyz = colour_out.spectral_to_xyz(result.camera_radiance, result.bins)
     return colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1])
@@ -45,7 +45,7 @@ CAMERA_SCENES = {"ocean_floor": 0.0, "pool_pots": 1.0, "buried_in_sand": 1.0}
 
 def main() -> int:
     import warpcaustics as wc
-    from warpcaustics.output import write_png
+    from warpcaustics.io.output import write_png
 
     images = ROOT / "docs" / "images"
     ocean = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml"), device="cpu")
@@ -77,7 +77,7 @@ METHOD_SCENES = {
 def _method_pictures(images: Path) -> None:
     import tempfile
 
-    from warpcaustics.compare import compare_methods, write_comparison
+    from warpcaustics.batch.compare import compare_methods, write_comparison
 
     for name, (config, overrides, time_s) in METHOD_SCENES.items():
         comparison = compare_methods(ROOT / "configs" / config, overrides, time_s, "cpu")
@@ -89,7 +89,7 @@ def _method_pictures(images: Path) -> None:
 
 def _beam_pictures(images: Path) -> None:
     import warpcaustics as wc
-    from warpcaustics.output import write_png
+    from warpcaustics.io.output import write_png
 
     rows = []
     for name in ("pool_pots", "ocean_floor"):

@@ -33,7 +33,7 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
 
     fluxratio_s = median_time(flux_ratio, repeats, device)
     sunmap_s = median_time(sun_map, repeats, device)
-    from warpcaustics.output import map_correlation, relative_l1
+    from warpcaustics.io.output import map_correlation, relative_l1
 
     return {"config": config, "water_n": n, "map_m": m, "bins": len(result.wavelengths_nm),
             "fluxratio_s": fluxratio_s, "sunmap_s": sunmap_s,
@@ -48,7 +48,7 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
 def flux_ratio_pass(renderer, surface, highest_m: float):
     """A function that draws the flux-ratio map of ``surface`` with the renderer's buffers (the
     baseline the approximate methods are timed against)."""
-    from warpcaustics.refraction import refract_to_floor, sun_visibility
+    from warpcaustics.optics.refraction import refract_to_floor, sun_visibility
 
     scene = renderer.scene
     device = renderer.device

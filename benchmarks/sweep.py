@@ -41,10 +41,10 @@ base = "{base}"
 
 
 def run(quick: bool, device: str = "cpu") -> dict:
-    from warpcaustics.output import save_frame, write_run_json
+    from warpcaustics.batch.sweep import load_sweep, run_sweep
+    from warpcaustics.io.output import save_frame, write_run_json
     from warpcaustics.pipeline import Renderer
     from warpcaustics.scene import load_scene
-    from warpcaustics.sweep import load_sweep, run_sweep
 
     depths = [2.0, 4.0] if quick else [2.0, 4.0, 6.0, 8.0, 10.0, 12.0]
     n, m, k = (64, 64, 3) if quick else (256, 512, 16)

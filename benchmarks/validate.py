@@ -162,8 +162,8 @@ def main() -> int:
           f"({drawn / np.trapezoid(so, om) - 1:+.2%})")
 
     print("\n## Colour: D65 → linear sRGB / Y")
-    from warpcaustics import colour_out
-    from warpcaustics.spectra import SpectralBins
+    from warpcaustics.optics import colour as colour_out
+    from warpcaustics.optics.spectra import SpectralBins
 
     d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
     for width in (1.0, 5.0, 18.75):
@@ -226,7 +226,7 @@ APPROXIMATE = ("sunmap", "eikonal", "wave3d")
 
 def _approximate_methods() -> None:
     """The approximate methods against the flux-ratio map: docs/validation.md's method table."""
-    from warpcaustics.compare import compare_methods
+    from warpcaustics.batch.compare import compare_methods
 
     print("\n## Approximate methods vs the flux-ratio map (band-summed maps normalised by their means)")
     scenes = {"configs/ocean.toml": ({}, 0.0, APPROXIMATE),

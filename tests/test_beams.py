@@ -12,7 +12,7 @@ from test_photons import shaft_block, shaft_scene
 
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
-from warpcaustics.kernels import beams as beam_kernels
+from warpcaustics.kernels.caustics import beams as beam_kernels
 
 from conftest import fresnel_t_angles
 
@@ -525,7 +525,7 @@ def test_both_methods_write_both_results_and_their_difference(tmp_path):
 
     import OpenEXR
 
-    from warpcaustics.output import spectral_channel_name
+    from warpcaustics.io.output import spectral_channel_name
 
     overrides = {
         "caustics.method": "both",

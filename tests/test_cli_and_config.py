@@ -195,7 +195,7 @@ def test_animation_writes_numbered_frames(tmp_path):
 
 def test_failed_write_leaves_nothing(tmp_path):
     """A write that fails half-way leaves neither the file nor its temporary behind."""
-    from warpcaustics.output import atomic_path
+    from warpcaustics.io.output import atomic_path
 
     target = tmp_path / "frame_0000.exr"
     with pytest.raises(RuntimeError), atomic_path(target) as tmp:

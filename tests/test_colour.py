@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from warpcaustics import colour_out
-from warpcaustics.spectra import SpectralBins
+from warpcaustics.optics import colour as colour_out
+from warpcaustics.optics.spectra import SpectralBins
 
 
 @pytest.mark.parametrize("bin_nm", [1.0, 5.0])
@@ -31,7 +31,7 @@ def test_explicit_and_rgb_wavelengths():
     as published), with widths reaching half-way to the neighbours for integrals; "rgb" is three equal
     bins over 400–700 nm; D65 through them stays within 5 % of white (the price of three bins)."""
     import warpcaustics as wc
-    from warpcaustics import spectra
+    from warpcaustics.optics import spectra
 
     scene = wc.load_scene(None, {"optics.wavelengths": [450.0, 550.0, 700.0],
                                  "optics.water_type": "clear_ocean"})
@@ -57,7 +57,7 @@ def test_acescg_white_and_sun_white_balance():
     """D65 maps to ACEScg (1, 1, 1)·Y through CAT02 (1e-3, 5 nm bins); with white balance to the sun
     the ASTM G173 sun itself comes out neutral in ACEScg (1e-6) and sRGB (1e-3: IEC 61966-2-1's
     XYZ→sRGB matrix is rounded to four decimals), and without it, not."""
-    from warpcaustics import spectra
+    from warpcaustics.optics import spectra
 
     bins = spectra.SpectralBins.uniform(380.0, 780.0, 80)
     d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]

@@ -14,7 +14,7 @@ import pytest
 import warp as wp
 
 import warpcaustics.kernels as kernels
-from warpcaustics.kernels.ocean import row_fft_kernel
+from warpcaustics.kernels.water.ocean import row_fft_kernel
 from warpcaustics.water import cuda_fft_block_dim
 
 ARCH = 90

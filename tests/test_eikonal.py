@@ -7,8 +7,8 @@ import pytest
 import warp as wp
 
 import warpcaustics as wc
-from warpcaustics.eikonal import relax
-from warpcaustics.kernels import eikonal as eikonal_kernels
+from warpcaustics.caustics.eikonal import relax
+from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
 
 from conftest import fresnel_t_angles
 

@@ -10,7 +10,7 @@ from warpcaustics.cli import main
 from warpcaustics.errors import ConfigError
 
 jerlov = pytest.importorskip("jerlov")
-field = pytest.importorskip("warpcaustics.field")
+field = pytest.importorskip("warpcaustics.batch.field")
 
 
 def test_pooled_statistics_equal_those_of_all_texels():

@@ -200,7 +200,7 @@ def test_dispersion_flat_water_and_energy(device):
     E_sun cosθ T_λ(θ) exp(−c D/cosθ_t,λ) (1e-4; one index for all bands would miss by 5e-3), and a
     rough ocean keeps each band's transmitted flux (1e-4, against a float64 sum with that band's n)
     while the bands' maps differ (coloured fringes)."""
-    from warpcaustics import spectra
+    from warpcaustics.optics import spectra
 
     result = wc.render(_flat_scene(35.0, 5.0, **{"optics.dispersion": True}), device=device)
     n = spectra.quan_fry_index(result.wavelengths_nm, 35.0, 20.0)

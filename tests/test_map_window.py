@@ -93,7 +93,12 @@ def test_window_statistics_use_its_texels():
         device="cpu",
     )
     assert r.texel_area_m2 == pytest.approx(1e-4)
-    from warpcaustics.stats import band_integrated, collector_average, field_statistics, frame_statistics
+    from warpcaustics.batch.stats import (
+        band_integrated,
+        collector_average,
+        field_statistics,
+        frame_statistics,
+    )
 
     st = frame_statistics(r, r.scene.config.stats)
     total = band_integrated(r.floor_irradiance, r.bin_widths_nm)

@@ -8,10 +8,10 @@ import warp as wp
 from scipy import integrate
 
 import warpcaustics as wc
+from warpcaustics.batch.stats import cv_without_noise
+from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.errors import ConfigError
-from warpcaustics.kernels import multiple as mc_kernels
-from warpcaustics.multiple import MultipleScattering
-from warpcaustics.stats import cv_without_noise
+from warpcaustics.kernels.caustics import multiple as mc_kernels
 
 from conftest import fresnel_t_angles
 

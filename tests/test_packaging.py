@@ -30,9 +30,9 @@ def test_every_subpackage_is_listed():
 
 def test_kernels_import_as_subpackage():
     """Device code is reached as warpcaustics.kernels, never as a top-level 'kernels' module."""
-    from warpcaustics.kernels import floor
+    from warpcaustics.kernels.caustics import fluxratio as floor
 
-    assert floor.__name__ == "warpcaustics.kernels.floor"
+    assert floor.__name__ == "warpcaustics.kernels.caustics.fluxratio"
     assert "kernels" not in sys.modules
 
 
@@ -43,7 +43,7 @@ def test_shipped_configs_render(config, tmp_path):
     if "scene" in tomllib.loads(config.read_text()):
         import dataclasses
 
-        from warpcaustics.study import load_study, run_study
+        from warpcaustics.batch.study import load_study, run_study
 
         pytest.importorskip("matplotlib")
         study = load_study(config)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from warpcaustics.config import config_from_dict
-from warpcaustics.phase import PhaseFunction
+from warpcaustics.optics.phase import PhaseFunction
 
 
 def _sphere_integrals(pf, device):

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import warpcaustics as wc
-from warpcaustics import spectra
 from warpcaustics.errors import ConfigError, WarpcausticsError
-from warpcaustics.phase import PhaseFunction
+from warpcaustics.optics import spectra
+from warpcaustics.optics.phase import PhaseFunction
 
 from conftest import fresnel_t_angles
 
@@ -432,7 +432,7 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform(disk_deg):
 def test_mesh_files_and_spectral_albedo_files(tmp_path):
     """A mesh read from an OBJ/STL file receives what the same built-in mesh receives, and a
     reflectance CSV gives each band its bin average (a linear ramp: the value at the bin centre)."""
-    from warpcaustics.receivers import _primitive
+    from warpcaustics.scene.receivers import _primitive
 
     _primitive("cube").save(str(tmp_path / "cube.stl"))
     _primitive("sphere").save(str(tmp_path / "sphere.obj"))
@@ -655,7 +655,7 @@ def test_vtk_files_read_back_with_pyvista(tmp_path):
 def test_preview_draws_a_png(tmp_path):
     """`warpcaustics preview` renders a frame and draws it off screen into a PNG of the asked size
     (skipped, and saying so, where VTK has no off-screen context)."""
-    from warpcaustics.preview import preview_png
+    from warpcaustics.io.preview import preview_png
 
     scene = wc.load_scene(
         "configs/pool.toml",
@@ -681,7 +681,7 @@ def test_preview_draws_a_png(tmp_path):
 def test_albedo_and_relief_areas_follow_their_definitions():
     """A grey sRGB albedo becomes a flat reflectance spectrum (Mallett & Yuksel's basis sums to one
     at every wavelength), and a slope's texels have the area (L/M)² / cos(slope)."""
-    from warpcaustics.receivers import albedo_spectrum, floor_texel_area
+    from warpcaustics.scene.receivers import albedo_spectrum, floor_texel_area
 
     bins = spectra.bins_for(wc.load_scene(None, {}).config.optics)
     np.testing.assert_allclose(albedo_spectrum((0.5, 0.5, 0.5), bins), 0.5, rtol=1e-6)

@@ -6,7 +6,7 @@ import warp as wp
 
 import warpcaustics as wc
 from warpcaustics.config import DropConfig
-from warpcaustics.pool import ShallowWaterPool
+from warpcaustics.water.pool import ShallowWaterPool
 
 DEPTH_M = 1.5
 
@@ -95,7 +95,7 @@ def test_pool_is_stateful_and_renders(device):
 def test_wave_pool_energy_decays_at_the_damping_rate(device):
     """Damped wave equation: discrete wave energy decays as e^(−γt) (γ = 0.5 /s, within 2 %), and
     is conserved within 1 % over 1 s without damping."""
-    from warpcaustics.wavepool import WaveEquationPool
+    from warpcaustics.water.wavepool import WaveEquationPool
 
     bump = (DropConfig(time_s=0.0, radius_m=0.15, height_m=0.02),)
     for gamma in (0.5, 0.0):
@@ -114,7 +114,7 @@ def test_wave_pool_normals_match_the_bump_gradient(device):
     """The wave pool's normals (central differences of η) match the analytic gradient of the Gaussian
     bump it starts from, with the second-order error of central differences: the worst normal
     error falls about fourfold when the grid is refined twofold."""
-    from warpcaustics.wavepool import WaveEquationPool
+    from warpcaustics.water.wavepool import WaveEquationPool
 
     extent, sigma, height = 2.0, 0.12, 0.03
     errors = []
@@ -139,7 +139,7 @@ def test_wave_pool_normals_match_the_bump_gradient(device):
 
 def test_wave_pool_ridge_travels_at_c(device):
     """A ridge in the wave pool splits into pulses moving at c = √(g·depth), within 3 %."""
-    from warpcaustics.wavepool import WaveEquationPool
+    from warpcaustics.water.wavepool import WaveEquationPool
 
     n, extent = 256, 32.0
     pool = WaveEquationPool(n, extent, DEPTH_M, device, damping_per_s=0.0)
@@ -237,7 +237,7 @@ def test_drops_during_the_run_add_their_volume(device):
 def test_wave_pool_drop_keeps_the_troughs(device):
     """A drop into a moving wave pool adds its bump and nothing else: troughs stay negative and the
     mean elevation rises by the bump's volume (a negative drop lowers it)."""
-    from warpcaustics.wavepool import WaveEquationPool
+    from warpcaustics.water.wavepool import WaveEquationPool
 
     for height in (0.002, -0.002):
         drops = (DropConfig(time_s=0.0, radius_m=0.15, height_m=0.02),
@@ -329,7 +329,7 @@ def test_slow_faces_rest_instead_of_going_subnormal(monkeypatch):
     the rest speed at 0 holds some; the depths are the same to the bit and the velocities differ
     by the order of REST_SPEED (a face set to rest passes its difference on to its neighbours
     through the advection and the Laplacian)."""
-    from warpcaustics.kernels.pool import REST_SPEED
+    from warpcaustics.kernels.water.pool import REST_SPEED
 
     import benchmarks.pool_step as twin
     from benchmarks.pool_step import _dt
@@ -357,7 +357,7 @@ def test_slow_faces_rest_instead_of_going_subnormal(monkeypatch):
 def test_a_nan_velocity_stays_nan_and_slow_faces_rest(device):
     """The force kernel keeps a NaN velocity NaN (so the CFL check sees a blow-up), sets a face
     slower than REST_SPEED to rest, and keeps one just above it."""
-    from warpcaustics.kernels import pool as pool_kernels
+    from warpcaustics.kernels.water import pool as pool_kernels
 
     n = 8
     u_adv = np.zeros((n, n + 1), np.float32)

@@ -89,8 +89,8 @@ def test_dispersion_follows_quan_fry(device):
     import csv
     from pathlib import Path
 
-    from warpcaustics import spectra
-    from warpcaustics.refraction import refract_to_floor
+    from warpcaustics.optics import spectra
+    from warpcaustics.optics.refraction import refract_to_floor
     from warpcaustics.water import HeightfieldWater
 
     table = (Path(__file__).resolve().parents[2] / "shared" / "data" / "water"

@@ -9,7 +9,7 @@ import pytest
 
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
-from warpcaustics.solar import sun_position
+from warpcaustics.optics.solar import sun_position
 
 
 def _spa_example() -> dict:

@@ -9,7 +9,7 @@ import pytest
 from scipy import special
 
 import warpcaustics as wc
-from warpcaustics import stats
+from warpcaustics.batch import stats
 from warpcaustics.errors import ConfigError
 
 
@@ -169,7 +169,7 @@ def test_sky_and_direct_parts_have_their_own_statistics():
     """With a sky, the statistics also hold the direct sun's part and the sky's alone: their means
     add up to the total's (1e-9) and the sky's is the mean of RenderResult.sky_floor_irradiance."""
     import warpcaustics as wc
-    from warpcaustics.stats import band_integrated, frame_statistics
+    from warpcaustics.batch.stats import band_integrated, frame_statistics
 
     scene = wc.load_scene("configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 32,
                                                  "sky.model": "uniform", "sky.diffuse_fraction": 0.3,

@@ -65,7 +65,7 @@ def test_study_input_errors_are_one_line(tmp_path, capsys, body, needle):
 def test_nested_overrides_set_keys_not_sections(tmp_path):
     """[overrides.water] resolution = 32 changes one key and keeps the scene's other water keys."""
     import warpcaustics as wc
-    from warpcaustics.study import load_study
+    from warpcaustics.batch.study import load_study
 
     root = Path(__file__).resolve().parents[1]
     study = tmp_path / "study.toml"

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import warpcaustics as wc
-from warpcaustics import spectra
 from warpcaustics.cli import main
 from warpcaustics.config import config_from_dict
+from warpcaustics.optics import spectra
 
 BINS = spectra.SpectralBins.uniform(400.0, 700.0, 30)
 
@@ -71,7 +71,7 @@ def test_floor_scales_with_the_sun():
 
 def test_d65_sun_has_the_d65_shape():
     """The d65 sun is colour-science's CIE D65 averaged over each bin, up to the overall scale."""
-    from warpcaustics.colour_out import _colour
+    from warpcaustics.optics.colour import _colour
 
     d65 = _colour().SDS_ILLUMINANTS["D65"]
     ours = spectra.sun_irradiance(BINS, _sun(spectrum="d65"))

@@ -153,7 +153,7 @@ def test_grid_methods_move_their_map_by_the_disk_parallax(focus_maps):
     where the exact integration is known: the parallax average of the point sun's map holds its
     flux in the same radii as the exact disk's (q = ¼, ½, ¾, to a texel) and keeps the flux (1e-6,
     periodic). The eikonal map of an ocean keeps its mean with a disk (1e-6)."""
-    from warpcaustics.eikonal import parallax_disk_average
+    from warpcaustics.caustics.eikonal import parallax_disk_average
 
     maps, x = focus_maps
     scene, point_map = maps[0.0]
@@ -189,7 +189,7 @@ def test_parallax_moves_a_map_as_still_water_displaces_light(periodic):
     texel's centroid moves by D·(t_xy/|t_z| − t0_xy/|t0_z|), t from Snell's law written out here
     (1e-9 texels: bilinear moves keep centroids), rows along +y and columns along +x. Without
     wrapping, what is moved past the edge is lost, in the bilinear share."""
-    from warpcaustics.eikonal import parallax_disk_average
+    from warpcaustics.caustics.eikonal import parallax_disk_average
 
     n_w, depth, extent, m = 1.34, 5.0, 2.0, 64
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import warpcaustics as wc
+from warpcaustics.caustics.sunmap import SunMapCaustics
 from warpcaustics.errors import ConfigError
-from warpcaustics.sunmap import SunMapCaustics
 from warpcaustics.water import HeightfieldWater, ProceduralWater
 
 from conftest import fresnel_t_angles

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from warpcaustics.batch.sweep import load_sweep, read_manifest, run_sweep
 from warpcaustics.errors import ConfigError
-from warpcaustics.sweep import load_sweep, read_manifest, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -82,7 +82,7 @@ def test_local_sweep_runs_every_task_and_resumes(tmp_path):
     again = run_sweep(sweep, out, workers=2, device="cpu", quiet=True)
     assert (again.done, again.skipped) == (0, 8)
     from warpcaustics import __version__
-    from warpcaustics.sweep import task_id
+    from warpcaustics.batch.sweep import task_id
 
     for rec in read_manifest(out).values():  # the manifest holds what the id hashes
         assert rec["version"] == __version__ and rec["config"]["water"]["resolution"] == 16
@@ -194,7 +194,7 @@ def test_interrupted_pool_animation_resumes_from_its_checkpoint(tmp_path, monkey
     import numpy as np
 
     from warpcaustics import pipeline
-    from warpcaustics.sweep import run_task
+    from warpcaustics.batch.sweep import run_task
 
     path = tmp_path / "pool.toml"
     path.write_text(POOL.format(base=(ROOT / "configs" / "pool.toml").as_posix()))

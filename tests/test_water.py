@@ -5,7 +5,7 @@ import pytest
 import warp as wp
 
 from warpcaustics import water
-from warpcaustics.kernels import heightfield as hf_kernels
+from warpcaustics.kernels.water import heightfield as hf_kernels
 
 
 @pytest.mark.parametrize("n", [64, 256])

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import warpcaustics as wc
-from warpcaustics import spectra
 from warpcaustics.config import JerlovSource, OpticsConfig, WaterType
+from warpcaustics.optics import spectra
 
 from conftest import fresnel_t_angles
 

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from warpcaustics import __version__
-from warpcaustics.compare import FLOOR_METHODS
+from warpcaustics.batch.compare import FLOOR_METHODS
 from warpcaustics.errors import WarpcausticsError
 
 EXIT_USER_ERROR = 2
@@ -126,7 +126,7 @@ def _render(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
 
-    from warpcaustics.output import save_frame, write_run_json
+    from warpcaustics.io.output import save_frame, write_run_json
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
@@ -135,7 +135,7 @@ def _render(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
     results = []
-    from warpcaustics.sweep import Progress
+    from warpcaustics.batch.sweep import Progress
 
     progress = Progress(args.frames, args.quiet, unit="frame")
     try:
@@ -159,7 +159,7 @@ def _render(args: argparse.Namespace) -> int:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from warpcaustics.study import load_study, run_study
+    from warpcaustics.batch.study import load_study, run_study
 
     study = load_study(args.study)
     out = Path(args.out)
@@ -175,8 +175,8 @@ def _study(args: argparse.Namespace) -> int:
 
 def _preview(args: argparse.Namespace) -> int:
     from warpcaustics.config import parse_override
+    from warpcaustics.io.preview import preview_png
     from warpcaustics.pipeline import render
-    from warpcaustics.preview import preview_png
     from warpcaustics.scene import load_scene
 
     out = Path(args.out)
@@ -191,7 +191,7 @@ def _preview(args: argparse.Namespace) -> int:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from warpcaustics.compare import compare_methods, write_comparison
+    from warpcaustics.batch.compare import compare_methods, write_comparison
     from warpcaustics.config import parse_override
 
     if args.time != args.time or abs(args.time) == float("inf"):
@@ -214,7 +214,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
-    from warpcaustics.output import versions
+    from warpcaustics.io.output import versions
 
     for name, version in versions().items():
         print(f"{name:16s}{version}")
@@ -241,7 +241,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "study":
             return _study(args)
         if args.command == "sweep":
-            from warpcaustics.sweep import sweep_main
+            from warpcaustics.batch.sweep import sweep_main
 
             return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet, args.executor,
                               args.address)
@@ -250,7 +250,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "compare":
             return _compare(args)
         if args.command == "field":
-            from warpcaustics.field import run_gernez2009
+            from warpcaustics.batch.field import run_gernez2009
 
             paths = run_gernez2009(args.scene, args.out, series=tuple(args.series.split(",")),
                                    frames=args.frames, workers=args.workers, device=args.device,
@@ -258,7 +258,7 @@ def main(argv: list[str] | None = None) -> int:
             print("wrote " + ", ".join(str(p) for p in paths.values()))
             return 0
         if args.command == "report":
-            from warpcaustics.sweep import report_main
+            from warpcaustics.batch.sweep import report_main
 
             return report_main(args.out)
         return _info()

@@ -11,20 +11,22 @@ from pathlib import Path
 import numpy as np
 import warp as wp
 
-from warpcaustics import beams, caustics, photons, spectra
 from warpcaustics import device as devices
-from warpcaustics.camera import UnderwaterCamera, camera_bytes
+from warpcaustics.caustics import beams, photons
+from warpcaustics.caustics import fluxratio as caustics
+from warpcaustics.caustics.eikonal import EikonalCaustics, GridCaustics, eikonal_bytes
+from warpcaustics.caustics.multiple import MultipleScattering
+from warpcaustics.caustics.sunmap import SunMapCaustics
+from warpcaustics.caustics.wave3d import Wave3DCaustics, wave3d_bytes
 from warpcaustics.config import CausticsMethod, Scattering, SkyModel
-from warpcaustics.eikonal import EikonalCaustics, GridCaustics, eikonal_bytes
 from warpcaustics.errors import WarpcausticsError
-from warpcaustics.multiple import MultipleScattering
-from warpcaustics.phase import PhaseFunction
-from warpcaustics.receivers import WALL_FACES, Receivers
-from warpcaustics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
+from warpcaustics.optics import spectra
+from warpcaustics.optics.phase import PhaseFunction
+from warpcaustics.optics.refraction import Refracted, height_range, refract_to_floor, sun_visibility
 from warpcaustics.scene import Scene
-from warpcaustics.sunmap import SunMapCaustics
+from warpcaustics.scene.camera import UnderwaterCamera, camera_bytes
+from warpcaustics.scene.receivers import WALL_FACES, Receivers
 from warpcaustics.water import make_water, water_bytes
-from warpcaustics.wave3d import Wave3DCaustics, wave3d_bytes
 
 
 @dataclass
@@ -164,7 +166,7 @@ class RenderResult:
 
         Each file is written to a temporary name and renamed; run.json comes last.
         """
-        from warpcaustics.output import save_frame, write_run_json
+        from warpcaustics.io.output import save_frame, write_run_json
 
         paths = save_frame(self, Path(out_dir), frame=frame)
         paths["json"] = write_run_json(Path(out_dir), [self])
@@ -232,7 +234,7 @@ def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) 
     """The camera must be in the water: over a non-periodic patch (inside a pool's walls) and above
     the floor."""
     from warpcaustics.errors import ConfigError
-    from warpcaustics.receivers import floor_relief_height
+    from warpcaustics.scene.receivers import floor_relief_height
 
     x, y, z = cfg.camera.position_m
     half = 0.5 * cfg.water.extent_m
@@ -249,7 +251,7 @@ def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) 
 
 def receiver_face_estimate(scene: Scene, periodic: bool) -> int:
     """Faces of the receivers' BVH (the floor grid with its margin, walls, meshes)."""
-    from warpcaustics.receivers import floor_mesh_cells
+    from warpcaustics.scene.receivers import floor_mesh_cells
 
     cfg = scene.config
     cells = floor_mesh_cells(cfg)

@@ -1,0 +1,1 @@
+"""Device code of the caustic methods, one module per method."""

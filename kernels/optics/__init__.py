@@ -1,0 +1,1 @@
+"""Device code of the optics: refraction with Fresnel transmittance, phase functions."""

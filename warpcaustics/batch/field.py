@@ -1,0 +1,318 @@
+"""Field comparison: the model's irradiance fluctuations against Gernez & Antoine (2009).
+
+Gernez, P. and Antoine, D. (2009), "Field characterization of wave-induced underwater light field
+fluctuations", J. Geophys. Res. 114, C06025, measured the coefficient of variation (CV = std/mean)
+of the downwelling irradiance at 510 nm, 2.7-3.7 m deep, with an 8 mm collector, at the BOUSSOLE
+buoy under clear skies, against the sun's zenith angle (their Fig. 8a) and against the wind
+(Fig. 8c). The measured values, and the diffuse share of the sky they print along Fig. 8a, come
+from the ``jerlov`` package (``gernez2009_cv_by_sun_zenith``, ``gernez2009_cv_by``,
+``gernez2009_diffuse_share``), which read them off the figures and records how.
+
+``warpcaustics field gernez2009 SCENE --out DIR`` renders SCENE (``configs/field/gernez2009.toml``)
+at each measured zenith, with the paper's diffuse share, and at each wind, as one resumable sweep
+(issue 7's runner: ``--workers`` processes), then pools every point's frames and writes
+``gernez2009.csv`` and ``gernez2009.png``.
+
+The model's CV is spatial: the CV over the floor-map window after the collector, pooled over the
+frames. The measurement's is temporal, at one point over minutes. The two agree for a statistically
+homogeneous, stationary sea (ergodicity), which a linear random FFT sea is.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from warpcaustics.config import SkyModel
+from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.io.output import atomic_path, pyplot, write_csv
+
+SERIES = ("zenith", "wind")
+
+WIND_SERIES_ZENITH_DEG = 40.0
+"""Sun zenith of the wind series. The paper's Fig. 8c pools all zeniths; 40° is our choice, near the
+middle of the 20-85° range it reports."""
+
+MIN_SQRT_WIND = 1.2
+"""The wind series starts at the class √U = 1.2 (1.44 m/s): below it a wind sea is nearly flat,
+while the buoy still saw swell from elsewhere, which a wind-driven spectrum cannot hold."""
+
+QUICK_OVERRIDES = {
+    "water.resolution": 64,
+    "caustics.map_resolution": 64,
+    "sun.disk_samples": 2,
+    "sky.directions": 2,
+}
+"""``--quick``: a coarse version of every task, to check the command end to end in seconds (CI,
+tests). Its CVs are not a comparison: the surface cells (0.5 m) are far too coarse to focus."""
+
+
+@dataclass(frozen=True)
+class Point:
+    """One condition of the comparison and the paper's CV there."""
+
+    series: str
+    sun_zenith_deg: float
+    wind_m_s: float | None
+    """None: the scene's own wind."""
+    diffuse_fraction: float
+    measured_cv: float
+    measured_cv_sd: float
+
+    def overrides(self) -> dict:
+        out = {"sun.elevation_deg": 90.0 - self.sun_zenith_deg, "sky.diffuse_fraction": self.diffuse_fraction}
+        if self.wind_m_s is not None:
+            out["water.wind_speed_m_s"] = self.wind_m_s
+        return out
+
+
+def diffuse_fraction(sun_zenith_deg: float) -> float:
+    """The paper's diffuse share E_diffuse/E_total of the above-water irradiance (from its sky model)
+    at this zenith: linear between the values printed every 10° (``jerlov.gernez2009_diffuse_share``)."""
+    import jerlov
+
+    share = jerlov.gernez2009_diffuse_share()
+    return float(np.interp(sun_zenith_deg, share.sun_zenith_deg, share.diffuse_fraction))
+
+
+def gernez2009_points(series: tuple[str, ...] = SERIES) -> list[Point]:
+    """The measured points: CV against the sun's zenith (Fig. 8a) and against √wind (Fig. 8c)."""
+    import jerlov
+
+    points = []
+    if "zenith" in series:
+        by_zenith = jerlov.gernez2009_cv_by_sun_zenith()
+        for z, cv, sd in zip(by_zenith.sun_zenith_deg, by_zenith.cv, by_zenith.cv_sd):
+            points.append(Point("zenith", float(z), None, diffuse_fraction(float(z)), float(cv), float(sd)))
+    if "wind" in series:
+        by_wind = jerlov.gernez2009_cv_by("sqrt_wind")
+        f = diffuse_fraction(WIND_SERIES_ZENITH_DEG)
+        for x, cv, sd in zip(by_wind.x, by_wind.cv, by_wind.cv_sd):
+            if x >= MIN_SQRT_WIND:
+                points.append(Point("wind", WIND_SERIES_ZENITH_DEG, float(x) ** 2, f, float(cv), float(sd)))
+    return points
+
+
+def pooled_statistics(
+    frames: list[tuple[float, float]], background: list[float] | None = None
+) -> tuple[float, float]:
+    """Mean and CV of all texels of several equal-sized frames, from each frame's (mean μᵢ, CVᵢ):
+    E[E²] = mean over frames of μᵢ²(1 + CVᵢ²), so CV² = E[E²]/μ² − 1 with μ the mean of the μᵢ.
+    ``background``: a uniform irradiance Bᵢ added to every texel of frame i (its mean grows by
+    Bᵢ, its variance does not)."""
+    mu = np.array([m for m, _ in frames], np.float64)
+    sd = mu * np.array([c for _, c in frames], np.float64)
+    if background is not None:
+        mu = mu + np.asarray(background, np.float64)
+    mean = float(mu.mean())
+    second = float(np.mean(mu**2 + sd**2))
+    return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0
+
+
+def direct_transmission(sun_zenith_deg: float, depth_m: float, ior: float, scattering_per_m: float) -> float:
+    """exp(−b·d/cos θ_w): the share of the sun's refracted beam not scattered on its way down. The
+    rest, lost by single scattering, is mostly scattered forward (Petzold's mean cosines are
+    0.87-0.95, docs/physics.md) and arrives spread over tens of centimetres, wider than the
+    caustics: a uniform background is its limit."""
+    sin_w = math.sin(math.radians(sun_zenith_deg)) / ior
+    return math.exp(-scattering_per_m * depth_m / math.sqrt(1.0 - sin_w * sin_w))
+
+
+def run_gernez2009(
+    scene: str | Path,
+    out: str | Path,
+    *,
+    series: tuple[str, ...] = SERIES,
+    frames: int = 3,
+    frame_interval_s: float = 2.0,
+    workers: int = 1,
+    device: str | None = None,
+    quick: bool = False,
+    quiet: bool = False,
+) -> dict[str, Path]:
+    """Render every point of the comparison (a resumable sweep into ``out``), pool each point's
+    frames and write ``gernez2009.csv`` and ``gernez2009.png``."""
+    from warpcaustics.batch.sweep import expand_sweep, format_report, run_sweep
+    from warpcaustics.scene import load_scene
+
+    unknown = set(series) - set(SERIES)
+    if not series or unknown:
+        raise ConfigError(f"--series {','.join(series)!r} must name some of: {', '.join(SERIES)}")
+    if frames < 1:
+        raise ConfigError(f"--frames = {frames} must be at least 1")
+    scene_path = Path(scene).resolve()
+    fixed = dict(QUICK_OVERRIDES) if quick else {}
+    base = load_scene(scene_path, fixed)
+    _check_scene(base.config)
+    pyplot(PLOT_NEEDS)  # before the sweep, not after it
+    points = gernez2009_points(series)
+    if quick:  # the first and last zenith, the first wind
+        ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
+        points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
+    overrides, variants = point_variants(points, base.config)
+    zipped = {k: [o[k] for o in variants] for k in variants[0]}
+    times = tuple(i * frame_interval_s for i in range(frames))
+    sweep = expand_sweep(scene_path, fixed, {}, zipped, times, scene_path)
+    bad = next((t.error for t in sweep.tasks if t.error is not None), None)
+    if bad is not None:
+        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
+    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet)
+    if not quiet:
+        print(format_report(report))
+    if report.failed:
+        raise WarpcausticsError(
+            f"{len(report.failed)} task(s) failed (see {Path(out) / 'manifest.jsonl'}); "
+            "fix the cause and rerun the same command to finish them"
+        )
+    rows = _rows(points, overrides, sweep, Path(out), base.config)
+    out = Path(out)
+    paths = {"csv": out / "gernez2009.csv", "png": out / "gernez2009.png"}
+    write_csv(paths["csv"], rows)
+    _plot(rows, paths["png"], quick)
+    return paths
+
+
+def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]:
+    """Each point's overrides, setting every varied key (the scene's value where the point leaves
+    it) so that a point's tasks are found by their overrides alone; and the distinct ones, to
+    render (points of the two series share a condition when the scene's wind is a wind class)."""
+    keys = sorted({k for p in points for k in p.overrides()})
+    overrides = [{k: p.overrides().get(k, _scene_value(config, k)) for k in keys} for p in points]
+    return overrides, [o for i, o in enumerate(overrides) if o not in overrides[:i]]
+
+
+def _check_scene(config) -> None:
+    """The comparison needs one band at the paper's 510 nm (its CV is of that band), a sky that can
+    take the paper's diffuse share and a stateless sea (each frame pooled is its own task)."""
+    wl = config.optics.wavelengths
+    one_band = (wl.list_nm == (510.0,)) or (
+        not wl.list_nm and wl.bins == 1 and wl.min_nm <= 510.0 <= wl.max_nm
+    )
+    if not one_band:
+        raise ConfigError(
+            "the Gernez 2009 comparison is of one band at 510 nm: set optics.wavelengths = [510.0]"
+        )
+    if config.water.stateful:
+        raise ConfigError(
+            f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
+            "independent frames of a wind sea: use water.model = 'fft'"
+        )
+    if config.sky.model is not SkyModel.UNIFORM:
+        raise ConfigError(
+            "the Gernez 2009 comparison needs the sky's diffuse share: set sky.model = 'uniform'"
+        )
+
+
+def _scene_value(config, key: str):
+    section, name = key.split(".")
+    return getattr(getattr(config, section), name)
+
+
+def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) -> list[dict]:
+    from warpcaustics.optics.spectra import bins_for, water_optics
+
+    bins = bins_for(config.optics)
+    band = int(np.argmin(np.abs(bins.centres_nm - 510.0)))
+    b = float(water_optics(config.optics, bins).scattering_per_m[band])
+    rows = []
+    for point, o in zip(points, overrides):
+        total, direct, sky = [], [], []
+        for task in sweep.tasks:
+            if all(task.overrides.get(k) == v for k, v in o.items()):
+                run = json.loads((out / task.id / "run.json").read_text())
+                s = run["frames"][0]["statistics"]
+                total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
+                direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
+                sky.append(s["sky_irradiance_w_m2"]["mean"])
+        mean, cv = pooled_statistics(total)
+        per_frame = [c for _, c in total]
+        # the sky as a uniform background: its K directions' own caustics removed
+        _, cv_uniform_sky = pooled_statistics(direct, sky)
+        # and the sun's scattered light, lost by single scattering, back as a uniform background
+        t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
+        scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky)]
+        _, cv_scattered = pooled_statistics(direct, scattered)
+        wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s
+        rows.append(
+            {
+                "series": point.series,
+                "sun_zenith_deg": point.sun_zenith_deg,
+                "wind_m_s": round(wind, 4),
+                "sqrt_wind": round(math.sqrt(wind), 4),
+                "diffuse_fraction": round(point.diffuse_fraction, 4),
+                "measured_cv": round(point.measured_cv, 4),
+                "measured_cv_sd": round(point.measured_cv_sd, 4),
+                "model_cv": round(cv, 4),
+                "model_cv_frame_sd": round(float(np.std(per_frame)), 4),
+                "model_cv_uniform_sky": round(cv_uniform_sky, 4),
+                "model_cv_uniform_sky_scattered": round(cv_scattered, 4),
+                "direct_transmission": round(t, 4),
+                "frames": len(total),
+                "model_mean_w_m2": mean,
+            }
+        )
+    return rows
+
+
+PLOT_NEEDS = "the comparison's plot needs"
+"""How the missing-matplotlib error begins (output.pyplot)."""
+
+
+def _plot(rows: list[dict], path: Path, quick: bool) -> None:
+    plt = pyplot(PLOT_NEEDS)
+    series = [s for s in SERIES if any(r["series"] == s for r in rows)]
+    fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 4.2), squeeze=False)
+    for ax, s in zip(axes[0], series):
+        rs = [r for r in rows if r["series"] == s]
+        x = [r["sun_zenith_deg"] if s == "zenith" else r["sqrt_wind"] for r in rs]
+        ax.errorbar(
+            x,
+            [r["measured_cv"] for r in rs],
+            yerr=[r["measured_cv_sd"] for r in rs],
+            fmt="ko",
+            capsize=3,
+            label="Gernez & Antoine 2009 (median ± sd)",
+        )
+        ax.errorbar(
+            x,
+            [r["model_cv"] for r in rs],
+            yerr=[r["model_cv_frame_sd"] for r in rs],
+            fmt="s-",
+            color="tab:blue",
+            capsize=3,
+            label="model as rendered (sky over its directions)",
+        )
+        ax.plot(
+            x,
+            [r["model_cv_uniform_sky"] for r in rs],
+            "v--",
+            color="tab:green",
+            label="model, sky as a uniform background",
+        )
+        ax.plot(
+            x,
+            [r["model_cv_uniform_sky_scattered"] for r in rs],
+            "^:",
+            color="tab:orange",
+            label="… and the sun's scattered light too",
+        )
+        if s == "zenith":
+            ax.set_xlabel("sun zenith angle [deg]")
+            ax.set_title("CV at 510 nm, 3.2 m, 8 mm collector")
+        else:
+            ax.set_xlabel("√(wind speed) [√(m/s)]")
+            ax.set_title(f"CV against the wind, sun zenith {WIND_SERIES_ZENITH_DEG:g}°")
+        ax.set_ylabel("CV of downwelling irradiance")
+        ax.set_ylim(bottom=0.0)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    if quick:
+        fig.suptitle("--quick: coarse check of the command, not a comparison", color="tab:red")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)

@@ -1,0 +1,649 @@
+"""Parameter sweeps: many scene variants and frames, in worker processes, resumable.
+
+A sweep TOML names a base scene and the keys to vary::
+
+    base = "../ocean.toml"            # relative to the sweep file
+    [set]                             # the same for every task
+    "water.resolution" = 64
+    [grid]                            # cartesian product
+    "optics.water_type" = ["clear_ocean", "coastal_ocean"]
+    "floor.depth_m" = [2.0, 5.0]
+    [zip]                             # varied together (equal lengths): one more grid axis
+    "sun.elevation_deg" = [30.0, 60.0]
+    "sun.azimuth_deg" = [0.0, 90.0]
+    [frames]                          # animation frames of every variant
+    count = 1
+    fps = 30.0
+    start_s = 0.0
+
+A task is a scene variant × frame for stateless water, and a whole variant (all its frames, in
+order) for the stateful pools. Its id hashes the resolved config, the frame time(s) and the package
+version, so a rerun recognises finished tasks. Each task renders into ``DIR/.<id>.tmp-<pid>/`` and
+that folder is renamed to ``DIR/<id>/`` only once complete. The driver alone appends to
+``DIR/manifest.jsonl`` (one JSON object per line, flushed and fsynced): a task whose id is recorded
+as done and whose folder exists is skipped on a rerun; anything else runs again. Leftover
+temporary folders of a killed run are removed at the start. Workers are separate processes (Warp's
+CPU launches run on one core each), and they die with the driver (parent-death signal plus a parent
+check), so a killed sweep leaves nothing writing.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import itertools
+import json
+import os
+import shutil
+import sys
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from warpcaustics import __version__
+from warpcaustics.config import config_to_dict, read_toml
+from warpcaustics.errors import ConfigError, WarpcausticsError
+
+MANIFEST = "manifest.jsonl"
+SUMMARY = "summary.csv"
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: a scene variant and the frame times it renders."""
+
+    id: str
+    overrides: dict[str, Any]
+    """Dotted overrides applied to the base scene (``set``, then the grid and zip values)."""
+    times_s: tuple[float, ...]
+    frame_start: int
+    """Index of the first frame (for file names)."""
+    error: str | None = None
+    """Why the variant cannot run (its overrides do not make a valid scene); recorded as failed."""
+    stateful: bool = False
+    """A pool animation: its frames step on from each other, with a checkpoint after each."""
+    config: dict | None = None
+    """The resolved configuration the id hashes (recorded in the manifest)."""
+
+
+@dataclass
+class Sweep:
+    base: Path
+    tasks: list[Task]
+    source: Path
+    varied: list[str] = field(default_factory=list)
+    """The grid and zip keys, in order (the study table's leading columns)."""
+
+
+def _values(table: Any, key: str) -> dict[str, list]:
+    if table is None:
+        return {}
+    if not isinstance(table, dict):
+        raise ConfigError(
+            f'sweep [{key}] must be a table of dotted keys, e.g. [{key}] "floor.depth_m" = [2.0]'
+        )
+    out = {}
+    for name, values in table.items():
+        if isinstance(values, dict):
+            raise ConfigError(f'sweep [{key}] {name!r} is a table; quote dotted keys: "{name}.…" = [...]')
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"sweep [{key}] {name!r} must be a non-empty list of values")
+        out[name] = values
+    return out
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Read a sweep TOML and expand it into tasks; every variant is validated before anything runs."""
+    path = Path(path)
+    table = read_toml(path)
+    unknown = set(table) - {"base", "set", "grid", "zip", "frames"}
+    if unknown:
+        raise ConfigError(f"sweep key(s) {sorted(unknown)} unknown; allowed: base, set, grid, zip, frames")
+    if not isinstance(table.get("base"), str):
+        raise ConfigError("sweep 'base' is missing; name the base scene, e.g. base = \"../ocean.toml\"")
+    base = (path.parent / table["base"]).resolve()
+    fixed = table.get("set", {})
+    if not isinstance(fixed, dict):
+        raise ConfigError("sweep [set] must be a table of dotted keys and values")
+    grid = _values(table.get("grid"), "grid")
+    zipped = _values(table.get("zip"), "zip")
+    lengths = {len(v) for v in zipped.values()}
+    if len(lengths) > 1:
+        raise ConfigError(f"sweep [zip] lists must have equal lengths; got {sorted(lengths)}")
+    frames = table.get("frames", {})
+    count = frames.get("count", 1)
+    fps = frames.get("fps", 30.0)
+    start = frames.get("start_s", 0.0)
+    if not isinstance(count, int) or isinstance(count, bool) or count < 1:
+        raise ConfigError(f"sweep frames.count = {count!r} must be a positive integer")
+    if not isinstance(fps, (int, float)) or not fps > 0:
+        raise ConfigError(f"sweep frames.fps = {fps!r} must be a positive number")
+    times = tuple(float(start) + i / float(fps) for i in range(count))
+    return expand_sweep(base, fixed, grid, zipped, times, path)
+
+
+def expand_sweep(
+    base: Path,
+    fixed: dict,
+    grid: dict[str, list],
+    zipped: dict[str, list],
+    times: tuple[float, ...],
+    source: Path,
+) -> Sweep:
+    """The tasks of a sweep: every ``grid`` combination (with the ``zip`` lists as one more axis)
+    applied after ``fixed``, each variant validated, and one task per frame time (a whole animation
+    for the stateful pools). Also used by commands that build their sweep in code
+    (``warpcaustics field``)."""
+    from warpcaustics.scene import load_scene
+
+    axes = [[(k, v) for v in values] for k, values in grid.items()]
+    if zipped:
+        axes.append([tuple(zip(zipped, combo)) for combo in zip(*zipped.values())])
+    tasks: list[Task] = []
+    for combo in itertools.product(*axes) if axes else [()]:
+        overrides = dict(fixed)
+        for item in combo:
+            pairs = item if isinstance(item[0], tuple) else (item,)
+            overrides.update(dict(pairs))
+        try:
+            scene = load_scene(base, overrides)
+        except ConfigError as exc:  # a bad variant fails alone; the rest of the sweep runs
+            tasks.append(Task(task_id({"overrides": overrides}, times), overrides, times, 0, str(exc)))
+            continue
+        resolved = config_to_dict(scene.config)
+        stateful = scene.config.water.stateful  # the pools: frame k steps on from frame k-1
+        groups = [times] if stateful else [(t,) for t in times]
+        for i, group in enumerate(groups):
+            tasks.append(
+                Task(
+                    task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
+                )
+            )
+    return Sweep(base, tasks, source, list(grid) + list(zipped))
+
+
+def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
+    """Stable id: SHA-256 of the resolved config, the frame times and the package version."""
+    text = json.dumps(
+        {"config": resolved_config, "times_s": times_s, "version": __version__}, sort_keys=True, default=str
+    )
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+# ---------------------------------------------------------------------------------------------
+# Workers
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """Worker initializer: end this process when the driver goes (Linux parent-death signal, plus
+    a thread that checks the parent every half second elsewhere)."""
+    import signal
+    import threading
+
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent_pid:
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
+    """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
+    if task.stateful:
+        return run_pool_task(base, task, out_dir, device)
+    from warpcaustics.io.output import frame_entry, save_frame, write_run_json
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.scene import load_scene
+
+    t0 = time.perf_counter()
+    final = Path(out_dir) / task.id
+    tmp = Path(out_dir) / f".{task.id}.tmp-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        renderer = Renderer(load_scene(base, task.overrides), device)
+        results = []
+        for k, t in enumerate(task.times_s):
+            result = renderer.render(t)
+            save_frame(result, tmp, frame=task.frame_start + k)
+            results.append(result)
+        entries = [frame_entry(task.frame_start + k, r) for k, r in enumerate(results)]  # as the files
+        write_run_json(tmp, results, frames=entries)
+        if final.exists():
+            shutil.rmtree(final)
+        os.replace(tmp, final)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return {
+        "rows": [summary_row(task, r, k, entries[k]["statistics"]) for k, r in enumerate(results)],
+        "seconds": time.perf_counter() - t0,
+        "device": results[0].device,
+    }
+
+
+CHECKPOINT = "checkpoint.npz"
+CHECKPOINT_META = "checkpoint.json"
+
+
+def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
+    """Render a pool animation into ``out_dir/.<id>.partial/``, checkpointing the pool's state after
+    every frame, and rename the folder to ``out_dir/<id>`` when all frames are done. A task that
+    was interrupted continues from its last checkpoint (same frames, bit for bit on one device)
+    instead of simulating from t = 0 again."""
+    import numpy as np
+
+    from warpcaustics.io.output import atomic_path, frame_entry, save_frame, write_json, write_run_json
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.scene import load_scene
+
+    t0 = time.perf_counter()
+    out = Path(out_dir)
+    final = out / task.id
+    partial = out / f".{task.id}.partial"
+    partial.mkdir(parents=True, exist_ok=True)
+    renderer = Renderer(load_scene(base, task.overrides), device)
+    entries: list[dict] = []
+    rows: list[dict] = []
+    meta_path = partial / CHECKPOINT_META
+    if meta_path.exists() and (partial / CHECKPOINT).exists():
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        with np.load(partial / CHECKPOINT) as data:
+            state = {name: data[name] for name in data.files}
+        if int(state.pop("frames_done")) == meta["frames_done"]:  # the pair was written together
+            state["time_s"] = float(state["time_s"])
+            renderer.water.load_state(state)
+            entries, rows = meta["entries"], meta["rows"]
+    result = None
+    for k in range(len(entries), len(task.times_s)):
+        result = renderer.render(task.times_s[k])
+        save_frame(result, partial, frame=task.frame_start + k)
+        entries.append(frame_entry(task.frame_start + k, result))
+        rows.append(summary_row(task, result, k, entries[-1]["statistics"]))
+        with atomic_path(partial / CHECKPOINT) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, frames_done=len(entries), **renderer.water.state())
+        write_json(meta_path, {"frames_done": len(entries), "entries": entries, "rows": rows})
+    if result is None:  # every frame was done before the interruption
+        result = renderer.render(task.times_s[-1])
+    write_run_json(partial, [result], frames=entries)
+    for name in (CHECKPOINT, CHECKPOINT_META):
+        (partial / name).unlink()
+    if final.exists():
+        shutil.rmtree(final)
+    os.replace(partial, final)
+    return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
+
+
+def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> dict:
+    """Summary statistics of one frame: per band mean and max floor irradiance, caustic contrast
+    (standard deviation / mean of the band-summed floor irradiance), photon counts, timings.
+    ``statistics``: the frame's run.json statistics, when already computed."""
+    import numpy as np
+
+    from warpcaustics.io.output import relative_l1
+
+    floor = result.floor_irradiance.astype(np.float64)
+    total = (floor * result.bin_widths_nm[:, None, None]).sum(axis=0)
+    row = {"id": task.id, "frame": task.frame_start + k, "time_s": result.time_s}
+    row.update({key: task.overrides[key] for key in sorted(task.overrides)})
+    for wl, band in zip(result.wavelengths_nm, floor):
+        row[f"mean_{wl:g}nm"] = float(band.mean())
+        row[f"max_{wl:g}nm"] = float(band.max())
+    row["floor_w_m2"] = float(total.mean())
+    row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
+    if statistics is None:
+        from warpcaustics.batch.stats import frame_statistics
+
+        statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
+    row["cv"] = statistics["irradiance_w_m2"]["cv"]
+    row["flash_fraction"] = statistics["irradiance_w_m2"]["flash_fraction"]
+    if "par_umol_m2_s" in statistics:
+        row["par_umol_m2_s"] = statistics["par_umol_m2_s"]["mean"]
+    if result.photon_stats:
+        row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
+    if result.beam_stats:
+        row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
+    if result.comparison is not None:  # "both" or "sunmap": how far the other method's floor map is
+        other = result.comparison
+        row[f"{result.method}_vs_{other.method}_l1"] = relative_l1(floor, other.floor_irradiance)
+    row["render_s"] = float(sum(result.timings_s.values()))
+    return row
+
+
+# ---------------------------------------------------------------------------------------------
+# Driver
+
+
+def read_manifest(out_dir: Path) -> dict[str, dict]:
+    """The last record of each task id (a line cut by a crash is ignored)."""
+    records: dict[str, dict] = {}
+    path = out_dir / MANIFEST
+    if path.exists():
+        for line in path.read_text(encoding="utf-8").splitlines():
+            try:
+                rec = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if isinstance(rec, dict) and "id" in rec:
+                records[rec["id"]] = rec
+    return records
+
+
+def _append(out_dir: Path, record: dict) -> None:
+    with open(out_dir / MANIFEST, "a", encoding="utf-8") as fh:
+        fh.write(json.dumps(record, default=str) + "\n")
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+@dataclass
+class SweepReport:
+    done: int = 0
+    skipped: int = 0
+    failed: list[tuple[str, str]] = field(default_factory=list)
+    seconds: float = 0.0
+
+
+class Progress:
+    """Progress of many tasks or frames: a tqdm bar with throughput and ETA on a terminal, one plain
+    line per step otherwise (logs, CI), nothing when quiet."""
+
+    def __init__(self, total: int, quiet: bool, unit: str = "task"):
+        self.total, self.quiet, self.count, self.t0 = total, quiet, 0, time.perf_counter()
+        self.bar = None
+        if not quiet and sys.stdout.isatty():
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, unit=unit, dynamic_ncols=True)
+
+    def step(self, text: str) -> None:
+        self.count += 1
+        if self.quiet:
+            return
+        if self.bar is not None:
+            self.bar.set_postfix_str(text[:60], refresh=False)
+            self.bar.update(1)
+            return
+        elapsed = time.perf_counter() - self.t0
+        rate = self.count / elapsed if elapsed > 0 else 0.0
+        eta = (self.total - self.count) / rate if rate > 0 else 0.0
+        print(f"[{self.count}/{self.total}] {text}  ({rate * 60:.1f}/min, ETA {eta:.0f} s)", flush=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def run_sweep(
+    sweep: Sweep,
+    out_dir: str | Path,
+    *,
+    workers: int = 1,
+    device: str | None = None,
+    quiet: bool = False,
+    executor: str = "local",
+    address: str | None = None,
+) -> SweepReport:
+    """Run every unfinished task of ``sweep`` into ``out_dir``: with a local process pool
+    (``executor = "local"``, ``workers`` processes) or on Ray (``"ray"``: the cluster at ``address``,
+    or a local instance of ``workers`` CPUs started and stopped here). Workers write the task
+    folders; the driver alone keeps the manifest."""
+    if executor not in ("local", "ray"):
+        raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
+    if workers < 1:
+        raise WarpcausticsError(f"--workers = {workers} must be at least 1")
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    for leftover in out.glob(".*.tmp-*"):  # a killed run's half-written tasks
+        shutil.rmtree(leftover, ignore_errors=True)
+    records = read_manifest(out)
+    report = SweepReport()
+    todo = []
+    for task in sweep.tasks:
+        if task.error is not None:
+            _append(
+                out,
+                {
+                    "id": task.id,
+                    "version": __version__,
+                    "overrides": task.overrides,
+                    "state": "failed",
+                    "error": task.error,
+                },
+            )
+            report.failed.append((task.id, task.error))
+            continue
+        rec = records.get(task.id)
+        if rec is not None and rec.get("state") == "done" and (out / task.id / "run.json").exists():
+            report.skipped += 1
+        else:
+            todo.append(task)
+    t0 = time.perf_counter()
+    progress = Progress(len(todo), quiet)
+
+    def finish(task: Task, outcome: dict | None, error: BaseException | None) -> None:
+        record = {
+            "id": task.id,
+            "version": __version__,
+            "config": task.config,
+            "overrides": task.overrides,
+            "times_s": list(task.times_s),
+        }
+        if error is not None:  # a failing task is recorded and the sweep goes on
+            message = _error_line(error)
+            _append(out, {**record, "state": "failed", "error": message})
+            report.failed.append((task.id, message))
+            progress.step(f"FAILED {task.id}: {message}")
+            return
+        _append(
+            out,
+            {
+                **record,
+                "state": "done",
+                "seconds": outcome["seconds"],
+                "device": outcome["device"],
+                "rows": outcome["rows"],
+            },
+        )
+        report.done += 1
+        progress.step(f"done {task.id} in {outcome['seconds']:.1f} s")
+
+    try:
+        if executor == "ray":
+            _run_on_ray(sweep, todo, out, workers, device, address, finish)
+        else:
+            _run_locally(sweep, todo, out, workers, device, finish)
+    finally:
+        progress.close()
+    report.seconds = time.perf_counter() - t0
+    write_summary(out, sweep)
+    return report
+
+
+def _error_line(error: BaseException) -> str:
+    """One line for a failed task; Ray's wrapped errors are unwrapped to their cause."""
+    cause = getattr(error, "cause", None)
+    if isinstance(cause, BaseException):
+        error = cause
+    text = str(error).strip()
+    return f"{type(error).__name__}: {text.splitlines()[0] if text else ''}"
+
+
+def _run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
+    import multiprocessing
+
+    context = multiprocessing.get_context("spawn")  # no forked Warp/CUDA state in the workers
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_die_with_parent, initargs=(os.getpid(),)
+    ) as pool:
+        pending = {pool.submit(run_task, str(sweep.base), task, str(out), device): task for task in todo}
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                task = pending.pop(future)
+                try:
+                    outcome = future.result()
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+
+
+def _run_on_ray(
+    sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, address: str | None, finish
+) -> None:
+    """One Ray task per sweep task (``num_gpus=1`` when rendering on CUDA); the workers write to
+    ``out``, which must be storage they share with the driver."""
+    try:
+        import ray
+    except ImportError:
+        raise WarpcausticsError("--executor ray needs Ray: pip install 'warpcaustics[ray]'") from None
+    started = not ray.is_initialized()
+    if started:
+        ray.init(
+            address=address,
+            num_cpus=None if address else workers,
+            include_dashboard=False,
+            log_to_driver=False,
+            configure_logging=False,
+        )
+    try:
+        gpus = 1 if device is not None and device.startswith("cuda") else 0
+        remote = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(run_task)
+        pending = {remote.remote(str(sweep.base), task, str(out.resolve()), device): task for task in todo}
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            for ref in ready:
+                task = pending.pop(ref)
+                try:
+                    outcome = ray.get(ref)
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def write_summary(out_dir: Path, sweep: Sweep) -> Path:
+    """``summary.csv`` (and ``summary.parquet`` if pyarrow is installed): one row per frame of the
+    sweep's finished tasks, in task order; written atomically."""
+    from warpcaustics.io.output import atomic_path, write_csv
+
+    records = read_manifest(out_dir)
+    rows = [
+        row
+        for task in sweep.tasks
+        if records.get(task.id, {}).get("state") == "done"
+        for row in records[task.id]["rows"]
+    ]
+    path = out_dir / SUMMARY
+    columns: list[str] = []
+    for row in rows:
+        columns += [c for c in row if c not in columns]
+    write_csv(path, rows, columns)
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return path
+    with atomic_path(out_dir / "summary.parquet") as tmp:
+        pq.write_table(pa.Table.from_pylist(rows), tmp)
+    return path
+
+
+def format_report(report: SweepReport) -> str:
+    lines = [
+        f"done {report.done}, skipped {report.skipped} (finished before), failed {len(report.failed)}"
+        f"  in {report.seconds:.1f} s"
+    ]
+    lines += [f"  failed {tid}: {msg}" for tid, msg in report.failed]
+    return "\n".join(lines)
+
+
+def sweep_main(
+    path: str,
+    out: str,
+    workers: int,
+    device: str | None,
+    quiet: bool,
+    executor: str = "local",
+    address: str | None = None,
+) -> int:
+    sweep = load_sweep(path)
+    report = run_sweep(
+        sweep, out, workers=workers, device=device, quiet=quiet, executor=executor, address=address
+    )
+    print(format_report(report), file=sys.stdout)
+    print(f"summary: {Path(out) / SUMMARY}")
+    return 1 if report.failed else 0
+
+
+def _short(text: str) -> str:
+    """A CSV cell for the printed table: floats to 4 significant digits."""
+    try:
+        value = float(text)
+    except ValueError:
+        return text
+    return text if value.is_integer() and "." not in text else f"{value:.4g}"
+
+
+def report_main(out: str) -> int:
+    """Print ``DIR/summary.csv`` as a table and plot the floor irradiance per task."""
+    path = Path(out) / SUMMARY
+    if not path.exists():
+        raise WarpcausticsError(
+            f"{str(path)!r} does not exist; run `warpcaustics sweep ... --out {out}` first"
+        )
+    with open(path, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        print("no finished tasks")
+        return 0
+    # The varied keys and the headline figures; per-band columns stay in the CSV.
+    fixed = {c for c in rows[0] if all(r[c] == rows[0][c] for r in rows)}
+    headline = {"id", "frame", "floor_w_m2", "contrast", "render_s"}
+    shown = [c for c in rows[0] if c in headline or (c not in fixed and not c.startswith(("mean_", "max_")))]
+    rows_shown = [{c: _short(r[c]) for c in shown} for r in rows]
+    widths = {c: max(len(c), *(len(r[c]) for r in rows_shown)) for c in shown}
+    print("  ".join(c.ljust(widths[c]) for c in shown))
+    for r in rows_shown:
+        print("  ".join(r[c].ljust(widths[c]) for c in shown))
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("(pip install warpcaustics[study] for the plot)")
+        return 0
+    from warpcaustics.io.output import atomic_path
+
+    fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(rows)), 4))
+    varied = [c for c in shown if c not in headline]
+    labels = ["/".join(_short(r[c]) for c in varied) or r["id"][:6] for r in rows]
+    ax.bar(range(len(rows)), [float(r["floor_w_m2"]) for r in rows])
+    ax.set_xticks(range(len(rows)), labels, rotation=90, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_ylabel("mean floor irradiance [W m$^{-2}$]")
+    ax.set_title(f"{len(rows)} frames of {Path(out).name}" + (f" ({' / '.join(varied)})" if varied else ""))
+    fig.tight_layout()
+    plot = Path(out) / "summary.png"
+    with atomic_path(plot) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
+    plt.close(fig)
+    print(f"plot: {plot}")
+    return 0

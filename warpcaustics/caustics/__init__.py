@@ -1,0 +1,2 @@
+"""Caustic methods: one module per ``caustics.method`` (flux ratio, photons, beams, sun map, eikonal,
+wave3d) and the multiple-scattering random walk."""

@@ -1,0 +1,295 @@
+"""Photon caustics (host side): emit, refract, intersect (BVH or Shah's iteration), deposit.
+
+See ``warpcaustics/kernels/photons.py`` for the method. The stage owns its photon buffers and the
+receivers' light view; both are reused from frame to frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from warpcaustics.config import Config, Intersection
+from warpcaustics.kernels.caustics import fluxratio as floor_kernels
+from warpcaustics.kernels.caustics import photons as photon_kernels
+from warpcaustics.optics.refraction import still_water_refraction
+from warpcaustics.scene.receivers import WALLS_ID, Receivers
+from warpcaustics.water import Surface
+
+PHOTON_BYTES = 12 + 12 + 4 + 12 + 4
+"""Per photon: origin, direction, weight, hit, face."""
+
+
+def photon_count(cfg: Config, n: int, groups: int, periodic: bool) -> int:
+    quads = n if periodic else n + 1
+    return groups * quads * quads * cfg.caustics.photon_subdivisions**2
+
+
+def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face_count: int) -> int:
+    """Device memory of the photon stage, receivers included [bytes]."""
+    m = cfg.caustics.map_resolution
+    r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
+    return (
+        photon_count(cfg, n, groups, periodic) * PHOTON_BYTES
+        + 2 * k * m * m * 4
+        + m * m * 4
+        + r * r * 16
+        + face_count * (k * 4 + 4 + 12 + 64)
+        + n * n * 4
+    )
+
+
+@dataclass
+class PhotonStats:
+    emitted: int
+    """Photons launched (all index groups)."""
+    carrying: int
+    """Photons with non-zero weight (lit from the front, refracted downwards)."""
+    landed: int
+    """Photons that found a receiver."""
+
+
+def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, ior: np.ndarray) -> None:
+    """On a periodic sea a photon is moved by whole periods so that, followed to the floor plane at
+    rest, it lands in the patch; a mesh only gets the light of photons whose path through it would
+    land there. Refuse meshes so near the patch edge that some of their light would be missed."""
+    from warpcaustics.errors import ConfigError
+
+    if not meshes:
+        return
+    half = 0.5 * cfg.water.extent_m
+    plane_z = -cfg.floor.depth_m
+    for i, mesh in enumerate(meshes):
+        worst = 0.0
+        for n in (float(np.min(ior)), float(np.max(ior))):
+            d = still_water_refraction(sun_dir, n)
+            drop = mesh.points[:, 2] - plane_z
+            landing = mesh.points[:, :2] + (drop / -d[2])[:, None] * d[None, :2]
+            # Waves tilt the rays: allow for a tenth of the drop either way, and 2 % of the patch.
+            margin = 0.1 * np.abs(drop) + 0.02 * cfg.water.extent_m
+            spots = np.concatenate([landing, mesh.points[:, :2]])
+            reach = np.max(np.abs(spots) + np.tile(margin, 2)[:, None])
+            worst = max(worst, float(reach - half))
+        if worst > 0.0:
+            raise ConfigError(
+                f"receivers[{i}] is {worst:.2f} m too near the edge of the periodic {cfg.water.extent_m:g} m "
+                "patch: part of the light that reaches it would land outside the patch and be missed; "
+                "move it towards the centre (receivers[].translate_m) or enlarge water.extent_m")
+
+
+def light_view_direction(sun_dir: np.ndarray, group_ior: np.ndarray) -> np.ndarray:
+    """The direction the Newton light view looks from: towards the sun as seen under still water,
+    i.e. minus the sun's refracted direction (mean index of the groups).
+
+    The receivers all lie in the water, where the photons run near this direction, so Shah's
+    iteration converges where a view along the sun in air does not: on the sphere of
+    tests/test_photons.py 98 % of the photons end within a texel of their exact hit, against 86 %
+    (docs/validation.md). A pool's walls are passed from outside (``render_light_view``)."""
+    return -still_water_refraction(sun_dir, float(np.mean(group_ior)))
+
+
+def light_view_frame(points: np.ndarray, view_dir: np.ndarray, resolution: int):
+    """(origin, u, v, texel) of an orthographic view along ``view_dir`` covering all ``points``;
+    u, v ⊥ ``view_dir`` and u × v = ``view_dir``."""
+    s = np.asarray(view_dir, np.float64)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(s[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(helper, s)
+    u /= np.linalg.norm(u)
+    v = np.cross(s, u)
+    a, b = points @ u, points @ v
+    span = max(np.ptp(a), np.ptp(b))
+    texel = span * (1.0 + 2.0 / resolution) / resolution
+    origin = u * (a.min() - texel) + v * (b.min() - texel)
+    return origin, u, v, texel
+
+
+class PhotonCaustics:
+    """Owns the photon stage's device buffers for one scene, reused from frame to frame."""
+
+    def __init__(
+        self,
+        cfg: Config,
+        receivers: Receivers,
+        n: int,
+        sun_irradiance: np.ndarray,
+        attenuation_per_m: np.ndarray,
+        group_ior: np.ndarray,
+        sun_dir: np.ndarray,
+        device: str,
+        *,
+        periodic: bool,
+    ):
+        """``sun_dir``: the sun's centre (the light view for the Newton guesses looks along its
+        refracted direction, and it is the photons' direction until :meth:`set_light`)."""
+        self.cfg = cfg
+        self.device = device
+        self.receivers = receivers
+        self.periodic = periodic
+        self.subdivisions = cfg.caustics.photon_subdivisions
+        self.quads = n if periodic else n + 1
+        groups = len(group_ior)
+        self.groups = groups
+        self.ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
+        """Refractive index of each index group (one, or one per band with dispersion)."""
+        count = photon_count(cfg, n, groups, periodic)
+        self.photons_per_group = count // groups
+        k = len(sun_irradiance)
+        m = cfg.caustics.map_resolution
+        self.sun_irradiance = wp.array(
+            np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device
+        )
+        self.attenuation_per_m = wp.array(
+            np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
+        )
+        self.origin = wp.empty(count, dtype=wp.vec3, device=device)
+        self.direction = wp.empty(count, dtype=wp.vec3, device=device)
+        self.weight = wp.empty(count, dtype=wp.float32, device=device)
+        """A⊥·T per photon [m²]."""
+        self.hit = wp.empty(count, dtype=wp.vec3, device=device)
+        self.face = wp.empty(count, dtype=wp.int32, device=device)
+        self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
+        self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
+        """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
+        other_faces = max(receivers.face_count - receivers.floor_face_count, 1)
+        self.face_flux = wp.empty((other_faces, k), dtype=wp.float32, device=device)
+        """Flux on each non-floor face (F_other, K) [W nm^-1]."""
+        self.floor_inv_area = wp.array(
+            (1.0 / receivers.floor_texel_area_m2).astype(np.float32), dtype=wp.float32, device=device
+        )
+        sun = np.asarray(sun_dir, np.float64)
+        self.light_dir = wp.vec3(*sun.astype(np.float32))  # the photons' direction (set per pass)
+        # A flat-floor plane for moving periodic photons by whole periods before they are traced.
+        self.plane_z = -cfg.floor.depth_m
+        self.view = self._light_view(
+            light_view_direction(sun, group_ior),
+            cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 1,
+        )
+        self.newton_iterations = (
+            cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
+        )
+
+    def _light_view(self, view_dir: np.ndarray, resolution: int) -> photon_kernels.LightView:
+        # The view needs the receivers where photons land: on a periodic sea that is the patch
+        # (photons are moved by whole periods first), not the floor's margin beyond it.
+        points = self.receivers.points
+        if self.periodic:
+            reach = 0.55 * self.cfg.water.extent_m
+            points = points[
+                np.all(np.abs(points[:, :2]) <= reach, axis=1)
+                | (np.arange(len(points)) >= self.receivers.floor_vertex_count)
+            ]
+        origin, u, v, texel = light_view_frame(points, view_dir, resolution)
+        view = photon_kernels.LightView()
+        view.origin = wp.vec3(*origin.astype(np.float32))
+        view.u = wp.vec3(*u.astype(np.float32))
+        view.v = wp.vec3(*v.astype(np.float32))
+        view.texel_m = float(texel)
+        view.positions = wp.empty((resolution, resolution), dtype=wp.vec3, device=self.device)
+        view.faces = wp.empty((resolution, resolution), dtype=wp.int32, device=self.device)
+        if resolution > 1:
+            distance = float(np.abs(self.receivers.points @ view_dir).max() + 1.0)
+            wp.launch(
+                photon_kernels.render_light_view,
+                dim=(resolution, resolution),
+                inputs=[self.receivers.mesh.id, self.receivers.face_receiver, WALLS_ID,
+                        wp.vec3(*view_dir.astype(np.float32)), distance, view],
+                device=self.device,
+            )
+        return view
+
+    def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:
+        """Emit, trace and deposit every photon; fills :attr:`irradiance` and :attr:`face_flux`."""
+        dev = self.device
+        s = self.subdivisions
+        ior = self.ior
+        extent = float(surface.extent_m)
+        wp.launch(
+            photon_kernels.emit_photons,
+            dim=(self.groups, self.quads, self.quads, s * s),
+            inputs=[
+                surface.positions,
+                surface.normals,
+                visible,
+                ior,
+                self.light_dir,
+                s,
+                extent,
+                int(self.periodic),
+            ],
+            outputs=[self.origin, self.direction, self.weight],
+            device=dev,
+        )
+        wp.launch(
+            photon_kernels.trace_photons,
+            dim=self.weight.shape[0],
+            inputs=[
+                self.receivers.mesh.id,
+                self.view,
+                self.receivers.face_receiver,
+                self.newton_iterations,
+                extent,
+                int(self.periodic),
+                float(self.plane_z),
+                self.origin,
+                self.direction,
+                self.weight,
+            ],
+            outputs=[self.hit, self.face],
+            device=dev,
+        )
+        self.texels.zero_()
+        self.face_flux.zero_()
+        k = self.sun_irradiance.shape[0]
+        wp.launch(
+            photon_kernels.deposit_photons,
+            dim=self.weight.shape[0],
+            inputs=[
+                self.hit,
+                self.face,
+                self.origin,
+                self.weight,
+                self.photons_per_group,
+                self.sun_irradiance,
+                self.attenuation_per_m,
+                k // self.groups,
+                self.receivers.floor_face_count,
+                extent,
+                int(self.periodic),
+                self.floor_inv_area,
+            ],
+            outputs=[self.texels, self.face_flux],
+            device=dev,
+        )
+        m = self.texels.shape[0]
+        wp.launch(
+            floor_kernels.texels_to_bands,
+            dim=(m, m),
+            inputs=[self.texels],
+            outputs=[self.irradiance],
+            device=dev,
+        )
+        return self.irradiance
+
+    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
+        """Emit the next :meth:`run`'s photons from ``direction`` (3,) (towards a point of the sun's
+        disk, or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
+        [W m⁻² nm⁻¹]; the renderer adds the passes up. One direction per pass: a photon's lattice
+        neighbours must share its direction, or the camera's lattice splats draw a pattern."""
+        self.light_dir = wp.vec3(*np.asarray(direction, np.float32))
+        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
+
+    def transmitted_flux(self) -> np.ndarray:
+        """(K,) flux the photons carry into the water before attenuation [W nm^-1] (float64)."""
+        w = self.weight.numpy().astype(np.float64).reshape(self.groups, -1).sum(axis=1)
+        e = self.sun_irradiance.numpy().astype(np.float64)
+        return e * np.repeat(w, len(e) // self.groups)
+
+    def stats(self) -> PhotonStats:
+        w = self.weight.numpy()
+        return PhotonStats(
+            emitted=len(w),
+            carrying=int(np.count_nonzero(w > 0)),
+            landed=int(np.count_nonzero(self.face.numpy() >= 0)),
+        )

@@ -1,0 +1,139 @@
+"""A validated scene: the configuration plus what it refers to (a height-field file)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from warpcaustics.config import (
+    Config,
+    FloorShape,
+    WaterModel,
+    config_from_dict,
+    read_toml,
+)
+from warpcaustics.scene.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
+from warpcaustics.water.heights import DEFAULT_RESOLUTION, load_heights
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything a render needs besides time and device; build it with :func:`load_scene`."""
+
+    config: Config
+    base_dir: Path = field(default_factory=Path.cwd)
+    """Folder that relative paths in the config start from."""
+    heights: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``water.file``'s heights [m] for ``water.model = "heightfield"``."""
+    source: str | None = None
+    """The file the scene came from, if any."""
+    floor_relief: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``floor.file``'s relief [m] for ``floor.shape = "file"``."""
+    receiver_meshes: tuple = field(default=(), repr=False, compare=False)
+    """The ``[[receivers]]`` meshes in world space (:class:`warpcaustics.scene.receivers.TriangleMesh`)."""
+
+    @property
+    def water_resolution(self) -> int:
+        return self.config.water.resolution
+
+    def sun_disk_directions(self) -> np.ndarray:
+        """(S, 3) unit directions over the sun's disk, each standing for an equal solid angle: a
+        sunflower pattern (radius ρ√((i + ½)/h), turns of the golden angle) of h = S/2 points and
+        their mirror images through the centre, so the pattern's centroid is the sun's centre and
+        the first-order error of the sampling cancels; the centre alone for a point sun."""
+        sun = self.config.sun
+        s = self.sun_direction
+        if sun.angular_diameter_deg <= 0.0:
+            return s[None]
+        count = max(1, sun.disk_samples // 2)
+        radius = 0.5 * math.radians(sun.angular_diameter_deg)
+        u = np.cross(s, [0.0, 0.0, 1.0] if abs(s[2]) < 0.9 else [1.0, 0.0, 0.0])
+        u /= np.linalg.norm(u)
+        v = np.cross(s, u)
+        i = np.arange(count) + 0.5
+        r = radius * np.sqrt(i / count)
+        phi = i * math.pi * (3.0 - math.sqrt(5.0))
+        around = np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * v
+        around = np.concatenate([around, -around])
+        r = np.concatenate([r, r])
+        d = np.cos(r)[:, None] * s + np.sin(r)[:, None] * around
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+    def sky_directions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(K, 3) unit directions towards the sky and (K,) the share of the sky's horizontal
+        irradiance each carries on a plane perpendicular to it, 1/(K cosθ): cosine-weighted
+        stratified samples (sinθ = √((j + ½)/K), turns of the golden angle), so for a uniform sky
+        each direction brings 1/K of the horizontal irradiance."""
+        count = self.config.sky.directions
+        j = np.arange(count) + 0.5
+        sin_t = np.sqrt(j / count)
+        cos_t = np.sqrt(1.0 - sin_t * sin_t)
+        phi = j * math.pi * (3.0 - math.sqrt(5.0))
+        d = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
+        return d, 1.0 / (count * cos_t)
+
+    def sky_irradiance(self, sun_irradiance: np.ndarray) -> np.ndarray:
+        """(K,) the sky's horizontal spectral irradiance [W m⁻² nm⁻¹]: ``sky.diffuse_fraction`` f of
+        the global, the sun's direct beam E_sun sin(elevation) the rest, so E_sky = f/(1 − f) ×
+        that beam (the sky takes the sun's spectral shape: a simplification)."""
+        f = self.config.sky.diffuse_fraction
+        elevation = math.radians(self.config.sun.elevation_deg)
+        return f / (1.0 - f) * np.asarray(sun_irradiance, np.float64) * math.sin(elevation)
+
+    @property
+    def sun_direction(self) -> np.ndarray:
+        """Unit vector towards the sun (z up; azimuth from +x towards +y)."""
+        el = math.radians(self.config.sun.elevation_deg)
+        az = math.radians(self.config.sun.azimuth_deg)
+        return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+
+
+def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) -> Scene:
+    """Load what the config refers to and fill in ``water.resolution`` (file shape or default)."""
+    heights = None
+    n = cfg.water.resolution or DEFAULT_RESOLUTION
+    if cfg.water.model is WaterModel.HEIGHTFIELD:
+        path = Path(cfg.water.file)
+        heights = load_heights(path if path.is_absolute() else base_dir / path, cfg.water.resolution)
+        n = heights.shape[0]
+    cfg = dataclasses.replace(cfg, water=dataclasses.replace(cfg.water, resolution=n))
+    _check_spectral_data(cfg, base_dir)
+    relief = None
+    if cfg.floor.shape is FloorShape.FILE:
+        path = Path(cfg.floor.file)
+        relief = load_floor_relief(path if path.is_absolute() else base_dir / path)
+    meshes = tuple(load_receiver_mesh(r, base_dir, f"receivers[{i}]") for i, r in enumerate(cfg.receivers))
+    if cfg.caustics.method.uses_receivers:
+        from warpcaustics.optics import spectra
+
+        receiver_albedos(cfg, spectra.bins_for(cfg.optics), base_dir)  # bad albedo files fail at load
+    return Scene(cfg, base_dir, heights, source, relief, meshes)
+
+
+def _check_spectral_data(cfg: Config, base_dir: Path) -> None:
+    """Fail at load time, not at render time, when the bins leave the optical data's range or
+    the sun's spectrum cannot be read."""
+    from warpcaustics.optics import spectra
+    from warpcaustics.optics.colour import bin_cmfs
+
+    bins = spectra.bins_for(cfg.optics)
+    spectra.sun_irradiance(bins, cfg.sun, base_dir)
+    bin_cmfs(bins)  # the colour-matching functions must cover the bins too
+    spectra.water_optics(cfg.optics, bins)
+
+
+def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Scene:
+    """Read and validate a TOML scene; ``overrides`` maps dotted keys to values.
+
+    ``load_scene(None, {...})`` builds a scene from the defaults and the overrides alone.
+    Raises :class:`warpcaustics.errors.ConfigError` with a one-line message on any bad input.
+    """
+    table = read_toml(path) if path is not None else {}
+    cfg = config_from_dict(table, overrides)
+    base = Path(path).resolve().parent if path is not None else Path.cwd()
+    return scene_from_config(cfg, base, str(path) if path is not None else None)
