@@ -1,6 +1,6 @@
 """Wave caustic texture (after Mercier 2013, §4): the 3-D wave equation driven from the interface.
 
-On the eikonal grid (``kernels/eikonal.py``: N×N columns, layers h apart, the frozen layers at and
+On the eikonal grid (``kernels/caustics/eikonal.py``: N×N columns, layers h apart, the frozen layers at and
 just under the surface), a scalar wave u obeys u_tt = v² ∇²u − σ u_t with v = 1/n_w (time is
 measured in metres of optical path, so the phase of the sunlight is ω(t − φ)). The frozen nodes
 are driven with the refracted plane wave, u = ramp(t) √I₀ sin(ω(t − φ_ext)), I₀ the refracted
