@@ -1,0 +1,67 @@
+"""``[sun]`` and ``[sky]``: the light falling on the water."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+from warpcaustics.config.fields import _range
+
+
+class SunSpectrum(str, enum.Enum):
+    ASTM_G173 = "astm_g173"
+    D65 = "d65"
+    BLACKBODY = "blackbody"
+    FILE = "file"
+
+
+class SkyModel(str, enum.Enum):
+    NONE = "none"
+    UNIFORM = "uniform"
+
+
+@dataclass(frozen=True)
+class SunConfig:
+    elevation_deg: float = field(default=60.0, metadata=_range(0.0, 90.0, lo_open=True))
+    """Angle of the sun above the horizon [deg]."""
+    azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Direction towards the sun, from +x towards +y [deg]."""
+    angular_diameter_deg: float = field(default=0.53, metadata=_range(0.0, 5.0))
+    """Angular diameter of the sun's disk [deg]: 0 = a point; 0.53 = the real sun, integrated over
+    ``disk_samples`` directions (every method but ``sunmap``, which draws this disk in its sun map)."""
+    disk_samples: int = field(default=16, metadata=_range(2, 1024))
+    """Directions over the sun's disk (equal solid angles: a sunflower pattern and its mirror
+    image; an odd number is rounded down to even) [-]."""
+    spectrum: SunSpectrum = SunSpectrum.ASTM_G173
+    """Shape of the sun's spectrum: ``astm_g173`` (direct + circumsolar, absolute), ``d65``,
+    ``blackbody`` (at ``temperature_k``) or ``file`` (``sun.file``)."""
+    temperature_k: float = field(default=5778.0, metadata=_range(1000.0, 100000.0))
+    """Temperature of the ``blackbody`` spectrum [K]."""
+    file: str | None = None
+    """CSV of the ``file`` spectrum: a header line, then wavelength [nm], spectral irradiance
+    (any scale); relative paths start at the config file's folder."""
+    datetime: str | None = None
+    """Date and time with UTC offset (ISO 8601, e.g. ``2009-07-14T11:30:00+02:00``): with
+    ``latitude_deg`` and ``longitude_deg`` it sets elevation and azimuth (pvlib's SPA; the
+    ``science`` extra). Give either this or ``elevation_deg``/``azimuth_deg``."""
+    latitude_deg: float | None = field(default=None, metadata=_range(-90.0, 90.0))
+    """Latitude of the site, north positive [deg]."""
+    longitude_deg: float | None = field(default=None, metadata=_range(-180.0, 180.0))
+    """Longitude of the site, east positive [deg]."""
+    irradiance_w_m2: float = field(default=0.0, metadata=_range(0.0, 1.0e5))
+    """Sun irradiance on a plane perpendicular to the beam, integrated over the render's
+    wavelengths [W/m²]; 0 = that of ASTM G173 direct + circumsolar over the same range."""
+
+
+@dataclass(frozen=True)
+class SkyConfig:
+    model: SkyModel = SkyModel.NONE
+    """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky; every
+    method but ``sunmap``). ``cie_clear`` is planned: it waits for a sourced table of the CIE
+    standard skies (colour-science's ``sky_luminance_distribution_CIE2003`` is in no release
+    yet)."""
+    diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
+    """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
+    (``sun.*``) is the rest [-]."""
+    directions: int = field(default=64, metadata=_range(1, 4096))
+    """Directions the sky is integrated over (cosine-weighted, stratified) [-]."""
