@@ -6,25 +6,14 @@ so ``XYZ = Σ_k E_k · cmf_k · Δλ_k`` is the bin-wise integral of the spectru
 
 from __future__ import annotations
 
-import functools
-import warnings
-
 import numpy as np
 
-from warpcaustics.optics.spectra import SpectralBins
-
-
-@functools.cache
-def _colour():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        import colour
-    return colour
+from warpcaustics.optics.spectra import SpectralBins, colour_science
 
 
 def bin_cmfs(bins: SpectralBins) -> np.ndarray:
     """(K, 3) CIE 1931 2° colour matching functions averaged over each bin."""
-    cmfs = _colour().MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    cmfs = colour_science().MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     wl = cmfs.wavelengths
     return np.stack([bins.average(wl, cmfs.values[:, i], what="CIE 1931 CMF") for i in range(3)], axis=1)
 
@@ -40,7 +29,7 @@ D65_XY = (0.3127, 0.3290)
 
 
 def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
-    colour = _colour()
+    colour = colour_science()
     return colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
 
 
@@ -51,7 +40,7 @@ def xyz_to_linear_rgb(xyz: np.ndarray, colourspace: str, white_xyz: np.ndarray |
     spectrum), adapted to D65 by the von Kries transform with CAT02; None keeps colours as a
     D65-adapted observer sees them. XYZ taken as D65-adapted is carried to ACEScg's white by CAT02.
     """
-    colour = _colour()
+    colour = colour_science()
     if white_xyz is not None:
         d65 = colour.xy_to_XYZ(np.array(D65_XY)) * white_xyz[1]
         xyz = colour.chromatic_adaptation(xyz, white_xyz, d65, method="Von Kries", transform="CAT02")
@@ -66,5 +55,5 @@ def tone_map_srgb8(linear_rgb: np.ndarray, luminance: np.ndarray, exposure_ev: f
     mean = float(np.mean(luminance))
     scale = (0.25 / mean if mean > 0 else 1.0) * 2.0**exposure_ev
     mapped = 1.0 - np.exp(-np.clip(linear_rgb * scale, 0.0, None) * 1.5)
-    encoded = _colour().cctf_encoding(mapped, function="sRGB")
+    encoded = colour_science().cctf_encoding(mapped, function="sRGB")
     return np.clip(np.round(encoded * 255.0), 0, 255).astype(np.uint8)

@@ -36,6 +36,16 @@ _SAMPLES_PER_NM = 10  # integration points per nm for bin averages of linear int
 
 
 @functools.cache
+def colour_science():
+    """The ``colour`` module of colour-science, imported on first use so that ``import warpcaustics``
+    stays light; the warnings it gives on import (optional packages it lacks) are silenced."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import colour
+    return colour
+
+
+@functools.cache
 def _table(name: str, column: str) -> tuple[np.ndarray, np.ndarray]:
     path = DATA_DIR / name
     header = path.read_text(encoding="utf-8").splitlines()[0].split(",")
@@ -139,8 +149,7 @@ def spectral_distribution(wavelength_nm: np.ndarray, values: np.ndarray, name: s
     """A table as a ``colour.SpectralDistribution`` interpolated linearly between its points (the
     sources' own resolution, nothing invented between them; colour-science's default for regular
     tables, Sprague, is a higher-order polynomial that can overshoot between the points)."""
-    import colour
-
+    colour = colour_science()
     return colour.SpectralDistribution(
         np.asarray(values, dtype=np.float64),
         np.asarray(wavelength_nm, dtype=np.float64),
@@ -192,15 +201,11 @@ def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
     if sun.spectrum is SunSpectrum.ASTM_G173:
         shape = astm
     elif sun.spectrum is SunSpectrum.D65:
-        from warpcaustics.optics.colour import _colour
-
-        d65 = _colour().SDS_ILLUMINANTS["D65"]
+        d65 = colour_science().SDS_ILLUMINANTS["D65"]
         shape = bins.average(d65.wavelengths, d65.values, what="CIE D65")
     elif sun.spectrum is SunSpectrum.BLACKBODY:
-        from warpcaustics.optics.colour import _colour
-
         fine = bins.fine_grid()
-        planck = _colour().colorimetry.planck_law(fine * 1e-9, sun.temperature_k)
+        planck = colour_science().colorimetry.planck_law(fine * 1e-9, sun.temperature_k)
         shape = bins.average(fine, planck, what="Planck")
     else:
         shape = bins.average(*read_spectrum_csv(sun.file, base_dir), what=f"sun.file {sun.file!r}")

@@ -17,8 +17,8 @@ from warpcaustics.config import (
     config_from_dict,
     read_toml,
 )
+from warpcaustics.scene.heights import DEFAULT_RESOLUTION, load_heights
 from warpcaustics.scene.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
-from warpcaustics.water.heights import DEFAULT_RESOLUTION, load_heights
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """The shallow-water pool (host side): a stateful surface that steps forward in time.
 
 Sandberg's "Navier–Stokes water" dynamic pool: depth-averaged mass and momentum with gravity and
-viscosity (``kernels/pool.py``), reflecting walls at ±L/2, drops at given times and places, and a
+viscosity (``kernels/water/pool.py``), reflecting walls at ±L/2, drops at given times and places, and a
 disc-shaped body moving on a circular path that drags the water under it towards its velocity. Each
 call to :meth:`ShallowWaterPool.at` advances the state to the asked time with CFL-limited
 substeps, so an animation steps frame k from frame k−1 instead of re-simulating from t = 0.
@@ -14,10 +14,11 @@ import math
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import BodyConfig, Config, DropConfig
-from warpcaustics.errors import WarpcausticsError
+from warpcaustics.config import BodyConfig, Config, DropConfig, FloorShape
+from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.kernels.water import pool as pool_kernels
-from warpcaustics.water import Surface
+from warpcaustics.scene.receivers import floor_relief_height
+from warpcaustics.water.surface import FLOAT32_BYTES, SURFACE_BYTES_PER_VERTEX, Surface, surface_arrays
 
 MAX_SUBSTEPS_PER_CALL = 1_000_000
 SPEED_REFRESH_SUBSTEPS = 4
@@ -81,8 +82,7 @@ class WalledPool:
     def _surface(self, height: wp.array2d, floor_depth: wp.array2d) -> Surface:
         """Surface of elevation ``height − floor_depth`` at the cell centres, walled."""
         n = height.shape[0]
-        positions = wp.empty((n, n), dtype=wp.vec3, device=self.device)
-        normals = wp.empty((n, n), dtype=wp.vec3, device=self.device)
+        positions, normals = surface_arrays(n, self.device)
         wp.launch(pool_kernels.pool_surface, dim=(n, n), inputs=[height, floor_depth, self.extent_m],
                   outputs=[positions, normals], device=self.device)
         return Surface(positions, normals, self.extent_m, periodic=False)
@@ -91,10 +91,6 @@ class WalledPool:
 def floor_depth_map(cfg: Config, floor_relief: np.ndarray | None) -> np.ndarray | float:
     """Water depth at rest at the pool's cell centres [m]: ``floor.depth_m`` on a flat floor, else
     minus the floor relief's height there. Raises a ConfigError where the floor reaches the water."""
-    from warpcaustics.config import FloorShape
-    from warpcaustics.errors import ConfigError
-    from warpcaustics.scene.receivers import floor_relief_height
-
     if cfg.floor.shape is FloorShape.FLAT:
         return cfg.floor.depth_m
     n, extent = cfg.water.resolution, cfg.water.extent_m
@@ -143,12 +139,19 @@ class ShallowWaterPool(WalledPool):
         self._drop_water(0.0)
 
     @classmethod
-    def from_config(cls, cfg: Config, device: str,
+    def from_config(cls, cfg: Config, device: str, *, heights: np.ndarray | None = None,
                     floor_relief: np.ndarray | None = None) -> ShallowWaterPool:
         """The pool of ``cfg``; its depth map follows ``floor.shape`` (the floor the photons light)."""
         w = cfg.water
         return cls(w.resolution, w.extent_m, floor_depth_map(cfg, floor_relief), device,
                    viscosity_m2_s=w.viscosity_m2_s, cfl=w.cfl, drops=w.drops, body=w.body)
+
+    @staticmethod
+    def device_bytes(n: int, device) -> int:
+        cells = 3 * n * n  # floor depth, h and the next h
+        faces = 4 * n * (n + 1)  # u, v and their advected copies (on the cells' faces)
+        speed = 1  # the maximum wave speed, read back for the CFL limit
+        return (cells + faces + speed) * FLOAT32_BYTES + n * n * SURFACE_BYTES_PER_VERTEX
 
     def body_state(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Centre [m] and velocity [m/s] of the body at ``time_s`` on its circular path."""

@@ -1,6 +1,6 @@
 """The wave-equation pool (host side): Mercier's Gaussian bump, the webgl-water kind of pool.
 
-A damped linear wave equation on the surface elevation η (``kernels/pool.py:wave_equation_step``)
+A damped linear wave equation on the surface elevation η (``kernels/water/pool.py:wave_equation_step``)
 with reflecting walls; drops add Gaussian bumps. Like the shallow-water pool it is stateful: each
 frame steps on from the previous one.
 """
@@ -14,8 +14,8 @@ import warp as wp
 
 from warpcaustics.config import Config, DropConfig
 from warpcaustics.kernels.water import pool as pool_kernels
-from warpcaustics.water import GRAVITY_M_S2, Surface
 from warpcaustics.water.pool import WalledPool
+from warpcaustics.water.surface import FLOAT32_BYTES, GRAVITY_M_S2, SURFACE_BYTES_PER_VERTEX, Surface
 
 
 class WaveEquationPool(WalledPool):
@@ -42,10 +42,15 @@ class WaveEquationPool(WalledPool):
         self._drop_bumps(0.0)
 
     @classmethod
-    def from_config(cls, cfg: Config, device: str) -> WaveEquationPool:
+    def from_config(cls, cfg: Config, device: str, *, heights: np.ndarray | None = None,
+                    floor_relief: np.ndarray | None = None) -> WaveEquationPool:
         w = cfg.water
         return cls(w.resolution, w.extent_m, cfg.floor.depth_m, device, wave_speed_m_s=w.wave_speed_m_s,
                    damping_per_s=w.damping_per_s, cfl=w.cfl, drops=w.drops)
+
+    @staticmethod
+    def device_bytes(n: int, device) -> int:
+        return n * n * (4 * FLOAT32_BYTES + SURFACE_BYTES_PER_VERTEX)  # η, η⁻, η⁺, zero depth; the surface
 
     @property
     def resolution(self) -> int:

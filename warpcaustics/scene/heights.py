@@ -1,4 +1,4 @@
-"""Reading ``water.file`` height fields (no Warp needed, so configs validate quickly)."""
+"""Reading ``water.file`` height fields, an input of the scene like ``floor.file`` (numpy only)."""
 
 from __future__ import annotations
 
