@@ -126,7 +126,8 @@ def _render(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
 
-    from warpcaustics.io.output import save_frame, write_run_json
+    from warpcaustics.io.frame import save_frame
+    from warpcaustics.io.run_json import write_run_json
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
@@ -214,7 +215,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
-    from warpcaustics.io.output import versions
+    from warpcaustics.io.files import versions
 
     for name, version in versions().items():
         print(f"{name:16s}{version}")

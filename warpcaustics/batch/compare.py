@@ -77,7 +77,10 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
 def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Path]:
     """compare.json, compare.csv, compare.png and each method's frame (EXR, PNG, run.json) in
     ``out/<method>/``."""
-    from warpcaustics.io.output import save_frame, write_csv, write_png, write_run_json
+    from warpcaustics.io.files import write_csv
+    from warpcaustics.io.frame import save_frame
+    from warpcaustics.io.png import write_png
+    from warpcaustics.io.run_json import write_run_json
     from warpcaustics.optics import colour as colour_out
 
     out.mkdir(parents=True, exist_ok=True)

@@ -29,7 +29,7 @@ import numpy as np
 
 from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
-from warpcaustics.io.output import atomic_path, pyplot, write_csv
+from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 SERIES = ("zenith", "wind")
 
@@ -259,7 +259,7 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
 
 
 PLOT_NEEDS = "the comparison's plot needs"
-"""How the missing-matplotlib error begins (output.pyplot)."""
+"""How the missing-matplotlib error begins (io.files.pyplot)."""
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:

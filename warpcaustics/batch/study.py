@@ -16,7 +16,7 @@ import numpy as np
 
 from warpcaustics.config import WaterType, read_toml
 from warpcaustics.errors import ConfigError
-from warpcaustics.io.output import atomic_path, pyplot, write_csv
+from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 STUDY_KEYS = {"scene", "water_types", "depths_m", "sun_elevations_deg", "overrides"}
 
@@ -89,7 +89,7 @@ def floor_colour_hex(spectrum: np.ndarray, bins) -> str:
     xyz = colour_out.spectral_to_xyz(spectrum[:, None, None], bins)[0, 0]
     rgb = np.clip(colour_out.xyz_to_linear_srgb(xyz / max(xyz[1], 1e-30)), 0.0, None)
     rgb = rgb / max(rgb.max(), 1.0)
-    encoded = colour_out._colour().cctf_encoding(rgb, function="sRGB")
+    encoded = colour_out.colour_science().cctf_encoding(rgb, function="sRGB")
     return "#" + "".join(f"{int(round(v * 255)):02x}" for v in encoded)
 
 

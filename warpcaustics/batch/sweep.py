@@ -25,6 +25,9 @@ as done and whose folder exists is skipped on a rerun; anything else runs again.
 temporary folders of a killed run are removed at the start. Workers are separate processes (Warp's
 CPU launches run on one core each), and they die with the driver (parent-death signal plus a parent
 check), so a killed sweep leaves nothing writing.
+
+This module reads and expands sweeps and drives them; ``batch/worker.py`` renders one task,
+``batch/executors.py`` runs the tasks on a local process pool or on Ray.
 """
 
 from __future__ import annotations
@@ -37,14 +40,15 @@ import os
 import shutil
 import sys
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from warpcaustics import __version__
+from warpcaustics.batch.executors import run_locally, run_on_ray
 from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.io.files import atomic_path, write_csv
 
 MANIFEST = "manifest.jsonl"
 SUMMARY = "summary.csv"
@@ -170,154 +174,6 @@ def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
         {"config": resolved_config, "times_s": times_s, "version": __version__}, sort_keys=True, default=str
     )
     return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-# ---------------------------------------------------------------------------------------------
-# Workers
-
-
-def _die_with_parent(parent_pid: int) -> None:
-    """Worker initializer: end this process when the driver goes (Linux parent-death signal, plus
-    a thread that checks the parent every half second elsewhere)."""
-    import signal
-    import threading
-
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
-
-    def watch() -> None:
-        while True:
-            if os.getppid() != parent_pid:
-                os._exit(1)
-            time.sleep(0.5)
-
-    threading.Thread(target=watch, daemon=True).start()
-
-
-def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
-    """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
-    if task.stateful:
-        return run_pool_task(base, task, out_dir, device)
-    from warpcaustics.io.output import frame_entry, save_frame, write_run_json
-    from warpcaustics.pipeline import Renderer
-    from warpcaustics.scene import load_scene
-
-    t0 = time.perf_counter()
-    final = Path(out_dir) / task.id
-    tmp = Path(out_dir) / f".{task.id}.tmp-{os.getpid()}"
-    shutil.rmtree(tmp, ignore_errors=True)
-    try:
-        renderer = Renderer(load_scene(base, task.overrides), device)
-        results = []
-        for k, t in enumerate(task.times_s):
-            result = renderer.render(t)
-            save_frame(result, tmp, frame=task.frame_start + k)
-            results.append(result)
-        entries = [frame_entry(task.frame_start + k, r) for k, r in enumerate(results)]  # as the files
-        write_run_json(tmp, results, frames=entries)
-        if final.exists():
-            shutil.rmtree(final)
-        os.replace(tmp, final)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return {
-        "rows": [summary_row(task, r, k, entries[k]["statistics"]) for k, r in enumerate(results)],
-        "seconds": time.perf_counter() - t0,
-        "device": results[0].device,
-    }
-
-
-CHECKPOINT = "checkpoint.npz"
-CHECKPOINT_META = "checkpoint.json"
-
-
-def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
-    """Render a pool animation into ``out_dir/.<id>.partial/``, checkpointing the pool's state after
-    every frame, and rename the folder to ``out_dir/<id>`` when all frames are done. A task that
-    was interrupted continues from its last checkpoint (same frames, bit for bit on one device)
-    instead of simulating from t = 0 again."""
-    import numpy as np
-
-    from warpcaustics.io.output import atomic_path, frame_entry, save_frame, write_json, write_run_json
-    from warpcaustics.pipeline import Renderer
-    from warpcaustics.scene import load_scene
-
-    t0 = time.perf_counter()
-    out = Path(out_dir)
-    final = out / task.id
-    partial = out / f".{task.id}.partial"
-    partial.mkdir(parents=True, exist_ok=True)
-    renderer = Renderer(load_scene(base, task.overrides), device)
-    entries: list[dict] = []
-    rows: list[dict] = []
-    meta_path = partial / CHECKPOINT_META
-    if meta_path.exists() and (partial / CHECKPOINT).exists():
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        with np.load(partial / CHECKPOINT) as data:
-            state = {name: data[name] for name in data.files}
-        if int(state.pop("frames_done")) == meta["frames_done"]:  # the pair was written together
-            state["time_s"] = float(state["time_s"])
-            renderer.water.load_state(state)
-            entries, rows = meta["entries"], meta["rows"]
-    result = None
-    for k in range(len(entries), len(task.times_s)):
-        result = renderer.render(task.times_s[k])
-        save_frame(result, partial, frame=task.frame_start + k)
-        entries.append(frame_entry(task.frame_start + k, result))
-        rows.append(summary_row(task, result, k, entries[-1]["statistics"]))
-        with atomic_path(partial / CHECKPOINT) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, frames_done=len(entries), **renderer.water.state())
-        write_json(meta_path, {"frames_done": len(entries), "entries": entries, "rows": rows})
-    if result is None:  # every frame was done before the interruption
-        result = renderer.render(task.times_s[-1])
-    write_run_json(partial, [result], frames=entries)
-    for name in (CHECKPOINT, CHECKPOINT_META):
-        (partial / name).unlink()
-    if final.exists():
-        shutil.rmtree(final)
-    os.replace(partial, final)
-    return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
-
-
-def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> dict:
-    """Summary statistics of one frame: per band mean and max floor irradiance, caustic contrast
-    (standard deviation / mean of the band-summed floor irradiance), photon counts, timings.
-    ``statistics``: the frame's run.json statistics, when already computed."""
-    import numpy as np
-
-    from warpcaustics.io.output import relative_l1
-
-    floor = result.floor_irradiance.astype(np.float64)
-    total = (floor * result.bin_widths_nm[:, None, None]).sum(axis=0)
-    row = {"id": task.id, "frame": task.frame_start + k, "time_s": result.time_s}
-    row.update({key: task.overrides[key] for key in sorted(task.overrides)})
-    for wl, band in zip(result.wavelengths_nm, floor):
-        row[f"mean_{wl:g}nm"] = float(band.mean())
-        row[f"max_{wl:g}nm"] = float(band.max())
-    row["floor_w_m2"] = float(total.mean())
-    row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
-    if statistics is None:
-        from warpcaustics.batch.stats import frame_statistics
-
-        statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
-    row["cv"] = statistics["irradiance_w_m2"]["cv"]
-    row["flash_fraction"] = statistics["irradiance_w_m2"]["flash_fraction"]
-    if "par_umol_m2_s" in statistics:
-        row["par_umol_m2_s"] = statistics["par_umol_m2_s"]["mean"]
-    if result.photon_stats:
-        row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
-    if result.beam_stats:
-        row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
-    if result.comparison is not None:  # "both" or "sunmap": how far the other method's floor map is
-        other = result.comparison
-        row[f"{result.method}_vs_{other.method}_l1"] = relative_l1(floor, other.floor_irradiance)
-    row["render_s"] = float(sum(result.timings_s.values()))
-    return row
 
 
 # ---------------------------------------------------------------------------------------------
@@ -462,9 +318,9 @@ def run_sweep(
 
     try:
         if executor == "ray":
-            _run_on_ray(sweep, todo, out, workers, device, address, finish)
+            run_on_ray(sweep, todo, out, workers, device, address, finish)
         else:
-            _run_locally(sweep, todo, out, workers, device, finish)
+            run_locally(sweep, todo, out, workers, device, finish)
     finally:
         progress.close()
     report.seconds = time.perf_counter() - t0
@@ -481,68 +337,10 @@ def _error_line(error: BaseException) -> str:
     return f"{type(error).__name__}: {text.splitlines()[0] if text else ''}"
 
 
-def _run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
-    import multiprocessing
-
-    context = multiprocessing.get_context("spawn")  # no forked Warp/CUDA state in the workers
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=context, initializer=_die_with_parent, initargs=(os.getpid(),)
-    ) as pool:
-        pending = {pool.submit(run_task, str(sweep.base), task, str(out), device): task for task in todo}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                task = pending.pop(future)
-                try:
-                    outcome = future.result()
-                except Exception as exc:
-                    finish(task, None, exc)
-                else:
-                    finish(task, outcome, None)
-
-
-def _run_on_ray(
-    sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, address: str | None, finish
-) -> None:
-    """One Ray task per sweep task (``num_gpus=1`` when rendering on CUDA); the workers write to
-    ``out``, which must be storage they share with the driver."""
-    try:
-        import ray
-    except ImportError:
-        raise WarpcausticsError("--executor ray needs Ray: pip install 'warpcaustics[ray]'") from None
-    started = not ray.is_initialized()
-    if started:
-        ray.init(
-            address=address,
-            num_cpus=None if address else workers,
-            include_dashboard=False,
-            log_to_driver=False,
-            configure_logging=False,
-        )
-    try:
-        gpus = 1 if device is not None and device.startswith("cuda") else 0
-        remote = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(run_task)
-        pending = {remote.remote(str(sweep.base), task, str(out.resolve()), device): task for task in todo}
-        while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1)
-            for ref in ready:
-                task = pending.pop(ref)
-                try:
-                    outcome = ray.get(ref)
-                except Exception as exc:
-                    finish(task, None, exc)
-                else:
-                    finish(task, outcome, None)
-    finally:
-        if started:
-            ray.shutdown()
-
 
 def write_summary(out_dir: Path, sweep: Sweep) -> Path:
     """``summary.csv`` (and ``summary.parquet`` if pyarrow is installed): one row per frame of the
     sweep's finished tasks, in task order; written atomically."""
-    from warpcaustics.io.output import atomic_path, write_csv
-
     records = read_manifest(out_dir)
     rows = [
         row
@@ -630,8 +428,6 @@ def report_main(out: str) -> int:
     except ImportError:
         print("(pip install warpcaustics[study] for the plot)")
         return 0
-    from warpcaustics.io.output import atomic_path
-
     fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(rows)), 4))
     varied = [c for c in shown if c not in headline]
     labels = ["/".join(_short(r[c]) for c in varied) or r["id"][:6] for r in rows]

@@ -1,0 +1,100 @@
+"""Where a sweep's tasks run: a local pool of worker processes that die with the driver, or Ray.
+
+Each executor submits :func:`warpcaustics.batch.worker.run_task` per task and calls
+``finish(task, outcome, error)`` in the driver as tasks complete; the driver alone writes the
+manifest.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from warpcaustics.batch.worker import run_task
+from warpcaustics.errors import WarpcausticsError
+
+if TYPE_CHECKING:
+    from warpcaustics.batch.sweep import Sweep, Task
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """Worker initializer: end this process when the driver goes (Linux parent-death signal, plus
+    a thread that checks the parent every half second elsewhere)."""
+    import signal
+    import threading
+
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent_pid:
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
+    import multiprocessing
+
+    context = multiprocessing.get_context("spawn")  # no forked Warp/CUDA state in the workers
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=die_with_parent, initargs=(os.getpid(),)
+    ) as pool:
+        pending = {pool.submit(run_task, str(sweep.base), task, str(out), device): task for task in todo}
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                task = pending.pop(future)
+                try:
+                    outcome = future.result()
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+
+
+def run_on_ray(
+    sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, address: str | None, finish
+) -> None:
+    """One Ray task per sweep task (``num_gpus=1`` when rendering on CUDA); the workers write to
+    ``out``, which must be storage they share with the driver."""
+    try:
+        import ray
+    except ImportError:
+        raise WarpcausticsError("--executor ray needs Ray: pip install 'warpcaustics[ray]'") from None
+    started = not ray.is_initialized()
+    if started:
+        ray.init(
+            address=address,
+            num_cpus=None if address else workers,
+            include_dashboard=False,
+            log_to_driver=False,
+            configure_logging=False,
+        )
+    try:
+        gpus = 1 if device is not None and device.startswith("cuda") else 0
+        remote = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(run_task)
+        pending = {remote.remote(str(sweep.base), task, str(out.resolve()), device): task for task in todo}
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            for ref in ready:
+                task = pending.pop(ref)
+                try:
+                    outcome = ray.get(ref)
+                except Exception as exc:
+                    finish(task, None, exc)
+                else:
+                    finish(task, outcome, None)
+    finally:
+        if started:
+            ray.shutdown()

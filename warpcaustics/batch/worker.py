@@ -1,0 +1,135 @@
+"""What a worker does with one sweep task: render its frames into ``DIR/<id>/`` through a
+temporary folder (a pool animation through a checkpointed ``DIR/.<id>.partial/``), and return the
+summary rows the driver records in the manifest."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from warpcaustics.io.comparison import relative_l1
+from warpcaustics.io.files import atomic_path, write_json
+from warpcaustics.io.frame import save_frame
+from warpcaustics.io.run_json import frame_entry, write_run_json
+
+if TYPE_CHECKING:
+    from warpcaustics.batch.sweep import Task
+
+
+def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
+    """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
+    if task.stateful:
+        return run_pool_task(base, task, out_dir, device)
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.scene import load_scene
+
+    t0 = time.perf_counter()
+    final = Path(out_dir) / task.id
+    tmp = Path(out_dir) / f".{task.id}.tmp-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        renderer = Renderer(load_scene(base, task.overrides), device)
+        results = []
+        for k, t in enumerate(task.times_s):
+            result = renderer.render(t)
+            save_frame(result, tmp, frame=task.frame_start + k)
+            results.append(result)
+        entries = [frame_entry(task.frame_start + k, r) for k, r in enumerate(results)]  # as the files
+        write_run_json(tmp, results, frames=entries)
+        if final.exists():
+            shutil.rmtree(final)
+        os.replace(tmp, final)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return {
+        "rows": [summary_row(task, r, k, entries[k]["statistics"]) for k, r in enumerate(results)],
+        "seconds": time.perf_counter() - t0,
+        "device": results[0].device,
+    }
+
+
+CHECKPOINT = "checkpoint.npz"
+CHECKPOINT_META = "checkpoint.json"
+
+
+def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
+    """Render a pool animation into ``out_dir/.<id>.partial/``, checkpointing the pool's state after
+    every frame, and rename the folder to ``out_dir/<id>`` when all frames are done. A task that
+    was interrupted continues from its last checkpoint (same frames, bit for bit on one device)
+    instead of simulating from t = 0 again."""
+    from warpcaustics.pipeline import Renderer
+    from warpcaustics.scene import load_scene
+
+    t0 = time.perf_counter()
+    out = Path(out_dir)
+    final = out / task.id
+    partial = out / f".{task.id}.partial"
+    partial.mkdir(parents=True, exist_ok=True)
+    renderer = Renderer(load_scene(base, task.overrides), device)
+    entries: list[dict] = []
+    rows: list[dict] = []
+    meta_path = partial / CHECKPOINT_META
+    if meta_path.exists() and (partial / CHECKPOINT).exists():
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        with np.load(partial / CHECKPOINT) as data:
+            state = {name: data[name] for name in data.files}
+        if int(state.pop("frames_done")) == meta["frames_done"]:  # the pair was written together
+            state["time_s"] = float(state["time_s"])
+            renderer.water.load_state(state)
+            entries, rows = meta["entries"], meta["rows"]
+    result = None
+    for k in range(len(entries), len(task.times_s)):
+        result = renderer.render(task.times_s[k])
+        save_frame(result, partial, frame=task.frame_start + k)
+        entries.append(frame_entry(task.frame_start + k, result))
+        rows.append(summary_row(task, result, k, entries[-1]["statistics"]))
+        with atomic_path(partial / CHECKPOINT) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, frames_done=len(entries), **renderer.water.state())
+        write_json(meta_path, {"frames_done": len(entries), "entries": entries, "rows": rows})
+    if result is None:  # every frame was done before the interruption
+        result = renderer.render(task.times_s[-1])
+    write_run_json(partial, [result], frames=entries)
+    for name in (CHECKPOINT, CHECKPOINT_META):
+        (partial / name).unlink()
+    if final.exists():
+        shutil.rmtree(final)
+    os.replace(partial, final)
+    return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
+
+
+def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> dict:
+    """Summary statistics of one frame: per band mean and max floor irradiance, caustic contrast
+    (standard deviation / mean of the band-summed floor irradiance), photon counts, timings.
+    ``statistics``: the frame's run.json statistics, when already computed."""
+    floor = result.floor_irradiance.astype(np.float64)
+    total = (floor * result.bin_widths_nm[:, None, None]).sum(axis=0)
+    row = {"id": task.id, "frame": task.frame_start + k, "time_s": result.time_s}
+    row.update({key: task.overrides[key] for key in sorted(task.overrides)})
+    for wl, band in zip(result.wavelengths_nm, floor):
+        row[f"mean_{wl:g}nm"] = float(band.mean())
+        row[f"max_{wl:g}nm"] = float(band.max())
+    row["floor_w_m2"] = float(total.mean())
+    row["contrast"] = float(total.std() / total.mean()) if total.mean() > 0 else 0.0
+    if statistics is None:
+        from warpcaustics.batch.stats import frame_statistics
+
+        statistics = frame_statistics(result, result.scene.config.stats)  # after the collector
+    row["cv"] = statistics["irradiance_w_m2"]["cv"]
+    row["flash_fraction"] = statistics["irradiance_w_m2"]["flash_fraction"]
+    if "par_umol_m2_s" in statistics:
+        row["par_umol_m2_s"] = statistics["par_umol_m2_s"]["mean"]
+    if result.photon_stats:
+        row.update({f"photons_{k2}": v for k2, v in result.photon_stats.items()})
+    if result.beam_stats:
+        row.update({f"beams_{k2}": v for k2, v in result.beam_stats.items()})
+    if result.comparison is not None:  # "both" or "sunmap": how far the other method's floor map is
+        other = result.comparison
+        row[f"{result.method}_vs_{other.method}_l1"] = relative_l1(floor, other.floor_irradiance)
+    row["render_s"] = float(sum(result.timings_s.values()))
+    return row
