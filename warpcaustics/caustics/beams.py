@@ -1,6 +1,6 @@
 """Beam caustics (host side): build the warped beam volumes, bin them into tiles, gather.
 
-See ``warpcaustics/kernels/beams.py`` for the method. Horizontal tile grids over the patch serve
+See ``kernels/caustics/beams/`` for the method. Horizontal tile grids over the patch serve
 the floor map (blocks of texels) and every query at a point (receiver faces, the receiver points
 the camera sees); the camera's screen tiles serve the view rays of the volume caustics. The stage
 owns its buffers and reuses them from frame to frame.
@@ -13,9 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from warpcaustics.caustics.receiver_stage import ReceiverStage
 from warpcaustics.config import BeamInterpolation, Config, FloorShape
 from warpcaustics.kernels.caustics import beams as beam_kernels
-from warpcaustics.scene.receivers import Receivers, floor_relief_height
+from warpcaustics.kernels.scene.camera import PinholeCamera
+from warpcaustics.scene.receivers import WALL_FACES, Receivers, floor_relief_height
 from warpcaustics.water import Surface
 
 BEAM_BYTES = 3 * 12 + 3 * 12 + 3 * 4 + 3 * 4 + 4 * 12 + 4 + 12 + 16
@@ -220,7 +222,7 @@ class BeamCaustics:
         self.end_m = wp.empty((count, 3), dtype=wp.float32, device=device)
         self.ends = wp.empty((count, 4), dtype=wp.vec3, device=device)
         """Per beam: a point of its end plane, the plane's unit normal along the beam, the unit mean
-        edge direction, the base plane's unit normal (``kernels/beams.py fill_ends``)."""
+        edge direction, the base plane's unit normal (``kernels/caustics/beams/build.py fill_ends``)."""
         self.weight = wp.empty(count, dtype=wp.float32, device=device)
         """A⊥ per beam [m²] (0: dropped)."""
         self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
@@ -289,6 +291,18 @@ class BeamCaustics:
             self.vertex_direction = wp.empty((n, n), dtype=wp.vec3, device=device)
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
+
+    timing_name = "beams"
+    """The stage's entry in RenderResult.timings_s and its RenderResult.method."""
+    stats_key = "beam_stats"
+
+    def attach_camera(self, camera) -> None:
+        """Refine adaptive beams near ``camera``'s screen footprint."""
+        self.camera = camera
+
+    def render_camera(self, camera, shafts: bool) -> None:
+        """Shade ``camera``'s image with this pass's beams (and their shafts)."""
+        camera.render_beams(self, shafts)
 
     def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
         """Build the next :meth:`run`'s beams for light from ``direction`` (3,) (towards a point of
@@ -399,7 +413,7 @@ class BeamCaustics:
                     REFINE_END_JUMP,
                     self.extent_m,
                     int(cam is not None),
-                    cam.cam if cam is not None else beam_kernels.PinholeCamera(),
+                    cam.cam if cam is not None else PinholeCamera(),
                     REFINE_MAX_PIXELS,
                 ],
                 outputs=[split],
@@ -501,3 +515,19 @@ class BeamCaustics:
             dropped=int(self.dropped.numpy()[0]),
             tile_entries=self.floor_bins.entries,
         )
+
+
+class BeamStage(ReceiverStage):
+    """``beams``: warped beam volumes, software-rasterised, with scan-plane shafts."""
+
+    name = "beams"
+
+    def make_caustics(self, args: tuple) -> list:
+        return [BeamCaustics(*args, periodic=self.water.periodic, relief=self.scene.floor_relief)]
+
+    @classmethod
+    def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:
+        cfg = scene.config
+        walls = WALL_FACES if cfg.water.walled else 0
+        sampled = sum(len(m.triangles) for m in scene.receiver_meshes) + walls
+        return beams_bytes(cfg, n, k, groups, cfg.water.periodic, faces, sampled)

@@ -1,4 +1,4 @@
-"""Eikonal caustics on the host: ``caustics.method = "eikonal"`` (``kernels/eikonal.py``).
+"""Eikonal caustics on the host: ``caustics.method = "eikonal"`` (``kernels/caustics/eikonal.py``).
 
 Per frame: the refracted front in the frozen layers under the surface, the layer-by-layer
 Godunov relaxation of |∇φ| = n_w, Mercier's Laplacian texture, the transport of intensity along
@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from warpcaustics.caustics.fluxratio import ApproximateStage
+from warpcaustics.caustics.stage import Frame
 from warpcaustics.config import Config
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
@@ -250,3 +252,57 @@ class EikonalCaustics(GridCaustics):
         phi0 = (gradient[0] * c[None, None, :] + gradient[1] * c[None, :, None]
                 + gradient[2] * z[:, None, None])
         return self.psi.numpy().astype(np.float64) + phi0
+
+
+class GridStage(ApproximateStage):
+    """A 3-D grid method (eikonal, wave3d): its own sky, a solve per sky direction, and the sun's
+    disk by parallax over the centre's solve."""
+
+    keeps_sky_shading = True  # the sky's solves revisit the shading the flux ratio's sky pass made
+    grid: type[GridCaustics]
+    grid_bytes: staticmethod
+    """The grid's device memory for a config [bytes]."""
+
+    @classmethod
+    def bytes_needed(cls, scene, k: int, groups: int) -> int:
+        m = scene.config.caustics.map_resolution  # + the grid's own (K, M, M) floor map
+        return super().bytes_needed(scene, k, groups) + cls.grid_bytes(scene.config) + k * m * m * 4
+
+    def make(self, mean_ior: float) -> GridCaustics:
+        light = self.light
+        return self.grid(self.scene.config, self.scene.sun_direction, mean_ior, light.sun_irradiance,
+                         light.attenuation_per_m, self.device, periodic=self.water.periodic)
+
+    def sky_map(self, frame: Frame, flux_ratio: np.ndarray) -> np.ndarray | None:
+        """The sky's floor map by the grid: a solve per sky direction, lit with its share of the
+        sky and shaded by the crests as seen from it, as the flux ratio's sky pass shaded them this
+        frame; solved before the sun, so that the grid holds the sun's solve afterwards
+        (texture(), stats), and the sun's light is put back after."""
+        light = self.light
+        if light.sky_directions is None:
+            return None
+        grid = self.approximate
+        total = None
+        with frame.watch.stage("sky"):
+            try:
+                for i, (direction, irradiance) in enumerate(zip(light.sky_directions,
+                                                                light.sky_irradiance_np)):
+                    grid.set_light(direction, irradiance)
+                    floor, _ = grid.floor_map(frame.surface, self.water, frame.time_s, frame.highest,
+                                              light.sky_visible[i], flux_ratio)
+                    total = floor.astype(np.float64) if total is None else total + floor
+            finally:
+                grid.set_light(self.scene.sun_direction, light.sun_irradiance)
+        return total.astype(np.float32)
+
+    def finish(self, floor: np.ndarray) -> np.ndarray:
+        return self.approximate.disk_average(floor, self.light.sun_directions)
+
+
+class EikonalStage(GridStage):
+    """``eikonal``: Mercier 2013's eikonal caustics on a 3-D grid."""
+
+    name = "eikonal"
+    grid = EikonalCaustics
+    grid_bytes = staticmethod(eikonal_bytes)
+    memory_key = "caustics.eikonal_resolution"

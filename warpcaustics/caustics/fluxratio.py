@@ -1,19 +1,24 @@
-"""Floor caustics by flux ratio (host side): triangle fluxes, then footprint deposits."""
+"""Floor caustics by flux ratio (``caustics.method = "fluxratio"``, host side): triangle fluxes, then
+footprint deposits; with ``optics.scattering = "multiple"`` the random walk's map replaces it. The
+approximate floor-map methods (sun map, eikonal, wave3d) build on :class:`FluxRatioStage`."""
 
 from __future__ import annotations
 
 import numpy as np
 import warp as wp
 
+from warpcaustics.caustics.multiple import MultipleScattering
+from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
+from warpcaustics.config import Scattering
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
-from warpcaustics.optics.refraction import Refracted
+from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
 from warpcaustics.water import Surface
 
 
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
-    triangle_flux = k * 2 * (n + 1) * (n + 1) * 4
+    triangle_flux = 2 * k * 2 * (n + 1) * (n + 1) * 4  # delivered to the floor and entering the water
     return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
 
 
@@ -33,7 +38,10 @@ class FloorCaustics:
                                           device=device)
         quads = n if periodic else n + 1  # a walled surface also has quads reaching its walls
         self.flux = wp.empty((quads, quads, 2, k), dtype=wp.float32, device=device)
-        """Flux per triangle and wavelength (Q, Q, 2, K) [W nm^-1], Q quads per side."""
+        """Flux per triangle and wavelength (Q, Q, 2, K) delivered to the floor [W nm^-1], Q quads per
+        side."""
+        self.entering = wp.empty((quads, quads, 2, k), dtype=wp.float32, device=device)
+        """Flux per triangle and wavelength (Q, Q, 2, K) entering the water [W nm^-1]."""
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
@@ -80,7 +88,7 @@ class FloorCaustics:
                           self.sun_irradiance if irradiance is None else irradiance,
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
-                  outputs=[self.flux], device=self.device)
+                  outputs=[self.flux, self.entering], device=self.device)
         if clear:
             self.texels.zero_()
             self.coarse_count.zero_()
@@ -91,3 +99,149 @@ class FloorCaustics:
         wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
                   outputs=[self.irradiance], device=self.device)
         return self.irradiance
+
+
+class FluxRatioStage(CausticStage):
+    """``fluxratio``: the floor map from each surface triangle's refracted footprint, one pass per
+    direction of the sun's disk and of the sky; the random walk's map instead with
+    ``optics.scattering = "multiple"`` (the single-scattering map as its comparison)."""
+
+    name = "fluxratio"
+
+    def __init__(self, scene, water, light: Lighting, device: str):
+        super().__init__(scene, water, light, device)
+        cfg = scene.config
+        n = scene.water_resolution
+        self.floor_top_z = -cfg.floor.depth_m
+        self.refracted = Refracted.allocate(len(light.group_ior), n, device)
+        window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
+                  if cfg.caustics.map_extent_m else None)
+        self.multiple = None
+        if cfg.optics.scattering is Scattering.MULTIPLE:
+            sky = {}
+            if light.sky_directions is not None:
+                sky = dict(sky_dirs=light.sky_directions, sky_irradiance=np.stack(light.sky_irradiance_np))
+            self.multiple = MultipleScattering(cfg, light.sun_directions, float(light.group_ior[0]),
+                                               light.sun_irradiance, light.optics.absorption_per_m,
+                                               light.optics.scattering_per_m, device, **sky)
+        disk_share = light.sun_irradiance / len(light.sun_directions)
+        self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
+                                   device, periodic=water.periodic, window=window)
+
+    @classmethod
+    def bytes_needed(cls, scene, k: int, groups: int) -> int:
+        cfg = scene.config
+        m = cfg.caustics.map_resolution
+        walk = k * m * m * 4 if cfg.optics.scattering is Scattering.MULTIPLE else 0  # the walk's texels
+        return floor_bytes(scene.water_resolution, m, k, groups) + walk
+
+    def render(self, frame: Frame) -> StageOutput:
+        floor, transmitted, extra, single = self.flux_ratio(frame)
+        if single is None:
+            return StageOutput(floor, transmitted, self.name, extra)
+        return StageOutput(floor, transmitted, "multiple", extra,
+                           comparison=StageOutput(single[0], single[1], "single", single[2]))
+
+    def flux_ratio(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, dict, tuple | None]:
+        """(floor map, flux entering the water, RenderResult fields, the single-scattering (map,
+        entering flux, fields) the random walk replaced or None)."""
+        watch = frame.watch
+        extra = {}
+        # A sun disk: one refraction and deposit per direction over it, each with an equal share of
+        # the flux (the deposit's irradiance was divided by their number); crests shade by the
+        # disk's centre.
+        flux = 0.0  # (2, K): entering the water, delivered to the floor
+        for i, direction in enumerate(self.light.sun_directions):
+            floor, pass_flux = self._deposit(frame, frame.visible, direction,
+                                             ("refraction", "floor_caustics"), clear=i == 0)
+            flux = flux + pass_flux
+        with watch.stage("readback"):
+            # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
+            floor_np = floor.numpy().copy()
+        if self.light.sky_directions is not None:
+            sky_np, sky_flux = self._sky(frame)
+            extra["sky_floor_irradiance"] = sky_np
+            floor_np, flux = floor_np + sky_np, flux + sky_flux
+        transmitted = flux[0]
+        extra["delivered_flux_w_nm"] = flux[1]
+        if self.multiple is None:
+            return floor_np, transmitted, extra, None
+        # the walk's maps replace the single-scattering ones
+        single = (floor_np, transmitted, {"delivered_flux_w_nm": extra.pop("delivered_flux_w_nm")})
+        with watch.stage("multiple_scattering"):
+            floor_np, walk = self.multiple.run(frame.surface, frame.visible)
+            transmitted = np.asarray(walk["transmitted"])
+        if self.light.sky_directions is not None:
+            with watch.stage("sky"):
+                sky_np, walk["sky"] = self.multiple.run_sky(frame.surface, self.light.sky_visible)
+            extra["sky_floor_irradiance"] = sky_np
+            floor_np = floor_np + sky_np
+            transmitted = transmitted + np.asarray(walk["sky"]["transmitted"])
+        extra["multiple_scattering_stats"] = walk
+        return floor_np, transmitted, extra, single
+
+    def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+        """The sky's floor map and (2, K) flux (entering, delivered): one shaded refraction and
+        deposit per sky direction, each with its share of the sky's irradiance."""
+        light = self.light
+        transmitted = 0.0
+        for i, (direction, irradiance) in enumerate(zip(light.sky_directions, light.sky_irradiance_per_dir)):
+            with frame.watch.stage("sky"):
+                out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
+                visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out)
+            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=i == 0,
+                                        irradiance=irradiance)
+            transmitted = transmitted + flux
+        return floor.numpy().copy(), transmitted
+
+    def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
+                 irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:
+        """One flux-ratio pass for light arriving from ``direction`` (the sun's centre, a point of
+        its disk or of the sky): refraction, then the deposit added to the map unless ``clear``;
+        returns the map and the pass's (2, K) flux per band entering the water and delivered to the
+        floor [W nm^-1] (host read-backs; a device-side sum would spare them on CUDA)."""
+        with frame.watch.stage(stages[0]):
+            refracted = refract_to_floor(frame.surface, visible, self.light.group_ior, direction,
+                                         -self.scene.config.floor.depth_m, self.device, out=self.refracted)
+        with frame.watch.stage(stages[1]):
+            floor = self.floor.run(frame.surface, refracted, direction, clear=clear, irradiance=irradiance)
+            flux = np.stack([self.floor.entering.numpy().sum(axis=(0, 1, 2), dtype=np.float64),
+                             self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
+        return floor, flux
+
+
+class ApproximateStage(FluxRatioStage):
+    """A floor-map method of its own (sun map, eikonal, wave3d) on top of the flux ratio: the flux-
+    ratio map of the same frame sets its scale and is saved beside it as its comparison."""
+
+    def __init__(self, scene, water, light: Lighting, device: str):
+        super().__init__(scene, water, light, device)
+        # grey, one index for their rays (the bins' mean)
+        self.approximate = self.make(float(np.mean(light.ior)))
+
+    def make(self, mean_ior: float):
+        """The method's own floor-map object (with ``floor_map(...)``), its rays refracted with
+        ``mean_ior``."""
+        raise NotImplementedError
+
+    def sky_map(self, frame: Frame, flux_ratio: np.ndarray) -> np.ndarray | None:
+        """The sky's floor map by the method itself, solved before the sun's (None: none)."""
+        return None
+
+    def finish(self, floor: np.ndarray) -> np.ndarray:
+        """The sun's map after its solve (e.g. averaged over the sun's disk)."""
+        return floor
+
+    def render(self, frame: Frame) -> StageOutput:
+        flux_ratio, transmitted, fields, _ = self.flux_ratio(frame)
+        method_sky = self.sky_map(frame, flux_ratio)
+        with frame.watch.stage(self.name):
+            floor, extra = self.approximate.floor_map(frame.surface, self.water, frame.time_s, frame.highest,
+                                                      frame.visible, flux_ratio)
+            floor = self.finish(floor)
+        if method_sky is not None:
+            extra["sky_floor_irradiance"] = method_sky
+            floor = floor + method_sky
+        return StageOutput(floor, transmitted, self.name, extra,
+                           comparison=StageOutput(flux_ratio, transmitted, FluxRatioStage.name,
+                                                  {"delivered_flux_w_nm": fields["delivered_flux_w_nm"]}))

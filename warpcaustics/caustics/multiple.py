@@ -1,4 +1,4 @@
-"""Multiple scattering on the host: ``optics.scattering = "multiple"`` (``kernels/multiple.py``).
+"""Multiple scattering on the host: ``optics.scattering = "multiple"`` (``kernels/caustics/multiple.py``).
 
 A reference mode for flux-ratio scenes on a periodic sea: the floor map comes from a Monte Carlo
 random walk of photons that scatter on (by the configured phase function) instead of being lost

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from warpcaustics.caustics.receiver_stage import ReceiverStage
 from warpcaustics.config import Config, Intersection
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
@@ -49,34 +50,6 @@ class PhotonStats:
     """Photons with non-zero weight (lit from the front, refracted downwards)."""
     landed: int
     """Photons that found a receiver."""
-
-
-def check_meshes_inside_patch(cfg: Config, meshes: tuple, sun_dir: np.ndarray, ior: np.ndarray) -> None:
-    """On a periodic sea a photon is moved by whole periods so that, followed to the floor plane at
-    rest, it lands in the patch; a mesh only gets the light of photons whose path through it would
-    land there. Refuse meshes so near the patch edge that some of their light would be missed."""
-    from warpcaustics.errors import ConfigError
-
-    if not meshes:
-        return
-    half = 0.5 * cfg.water.extent_m
-    plane_z = -cfg.floor.depth_m
-    for i, mesh in enumerate(meshes):
-        worst = 0.0
-        for n in (float(np.min(ior)), float(np.max(ior))):
-            d = still_water_refraction(sun_dir, n)
-            drop = mesh.points[:, 2] - plane_z
-            landing = mesh.points[:, :2] + (drop / -d[2])[:, None] * d[None, :2]
-            # Waves tilt the rays: allow for a tenth of the drop either way, and 2 % of the patch.
-            margin = 0.1 * np.abs(drop) + 0.02 * cfg.water.extent_m
-            spots = np.concatenate([landing, mesh.points[:, :2]])
-            reach = np.max(np.abs(spots) + np.tile(margin, 2)[:, None])
-            worst = max(worst, float(reach - half))
-        if worst > 0.0:
-            raise ConfigError(
-                f"receivers[{i}] is {worst:.2f} m too near the edge of the periodic {cfg.water.extent_m:g} m "
-                "patch: part of the light that reaches it would land outside the patch and be missed; "
-                "move it towards the centre (receivers[].translate_m) or enlarge water.extent_m")
 
 
 def light_view_direction(sun_dir: np.ndarray, group_ior: np.ndarray) -> np.ndarray:
@@ -127,6 +100,7 @@ class PhotonCaustics:
         self.device = device
         self.receivers = receivers
         self.periodic = periodic
+        self.n = n
         self.subdivisions = cfg.caustics.photon_subdivisions
         self.quads = n if periodic else n + 1
         groups = len(group_ior)
@@ -272,6 +246,23 @@ class PhotonCaustics:
         )
         return self.irradiance
 
+    timing_name = "photons"
+    """The stage's entry in RenderResult.timings_s and its RenderResult.method."""
+    stats_key = "photon_stats"
+
+    def attach_camera(self, camera) -> None:
+        """The camera needs nothing of the photons before they are traced."""
+
+    def render_camera(self, camera, shafts: bool) -> None:
+        """Splat this pass's photons into ``camera``'s image, each over its lattice cell."""
+        spacing = self.cfg.water.extent_m / self.n / self.subdivisions
+        camera.render(self, spacing, shafts)
+
+    def face_flux_w_nm(self) -> np.ndarray:
+        """(F_other, K) flux on each non-floor face [W nm^-1] (float64)."""
+        other = self.receivers.face_count - self.receivers.floor_face_count
+        return self.face_flux.numpy()[:other].astype(np.float64)
+
     def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
         """Emit the next :meth:`run`'s photons from ``direction`` (3,) (towards a point of the sun's
         disk, or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
@@ -293,3 +284,16 @@ class PhotonCaustics:
             carrying=int(np.count_nonzero(w > 0)),
             landed=int(np.count_nonzero(self.face.numpy() >= 0)),
         )
+
+
+class PhotonStage(ReceiverStage):
+    """``photons``: photon splatting with the exact or Shah's Newton intersection."""
+
+    name = "photons"
+
+    def make_caustics(self, args: tuple) -> list:
+        return [PhotonCaustics(*args, periodic=self.water.periodic)]
+
+    @classmethod
+    def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:
+        return photons_bytes(scene.config, n, k, groups, scene.config.water.periodic, faces)

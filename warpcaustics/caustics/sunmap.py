@@ -1,6 +1,6 @@
 """Sun-map caustics (GPU Gems ch. 2) on the host: ``caustics.method = "sunmap"``.
 
-The kernels (``kernels/sunmap.py``) give a grey brightness per floor-map texel from backward rays;
+The kernels (``kernels/caustics/sunmap.py``) give a grey brightness per floor-map texel from backward rays;
 the pipeline scales it per band so that its mean equals the flux-ratio map's of the same frame
 (the chapter's map has no absolute scale: "zero means no lighting and one means a beam of very
 focused light"). The flux-ratio map rides along as the comparison.
@@ -13,6 +13,7 @@ import math
 import numpy as np
 import warp as wp
 
+from warpcaustics.caustics.fluxratio import ApproximateStage
 from warpcaustics.config import Config
 from warpcaustics.kernels.caustics import sunmap as sunmap_kernels
 from warpcaustics.optics.refraction import still_water_refraction
@@ -31,7 +32,7 @@ class SunMapCaustics:
         params.up = wp.vec3(*(-still_water_refraction(s, ior)).astype(np.float32))
         params.sun_dir = wp.vec3(*s.astype(np.float32))
         params.eta = float(ior)
-        disk = 0.5 * math.radians(cfg.caustics.sunmap_disk_deg)
+        disk = 0.5 * math.radians(cfg.sun.angular_diameter_deg)
         params.disk_rad = disk
         params.cos_disk = math.cos(disk)
         params.halo_rad = 0.5 * math.radians(cfg.caustics.sunmap_halo_deg)
@@ -83,3 +84,18 @@ def scale_to_flux_ratio(brightness: np.ndarray, flux_ratio: np.ndarray) -> np.nd
         return np.zeros_like(flux_ratio)
     scale = flux_ratio.mean(axis=(1, 2), dtype=np.float64) / mean
     return (scale[:, None, None] * b[None]).astype(np.float32)
+
+
+class SunMapStage(ApproximateStage):
+    """``sunmap``: GPU Gems ch. 2's sun map, scaled per band to the flux-ratio map's mean."""
+
+    name = "sunmap"
+
+    def make(self, mean_ior: float) -> SunMapCaustics:
+        return SunMapCaustics(self.scene.config, self.scene.sun_direction, mean_ior, self.device,
+                              periodic=self.water.periodic)
+
+    @classmethod
+    def bytes_needed(cls, scene, k: int, groups: int) -> int:
+        m = scene.config.caustics.map_resolution
+        return super().bytes_needed(scene, k, groups) + m * m * 4

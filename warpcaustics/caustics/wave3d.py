@@ -1,4 +1,4 @@
-"""Wave caustic texture on the host: ``caustics.method = "wave3d"`` (``kernels/wave3d.py``).
+"""Wave caustic texture on the host: ``caustics.method = "wave3d"`` (``kernels/caustics/wave3d.py``).
 
 Per frame, with the water surface held still (light crosses the pool in nanoseconds): the
 refracted front in the frozen layers (shared with the eikonal method), then leapfrog steps of the
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.eikonal import GridCaustics, all_lit, make_grid
+from warpcaustics.caustics.eikonal import GridCaustics, GridStage, all_lit, make_grid
 from warpcaustics.config import Config
 from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
 from warpcaustics.kernels.caustics import wave3d as wave_kernels
@@ -185,3 +185,12 @@ class Wave3DCaustics(GridCaustics):
             [self.psi, self.intensity, self.path, self.u, self.u_old, self.u_new, self.energy]
             if self.layers else [])
         return sum(a.capacity for a in arrays)
+
+
+class Wave3DStage(GridStage):
+    """``wave3d``: the 3-D wave-equation caustics."""
+
+    name = "wave3d"
+    grid = Wave3DCaustics
+    grid_bytes = staticmethod(wave3d_bytes)
+    memory_key = "caustics.wave3d_resolution"

@@ -3,21 +3,24 @@
 The camera looks at the receivers from inside the water; viewing from above the water through the
 refracting surface is not implemented yet. Receivers are static, so the G-buffer is cast once per
 scene; each frame splats the photons into a camera caustic map, draws their light shafts and
-shades (``kernels/camera.py`` has the equations).
+shades (``kernels/scene/camera/`` has the equations).
 """
 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.photons import PhotonCaustics
 from warpcaustics.config import CameraConfig
 from warpcaustics.kernels.scene import camera as camera_kernels
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.scene.receivers import Receivers
+
+if TYPE_CHECKING:
+    from warpcaustics.caustics.photons import PhotonCaustics
 
 DEPTH_TOLERANCE = 0.02
 """A photon counts as seen at a pixel if its distance is within 2 % of the G-buffer depth there."""

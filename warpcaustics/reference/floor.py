@@ -1,8 +1,9 @@
 """Vectorised float64 numpy implementation of the flux-ratio floor caustics (refraction included).
 
-The same algorithm as the Warp kernels (``kernels/refract.py``, ``kernels/floor.py``), written
-independently with array operations and no Python loops over triangles or texels. It is the
-baseline of ``benchmarks/`` and a float64 cross-check in ``tests/``.
+The same algorithm as the Warp kernels (``kernels/optics/refract.py``,
+``kernels/caustics/fluxratio.py``), written independently with array operations and no Python
+loops over triangles or texels. It is the baseline of ``benchmarks/`` and a float64 cross-check in
+``tests/``.
 """
 
 from __future__ import annotations

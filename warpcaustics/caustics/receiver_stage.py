@@ -1,0 +1,192 @@
+"""What the receiver methods (photons, beams, both) share: every receiver lit (relief, walls,
+meshes), the under-water camera fed, one light pass per direction of the sun's disk and of the sky."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
+from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.optics.phase import PhaseFunction
+from warpcaustics.optics.refraction import still_water_refraction, sun_visibility
+from warpcaustics.scene.camera import UnderwaterCamera, camera_bytes
+from warpcaustics.scene.receivers import WALL_FACES, Receivers, floor_mesh_cells, floor_relief_height
+
+WALL_TOP_M = 1.0
+"""Height of a walled pool's walls above the water at rest [m]."""
+
+
+def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) -> None:
+    """The camera must be in the water: over a non-periodic patch (inside a pool's walls) and above
+    the floor."""
+    x, y, z = cfg.camera.position_m
+    half = 0.5 * cfg.water.extent_m
+    if not periodic and max(abs(x), abs(y)) >= half:
+        where = "the pool's walls" if cfg.water.walled else f"the {cfg.water.model.value!r} water patch"
+        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is outside {where} "
+                          f"(|x|, |y| < {half:g} m); move the camera into the water")
+    floor_z = float(floor_relief_height(cfg.floor, floor_relief, cfg.water.extent_m, np.array(x),
+                                        np.array(y)))
+    if z <= floor_z:
+        raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is below the floor (z = "
+                          f"{floor_z:.3f} m there); move the camera up into the water")
+
+
+def check_meshes_inside_patch(cfg, meshes: tuple, sun_dir: np.ndarray, ior: np.ndarray) -> None:
+    """On a periodic sea a photon is moved by whole periods so that, followed to the floor plane at
+    rest, it lands in the patch; a mesh only gets the light of photons whose path through it would
+    land there. Refuse meshes so near the patch edge that some of their light would be missed."""
+    if not meshes:
+        return
+    half = 0.5 * cfg.water.extent_m
+    plane_z = -cfg.floor.depth_m
+    for i, mesh in enumerate(meshes):
+        worst = 0.0
+        for n in (float(np.min(ior)), float(np.max(ior))):
+            d = still_water_refraction(sun_dir, n)
+            drop = mesh.points[:, 2] - plane_z
+            landing = mesh.points[:, :2] + (drop / -d[2])[:, None] * d[None, :2]
+            # Waves tilt the rays: allow for a tenth of the drop either way, and 2 % of the patch.
+            margin = 0.1 * np.abs(drop) + 0.02 * cfg.water.extent_m
+            spots = np.concatenate([landing, mesh.points[:, :2]])
+            reach = np.max(np.abs(spots) + np.tile(margin, 2)[:, None])
+            worst = max(worst, float(reach - half))
+        if worst > 0.0:
+            raise ConfigError(
+                f"receivers[{i}] is {worst:.2f} m too near the edge of the periodic {cfg.water.extent_m:g} m "
+                "patch: part of the light that reaches it would land outside the patch and be missed; "
+                "move it towards the centre (receivers[].translate_m) or enlarge water.extent_m")
+
+
+def receiver_face_estimate(scene, periodic: bool) -> int:
+    """Faces of the receivers' BVH (the floor grid with its margin, walls, meshes)."""
+    cfg = scene.config
+    cells = floor_mesh_cells(cfg)
+    floor = 2 * int(cells * (1.5 if periodic else 1.0)) ** 2
+    walls = WALL_FACES if cfg.water.walled else 0
+    return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + walls
+
+
+class ReceiverStage(CausticStage):
+    """A method that lights every receiver and feeds the camera. Subclasses say which caustics
+    objects run (:meth:`make_caustics`, each with ``set_light``, ``run``, ``render_camera``,
+    ``transmitted_flux``, ``face_flux_w_nm``, ``stats``, ``timing_name`` and ``stats_key``) and
+    their memory (:meth:`caustics_bytes`); the first one's maps are the result, a second one's
+    its comparison."""
+
+    def __init__(self, scene, water, light: Lighting, device: str):
+        super().__init__(scene, water, light, device)
+        cfg = scene.config
+        periodic = water.periodic
+        self.receivers = Receivers(cfg, light.bins, device, periodic=periodic, relief=scene.floor_relief,
+                                   meshes=scene.receiver_meshes, water_top_z=WALL_TOP_M,
+                                   base_dir=scene.base_dir)
+        args = (cfg, self.receivers, scene.water_resolution, light.sun_irradiance, light.attenuation_per_m,
+                light.group_ior, scene.sun_direction, device)
+        self.caustics = self.make_caustics(args)
+        self.floor_top_z = self.receivers.floor_top_z
+        if periodic:
+            lights = [scene.sun_direction] + list(light.sky_directions if light.sky_directions is not None
+                                                  else [])
+            for direction in lights:
+                check_meshes_inside_patch(cfg, scene.receiver_meshes, direction, light.group_ior)
+        self.camera = None
+        if cfg.camera.enabled:
+            check_camera_position(cfg, scene.floor_relief, periodic)
+            self.camera = UnderwaterCamera(cfg.camera, self.receivers, light.optics.scattering_per_m,
+                                           PhaseFunction.from_optics(cfg.optics, device), device)
+            for caustics in self.caustics:
+                caustics.attach_camera(self.camera)
+
+    def make_caustics(self, args: tuple) -> list:
+        """The caustics objects of this method, built from (cfg, receivers, N, sun irradiance,
+        attenuation, index groups, sun direction, device)."""
+        raise NotImplementedError
+
+    @classmethod
+    def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:
+        """Device memory of this method's caustics objects [bytes]."""
+        raise NotImplementedError
+
+    @classmethod
+    def bytes_needed(cls, scene, k: int, groups: int) -> int:
+        cfg = scene.config
+        faces = receiver_face_estimate(scene, cfg.water.periodic)
+        cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
+        return cls.caustics_bytes(scene, scene.water_resolution, k, groups, faces) + cam
+
+    def check_frame(self, frame: Frame) -> None:
+        if self.receivers.mesh_top_z >= frame.lowest:
+            raise WarpcausticsError(
+                f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
+                f"lowest point z = {frame.lowest:.3f} m at t = {frame.time_s:g} s; receivers must stay under "
+                "the water: lower them (receivers[].translate_m) or make the floor deeper")
+        if self.camera is not None and self.camera.position_z >= frame.lowest:
+            raise WarpcausticsError(
+                f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
+                f"surface reaches down to z = {frame.lowest:.3f} m at t = {frame.time_s:g} s); viewing from "
+                "above the water is not implemented yet: lower the camera")
+
+    def render(self, frame: Frame) -> StageOutput:
+        outputs = [self._passes(caustics, i == len(self.caustics) - 1, frame)
+                   for i, caustics in enumerate(self.caustics)]
+        first = outputs[0]
+        if len(outputs) > 1:
+            first.comparison = outputs[1]
+        return first
+
+    def _passes(self, caustics, last: bool, frame: Frame) -> StageOutput:
+        """Run one caustics object (and the camera with it) over the light passes
+        (:meth:`Lighting.passes`): its floor map, transmitted flux and the RenderResult fields of
+        receivers, camera and sky, all on the host. Counts add up over the passes. Taking the
+        disk's directions in turn within one photon pass made each photon's lattice neighbours
+        another direction's, and the camera's lattice splats then drew that assignment's pattern."""
+        cfg = self.scene.config
+        watch = frame.watch
+        rec = self.receivers
+        totals: dict[bool, dict[str, np.ndarray]] = {False: {}, True: {}}
+        extra = {}
+        # with a second method, the first one's camera time is its own entry
+        camera_stage = "camera" if last else f"camera_{caustics.timing_name}"
+        for direction, irradiance, from_sky in self.light.passes():
+            caustics.set_light(direction, irradiance)
+            if from_sky:
+                with watch.stage("sky"):
+                    seen = sun_visibility(frame.surface, direction, frame.highest, self.device,
+                                          out=self.light.sky_visible)
+            else:
+                seen = frame.visible  # crests shade by the sun's centre
+            # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are
+            with watch.stage("sky" if from_sky else caustics.timing_name):
+                floor = caustics.run(frame.surface, seen)
+            part = {}
+            if self.camera is not None:
+                with watch.stage("sky" if from_sky else camera_stage):
+                    caustics.render_camera(self.camera, cfg.caustics.shafts)
+                    part["camera_radiance"] = self.camera.radiance.numpy().astype(np.float64)
+            with watch.stage("readback"):
+                part["floor"] = floor.numpy().astype(np.float64)
+                part["transmitted"] = caustics.transmitted_flux()
+                part["face_flux_w_nm"] = caustics.face_flux_w_nm()
+                counts = vars(caustics.stats())
+            total = totals[from_sky]
+            for key, value in part.items():
+                total[key] = total[key] + value if key in total else value
+            key = caustics.stats_key
+            extra[key] = {k: extra.get(key, {}).get(k, 0) + v for k, v in counts.items()}
+        sun, sky = totals[False], totals[True]
+        combined = {key: sun[key] + sky[key] if key in sky else sun[key] for key in sun}
+        extra["face_flux_w_nm"] = combined["face_flux_w_nm"]
+        if sky:
+            extra["sky_floor_irradiance"] = sky["floor"].astype(np.float32)
+        if self.camera is not None:
+            extra["camera_radiance"] = combined["camera_radiance"].astype(np.float32)
+            extra["camera_gbuffer"] = self.camera.gbuffer()
+        with watch.stage("readback"):
+            extra.update(face_receiver=rec.face_receiver_np[rec.floor_face_count:],
+                         face_area_m2=rec.face_area_m2[rec.floor_face_count:],
+                         face_centres_m=rec.face_centres_m[rec.floor_face_count:],
+                         floor_texel_area_m2=rec.floor_texel_area_m2,
+                         receiver_mesh=rec.non_floor_mesh())
+        return StageOutput(combined["floor"].astype(np.float32), combined["transmitted"],
+                           caustics.timing_name, extra)
