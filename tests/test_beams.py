@@ -14,34 +14,13 @@ import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 from warpcaustics.kernels.caustics import beams as beam_kernels
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, flat_floor_irradiance, flat_water_scene, fresnel_t_angles
 
 BEAMS = {"caustics.method": "beams"}
 
 
 def _flat(elevation_deg, depth_m, water_type="pure", **extra):
-    overrides = {
-        **BEAMS,
-        "water.model": "flat",
-        "water.resolution": 32,
-        "water.extent_m": 8.0,
-        "caustics.map_resolution": 32,
-        "sun.elevation_deg": elevation_deg,
-        "sun.azimuth_deg": 37.0,
-        "sun.angular_diameter_deg": 0.0,  # the analytic references are a point sun's
-        "floor.depth_m": depth_m,
-        "optics.water_type": water_type,
-        "optics.wavelengths.bins": 8,
-    }
-    overrides.update(extra)
-    return wc.load_scene(None, overrides)
-
-
-def _flat_floor_irradiance(result, elevation_deg, depth_m):
-    theta = np.radians(90.0 - elevation_deg)
-    cos_t = np.sqrt(1.0 - (np.sin(theta) / 1.333) ** 2)
-    t = fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
-    return result.sun_irradiance * np.cos(theta) * t * np.exp(-result.attenuation_per_m * depth_m / cos_t)
+    return flat_water_scene(elevation_deg, depth_m, water_type, **{**BEAMS, **extra})
 
 
 @pytest.mark.parametrize("elevation_deg", [5.0, 20.0, 55.0, 90.0])
@@ -49,7 +28,7 @@ def test_flat_water_beams_match_analytic_irradiance(device, elevation_deg):
     """Flat water: every texel reads E_sun cosθ T(θ) exp(−c D / cosθ_t) (the issue asks 0.5 %; the
     exact clipping leaves only float32 rounding)."""
     result = wc.render(_flat(elevation_deg, 3.0), device=device)
-    expected = _flat_floor_irradiance(result, elevation_deg, 3.0)
+    expected = flat_floor_irradiance(result, elevation_deg, 3.0)
     floor = result.floor_irradiance.astype(np.float64)
     np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=2e-5)
     assert result.beam_stats["dropped"] == 0
@@ -101,11 +80,11 @@ def test_beam_floor_map_conserves_flux_and_matches_the_flux_ratio_map():
     of issue 2 within 1 % relative L1 (measured: 7e-5)."""
     base = {"water.resolution": 128, "caustics.map_resolution": 64, "optics.wavelengths": "rgb"}
     beams = wc.render(
-        wc.load_scene("configs/ocean.toml", {**base, **BEAMS, "optics.water_type": "none"}), device="cpu"
+        wc.load_scene(CONFIGS / "ocean.toml", {**base, **BEAMS, "optics.water_type": "none"}), device="cpu"
     )
     np.testing.assert_allclose(beams.floor_flux_w_nm, beams.transmitted_flux_w_nm, rtol=1e-4)
-    reference = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu").floor_irradiance
-    beams = wc.render(wc.load_scene("configs/ocean.toml", {**base, **BEAMS}), device="cpu").floor_irradiance
+    reference = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu").floor_irradiance
+    beams = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, **BEAMS}), device="cpu").floor_irradiance
     l1 = np.abs(beams - reference).sum() / np.abs(reference).sum()
     assert l1 < 0.01
     assert beams.std() > 0.2 * beams.mean()  # a real caustic pattern, not a flat map
@@ -140,11 +119,11 @@ def test_beams_agree_with_exact_photons_on_the_floor_and_on_a_sphere():
     }
     photons = wc.render(
         wc.load_scene(
-            "configs/ocean.toml", {**base, "caustics.method": "photons", "caustics.photon_subdivisions": 4}
+            CONFIGS / "ocean.toml", {**base, "caustics.method": "photons", "caustics.photon_subdivisions": 4}
         ),
         device="cpu",
     )
-    beams = wc.render(wc.load_scene("configs/ocean.toml", {**base, **BEAMS}), device="cpu")
+    beams = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, **BEAMS}), device="cpu")
     f_b, f_p = beams.floor_irradiance, photons.floor_irradiance
     assert np.abs(f_b - f_p).sum() / np.abs(f_p).sum() < 0.03
     s_b, s_p = _sphere_bins(beams, 2, centre), _sphere_bins(photons, 2, centre)
@@ -396,7 +375,7 @@ def test_rays_in_a_shadow_get_no_light():
     open_floor = (np.abs(x)[:, None] > 1.6) | (np.abs(x)[None, :] > 1.6)
     shadow = (np.abs(x)[:, None] < 1.4) & (np.abs(x)[None, :] < 1.4)
     assert np.all(result.floor_irradiance[:, shadow] == 0.0)
-    expected = _flat_floor_irradiance(result, 90.0, 3.0)
+    expected = flat_floor_irradiance(result, 90.0, 3.0)
     np.testing.assert_allclose(result.floor_irradiance[:, open_floor].mean(axis=1), expected, rtol=1e-4)
 
 
@@ -414,7 +393,7 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform():
         "camera.fov_deg": 60.0,
     }
     result = wc.render(_flat(60.0, 3.0, "none", **overrides), device="cpu")
-    e = _flat_floor_irradiance(result, 60.0, 3.0)
+    e = flat_floor_irradiance(result, 60.0, 3.0)
     seen = result.camera_gbuffer["receiver"] == 0
     assert seen.sum() > 4000
     measured = result.camera_radiance[:, seen] * np.pi / 0.5 / e[:, None]
@@ -424,9 +403,9 @@ def test_camera_sees_a_uniformly_lit_floor_as_uniform():
 @pytest.mark.parametrize(
     "config, overrides",
     [
-        ("configs/ocean_floor.toml", {"water.resolution": 32}),
+        (CONFIGS / "ocean_floor.toml", {"water.resolution": 32}),
         (
-            "configs/pool.toml",
+            CONFIGS / "pool.toml",
             {
                 "water.resolution": 32,
                 "camera.enabled": True,
@@ -450,12 +429,12 @@ def test_the_cpu_tile_walk_gives_the_per_pixel_shafts_to_the_bit(config, overrid
     )
     renderer = wc.Renderer(scene, "cpu")
     renderer.render(0.0)
-    camera = renderer.camera
+    camera = renderer.method.camera
     assert camera.shaft_threads == "tile"
     tiles = camera.shafts.numpy().copy()
     tile_fill = camera.beam_fill()
     camera.shaft_threads = "pixel"
-    camera.render_beams(renderer.beams, True)
+    camera.render_beams(renderer.method.caustics[0], True)
     pixels = camera.shafts.numpy()
     assert tile_fill == camera.beam_fill()
     assert tile_fill["inside_pairs"] > 1000 and (pixels > 0).mean() > 0.3
@@ -467,7 +446,7 @@ def test_grazing_sun_folds_and_degenerate_beams_stay_finite():
     the camera with shafts: everything stays finite, beams facing away are dropped and counted,
     and the floor gets the flux that entered the water."""
     scene = wc.load_scene(
-        "configs/ocean_floor.toml",
+        CONFIGS / "ocean_floor.toml",
         {
             **BEAMS,
             "water.resolution": 64,
@@ -509,7 +488,8 @@ def test_smooth_interpolation_hides_beam_edges_and_keeps_the_flux():
     jumps = {}
     for interp in ("flat", "smooth"):
         r = wc.render(
-            wc.load_scene("configs/ocean.toml", {**base, "caustics.beam_interpolation": interp}), device="cpu"
+            wc.load_scene(CONFIGS / "ocean.toml", {**base, "caustics.beam_interpolation": interp}),
+            device="cpu",
         )
         np.testing.assert_allclose(r.floor_flux_w_nm, r.transmitted_flux_w_nm, rtol=1e-4)
         f = r.floor_irradiance[1].astype(np.float64)
@@ -525,7 +505,7 @@ def test_both_methods_write_both_results_and_their_difference(tmp_path):
 
     import OpenEXR
 
-    from warpcaustics.io.output import spectral_channel_name
+    from warpcaustics.io.exr import spectral_channel_name
 
     overrides = {
         "caustics.method": "both",
@@ -535,7 +515,7 @@ def test_both_methods_write_both_results_and_their_difference(tmp_path):
         "camera.width": 32,
         "camera.height": 24,
     }
-    result = wc.render(wc.load_scene("configs/ocean_floor.toml", overrides), device="cpu")
+    result = wc.render(wc.load_scene(CONFIGS / "ocean_floor.toml", overrides), device="cpu")
     other = result.comparison
     assert result.beam_stats is not None and other is not None and other.photon_stats is not None
     assert other.camera_radiance.shape == result.camera_radiance.shape
@@ -559,8 +539,8 @@ def test_adaptive_beams_refine_where_the_light_bends_and_keep_the_flux():
     uniform grid carry all the flux, and the map error shrinks as the tolerance does."""
     flat = wc.Renderer(_flat(55.0, 3.0, **{"caustics.beam_levels": 3, "water.resolution": 64}), "cpu")
     r = flat.render(0.0)
-    assert flat.beams.level_counts[3] == (64 // 8) ** 2 and r.beam_stats["beams"] == 2 * 8 * 8
-    expected = _flat_floor_irradiance(r, 55.0, 3.0)
+    assert flat.method.caustics[0].level_counts[3] == (64 // 8) ** 2 and r.beam_stats["beams"] == 2 * 8 * 8
+    expected = flat_floor_irradiance(r, 55.0, 3.0)
     np.testing.assert_allclose(
         r.floor_irradiance, np.broadcast_to(expected[:, None, None], r.floor_irradiance.shape), rtol=2e-5
     )
@@ -572,12 +552,12 @@ def test_adaptive_beams_refine_where_the_light_bends_and_keep_the_flux():
         "optics.wavelengths": "rgb",
         "optics.water_type": "none",
     }
-    uniform = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
+    uniform = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu")
     l1, counts = [], []
     for tol in (0.0, 0.1, 1.0):
         r = wc.render(
             wc.load_scene(
-                "configs/ocean.toml", {**base, "caustics.beam_levels": 2, "caustics.beam_tolerance": tol}
+                CONFIGS / "ocean.toml", {**base, "caustics.beam_levels": 2, "caustics.beam_tolerance": tol}
             ),
             device="cpu",
         )
@@ -617,8 +597,9 @@ def test_adaptive_beams_refine_near_the_camera_and_refuse_what_they_cannot_do():
         "cpu",
     )
     near.render(0.0)
-    assert far.beams.leaf_count == 64 and near.beams.leaf_count > far.beams.leaf_count
-    assert near.beams.level_counts[0] > 0
+    far_beams, near_beams = far.method.caustics[0], near.method.caustics[0]
+    assert far_beams.leaf_count == 64 and near_beams.leaf_count > far_beams.leaf_count
+    assert near.method.caustics[0].level_counts[0] > 0
     for bad, match in (
         ({"water.model": "pool"}, "needs a periodic sea"),
         ({"caustics.beam_interpolation": "smooth"}, "needs the uniform grid"),
@@ -644,10 +625,11 @@ def test_beams_on_rippled_sand_keep_the_flux_and_agree_with_photons():
         "floor.ripple_wavelength_m": 16.0 / np.hypot(7, 26),
         "floor.ripple_direction_deg": np.degrees(np.arctan2(26, 7)),
     }
-    beams = wc.render(wc.load_scene("configs/ocean.toml", {**common, **BEAMS}), device="cpu")
+    beams = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**common, **BEAMS}), device="cpu")
     photons = wc.render(
         wc.load_scene(
-            "configs/ocean.toml", {**common, "caustics.method": "photons", "caustics.photon_subdivisions": 8}
+            CONFIGS / "ocean.toml",
+            {**common, "caustics.method": "photons", "caustics.photon_subdivisions": 8},
         ),
         device="cpu",
     )
@@ -698,7 +680,7 @@ def test_adaptive_beams_follow_the_waves_from_frame_to_frame():
     are reused, and every frame keeps its flux (slots past a frame's beams carry nothing)."""
     renderer = wc.Renderer(
         wc.load_scene(
-            "configs/ocean.toml",
+            CONFIGS / "ocean.toml",
             {
                 **BEAMS,
                 "caustics.beam_levels": 2,

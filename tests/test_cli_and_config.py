@@ -4,7 +4,6 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +12,8 @@ import warpcaustics as wc
 from warpcaustics.cli import main
 from warpcaustics.errors import ConfigError
 
-ROOT = Path(__file__).resolve().parents[1]
+from helpers import CONFIGS, ROOT
+
 SMALL = ["--set", "water.resolution=32", "--set", "caustics.map_resolution=32",
          "--set", "optics.wavelengths.bins=4"]
 
@@ -56,7 +56,7 @@ def test_unknown_key_names_nearest(capsys, tmp_path):
 
 def test_unknown_key_in_override(capsys, tmp_path):
     """The same check applies to --set overrides."""
-    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "floor.dept_m=3"],
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--set", "floor.dept_m=3"],
                    "floor.dept_m", "'floor.depth_m'")
 
 
@@ -68,13 +68,13 @@ def test_wrong_type(capsys, tmp_path):
 
 def test_out_of_range(capsys, tmp_path):
     """An out-of-range value names the key, the value and the allowed range."""
-    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "sun.elevation_deg=95"],
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--set", "sun.elevation_deg=95"],
                    "sun.elevation_deg = 95.0", "0.0 < value <= 90.0")
 
 
 def test_bad_enum_value(capsys, tmp_path):
     """A value outside a closed set lists what is allowed."""
-    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--set", "water.model=wavy"],
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--set", "water.model=wavy"],
                    "water.model = 'wavy'", "flat, heightfield, fft")
 
 
@@ -96,7 +96,7 @@ def test_heightfield_bad_arrays(capsys, tmp_path, array, needle):
 
 def test_scene_too_big_for_memory(capsys, tmp_path):
     """A scene that cannot fit says how much it needs and which keys to lower."""
-    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"),
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"),
                                       "--set", "caustics.map_resolution=16384",
                                       "--set", "optics.wavelengths.bins=400"],
                    "the scene needs", "GiB", "caustics.map_resolution")
@@ -109,7 +109,7 @@ def test_cuda_requested_without_cuda(capsys, tmp_path):
     if wp.get_cuda_device_count() > 0:
         pytest.skip("this machine has CUDA")
     out_dir = tmp_path / "out"
-    code = main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out_dir),
+    code = main(["render", str(CONFIGS / "ocean.toml"), *SMALL, "--out", str(out_dir),
                  "--device", "cuda"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "no CUDA device is available" in err[0]
@@ -118,10 +118,10 @@ def test_cuda_requested_without_cuda(capsys, tmp_path):
 
 def test_python_overrides_and_errors():
     """Python overrides use the same dotted keys and raise ConfigError with the same message."""
-    scene = wc.load_scene(ROOT / "configs/ocean.toml", overrides={"sun.elevation_deg": 45.0})
+    scene = wc.load_scene(CONFIGS / "ocean.toml", overrides={"sun.elevation_deg": 45.0})
     assert scene.config.sun.elevation_deg == 45.0
     with pytest.raises(ConfigError, match="nearest valid key: 'sun.elevation_deg'"):
-        wc.load_scene(ROOT / "configs/ocean.toml", overrides={"sun.elevation": 45.0})
+        wc.load_scene(CONFIGS / "ocean.toml", overrides={"sun.elevation": 45.0})
 
 
 def test_render_writes_complete_outputs(tmp_path, capsys):
@@ -129,7 +129,7 @@ def test_render_writes_complete_outputs(tmp_path, capsys):
     import OpenEXR
 
     out = tmp_path / "out"
-    assert main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out),
+    assert main(["render", str(CONFIGS / "ocean.toml"), *SMALL, "--out", str(out),
                  "--device", "cpu"]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["frame_0000.exr", "frame_0000.png", "run.json"]
     run = json.loads((out / "run.json").read_text())
@@ -137,7 +137,7 @@ def test_render_writes_complete_outputs(tmp_path, capsys):
     assert {"warp-lang", "numpy", "warpcaustics"} <= set(run["versions"])
     assert {"water", "refraction", "floor_caustics"} <= set(run["frames"][0]["timings_s"])
 
-    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32,
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32,
                                                         "caustics.map_resolution": 32,
                                                         "optics.wavelengths.bins": 4})
     result = wc.render(scene, device="cpu")
@@ -156,7 +156,7 @@ def test_render_writes_complete_outputs(tmp_path, capsys):
 def test_device_environment_variable(tmp_path, monkeypatch):
     """$WARPCAUSTICS_DEVICE picks the device when --device is not given."""
     monkeypatch.setenv("WARPCAUSTICS_DEVICE", "cpu")
-    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32,
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32,
                                                         "caustics.map_resolution": 16,
                                                         "optics.wavelengths.bins": 2})
     assert wc.render(scene).device == "cpu"
@@ -184,7 +184,7 @@ def test_import_is_light():
 def test_animation_writes_numbered_frames(tmp_path):
     """--frames N --fps F writes N numbered frames at t = k/F and lists them in run.json."""
     out = tmp_path / "anim"
-    assert main(["render", str(ROOT / "configs/ocean.toml"), *SMALL, "--out", str(out),
+    assert main(["render", str(CONFIGS / "ocean.toml"), *SMALL, "--out", str(out),
                  "--device", "cpu", "--frames", "3", "--fps", "4"]) == 0
     run = json.loads((out / "run.json").read_text())
     assert [f["time_s"] for f in run["frames"]] == [0.0, 0.25, 0.5]
@@ -195,7 +195,7 @@ def test_animation_writes_numbered_frames(tmp_path):
 
 def test_failed_write_leaves_nothing(tmp_path):
     """A write that fails half-way leaves neither the file nor its temporary behind."""
-    from warpcaustics.io.output import atomic_path
+    from warpcaustics.io.files import atomic_path
 
     target = tmp_path / "frame_0000.exr"
     with pytest.raises(RuntimeError), atomic_path(target) as tmp:
@@ -224,7 +224,7 @@ def test_heightfield_unreadable_files(capsys, tmp_path, writer, needle):
 @pytest.mark.parametrize("time_arg", ["nan", "inf"])
 def test_non_finite_time_is_refused(capsys, tmp_path, time_arg):
     """--time must be a finite number of seconds."""
-    _fails_cleanly(capsys, tmp_path, [str(ROOT / "configs/ocean.toml"), "--time", time_arg], "--time")
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--time", time_arg], "--time")
 
 
 def test_wavelengths_outside_the_data_fail_at_load():
@@ -236,7 +236,7 @@ def test_wavelengths_outside_the_data_fail_at_load():
 def test_results_of_earlier_frames_stay_intact():
     """A Renderer reuses its device buffers; results already returned must not change with the next
     frame (on the CPU, Warp's .numpy() is a view)."""
-    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
                                                         "optics.wavelengths.bins": 2})
     renderer = wc.Renderer(scene, "cpu")
     first = renderer.render(0.0)
@@ -252,7 +252,7 @@ def test_spectral_exr_reads_back_through_colour_science_fichet_reader(tmp_path):
     pytest.importorskip("OpenImageIO")
     import colour
 
-    scene = wc.load_scene(ROOT / "configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 16,
                                                         "optics.wavelengths.bins": 4})
     result = wc.render(scene, device="cpu")
     result.save(tmp_path)
@@ -262,3 +262,32 @@ def test_spectral_exr_reads_back_through_colour_science_fichet_reader(tmp_path):
     assert spec.is_emissive and not spec.is_polarised
     np.testing.assert_allclose(wavelengths, result.wavelengths_nm)
     np.testing.assert_allclose(np.moveaxis(values, -1, 0), result.floor_irradiance[:, ::-1], rtol=1e-6)
+
+
+def test_merged_key_is_refused_naming_its_successor(capsys, tmp_path):
+    """caustics.sunmap_disk_deg, merged into sun.angular_diameter_deg, is refused in a file and in an
+    override with one line that names the key to set instead."""
+    message = "caustics.sunmap_disk_deg was merged into sun.angular_diameter_deg; set that instead"
+    _fails_cleanly(capsys, tmp_path, [_write(tmp_path, "[caustics]\nsunmap_disk_deg = 0.53\n")], message)
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--set", "caustics.sunmap_disk_deg=1"],
+                   message)
+    with pytest.raises(ConfigError, match="sun.angular_diameter_deg"):
+        wc.load_scene(None, {"caustics.method": "sunmap", "caustics.sunmap_disk_deg": 2.0})
+
+
+@pytest.mark.parametrize("diameter_deg", [0.0, 0.53, 2.0])
+def test_sun_map_draws_the_suns_disk(diameter_deg):
+    """The sun map's disk (full brightness inside, the halo's fall-off starting at its edge) is the
+    sun's, sun.angular_diameter_deg: its kernel parameters hold that angular radius (float32)."""
+    import math
+
+    from warpcaustics.caustics.sunmap import SunMapCaustics
+
+    scene = wc.load_scene(None, {"caustics.method": "sunmap", "caustics.map_resolution": 8,
+                                 "sun.angular_diameter_deg": diameter_deg})
+    params = SunMapCaustics(scene.config, scene.sun_direction, 1.333, "cpu", periodic=True).params
+    radius = 0.5 * math.radians(diameter_deg)
+    # the struct stores float32: one rounding of the radius and of its cosine
+    assert params.disk_rad == pytest.approx(radius, rel=1e-7, abs=1e-12)
+    assert params.cos_disk == pytest.approx(math.cos(radius), rel=1e-7)
+    assert params.halo_rad == pytest.approx(0.5 * math.radians(5.3), rel=1e-7)

@@ -10,7 +10,7 @@ from warpcaustics.optics.spectra import SpectralBins
 @pytest.mark.parametrize("bin_nm", [1.0, 5.0])
 def test_d65_is_srgb_white(bin_nm):
     """CIE D65 integrated over 1–5 nm bins maps to linear sRGB (1, 1, 1)·Y within 1e-3."""
-    colour = colour_out._colour()
+    colour = colour_out.colour_science()
     d65 = colour.SDS_ILLUMINANTS["D65"]
     bins = SpectralBins.uniform(380.0, 780.0, int(400 / bin_nm))
     spectrum = bins.average(d65.wavelengths, d65.values, what="D65")
@@ -43,7 +43,7 @@ def test_explicit_and_rgb_wavelengths():
     np.testing.assert_allclose(optics.scattering_per_m[:2], [0.039, 0.035], rtol=1e-12)
     rgb = spectra.bins_for(wc.load_scene(None, {"optics.wavelengths": "rgb"}).config.optics)
     np.testing.assert_allclose(rgb.edges_nm, [400.0, 500.0, 600.0, 700.0])
-    d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
+    d65 = colour_out.colour_science().SDS_ILLUMINANTS["D65"]
     d65_bins = rgb.average(d65.wavelengths, d65.values, "D65")
     xyz = colour_out.spectral_to_xyz(d65_bins[:, None, None], rgb)[0, 0]
     np.testing.assert_allclose(colour_out.xyz_to_linear_srgb(xyz) / xyz[1], 1.0, atol=0.05)
@@ -60,7 +60,7 @@ def test_acescg_white_and_sun_white_balance():
     from warpcaustics.optics import spectra
 
     bins = spectra.SpectralBins.uniform(380.0, 780.0, 80)
-    d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
+    d65 = colour_out.colour_science().SDS_ILLUMINANTS["D65"]
     d65_bins = bins.average(d65.wavelengths, d65.values, "D65")
     xyz = colour_out.spectral_to_xyz(d65_bins[:, None, None], bins)[0, 0]
     np.testing.assert_allclose(colour_out.xyz_to_linear_rgb(xyz, "ACEScg") / xyz[1], 1.0, atol=1e-3)

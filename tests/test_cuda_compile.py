@@ -30,7 +30,8 @@ def _nvrtc_archs() -> set:
 
 pytestmark = pytest.mark.skipif(ARCH not in _nvrtc_archs(), reason="Warp's NVRTC cannot target sm_90 here")
 
-MODULES = sorted(m.name for m in pkgutil.iter_modules(kernels.__path__))
+MODULES = sorted(m.name.removeprefix("warpcaustics.kernels.") for m in pkgutil.walk_packages(
+    kernels.__path__, "warpcaustics.kernels.") if not m.ispkg)  # stage subpackages included
 
 
 @pytest.mark.parametrize("name", MODULES)

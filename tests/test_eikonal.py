@@ -10,7 +10,7 @@ import warpcaustics as wc
 from warpcaustics.caustics.eikonal import relax
 from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, fresnel_t_angles
 
 IOR = 1.333
 
@@ -75,7 +75,7 @@ def test_flat_interface_is_a_plane_front_up_to_the_faces(elevation, model):
     extra = {"water.procedural_amplitude": 0.0} if model == "procedural" else {}
     renderer = wc.Renderer(_flat(elevation, model, **extra), device="cpu")
     result = renderer.render(0.0)
-    eik = renderer.approximate
+    eik = renderer.method.approximate
     assert eik.periodic == (model == "flat")
     psi = eik.psi.numpy()
     # float32 rounding of the upwind solves adds ~1e-7 m of optical path per layer, the same across
@@ -111,7 +111,7 @@ def test_lens_gain_before_focus_matches_paraxial_optics(depth_m):
     1.0 m on a 1.6 cm grid (−1.2 % and −1.3 % on a 0.8 cm grid), so within 5 %."""
     from test_lens import APEX_M, FOCAL_M
 
-    scene = wc.load_scene("configs/lens.toml", {
+    scene = wc.load_scene(CONFIGS / "lens.toml", {
         "caustics.method": "eikonal", "floor.depth_m": depth_m, "optics.water_type": "none",
         "optics.wavelengths": {"min_nm": 500.0, "max_nm": 600.0, "bins": 1}, "caustics.map_resolution": 128,
         "caustics.eikonal_resolution": 128})
@@ -138,7 +138,7 @@ def test_transport_keeps_the_flux_of_the_flux_ratio_map(depth_m):
     """Carrying the Laplacian along the rays keeps the light: over the rough ocean (no absorption)
     the eikonal floor receives the flux-ratio map's flux within 0.5 % (measured +0.35 %, +0.29 %),
     before and past the first caustics."""
-    r = wc.render(wc.load_scene("configs/ocean.toml", {
+    r = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {
         "caustics.method": "eikonal", "water.resolution": 64, "caustics.map_resolution": 64,
         "caustics.eikonal_resolution": 64, "optics.water_type": "none", "floor.depth_m": depth_m,
         "optics.wavelengths": "rgb"}), device="cpu")

@@ -6,16 +6,11 @@ import pytest
 import warpcaustics as wc
 from warpcaustics import reference
 
-from conftest import fresnel_t_angles
+from helpers import flat_floor_irradiance, flat_water_scene, fresnel_t_angles
 
 
 def _flat_scene(elevation_deg, depth_m, water_type="pure", **extra):
-    overrides = {"water.model": "flat", "water.resolution": 32, "water.extent_m": 8.0,
-                 "caustics.map_resolution": 48, "sun.elevation_deg": elevation_deg,
-                 "sun.azimuth_deg": 37.0, "floor.depth_m": depth_m, "optics.water_type": water_type,
-                 "optics.wavelengths.bins": 8, "sun.angular_diameter_deg": 0.0}  # a point sun's references
-    overrides.update(extra)
-    return wc.load_scene(None, overrides)
+    return flat_water_scene(elevation_deg, depth_m, water_type, **{"caustics.map_resolution": 48, **extra})
 
 
 @pytest.mark.parametrize("elevation_deg", [15.0, 40.0, 65.0, 90.0])
@@ -23,12 +18,7 @@ def _flat_scene(elevation_deg, depth_m, water_type="pure", **extra):
 def test_flat_water_matches_beer_lambert_and_fresnel(device, elevation_deg, depth_m):
     """Flat water: E = E_sun cosθ T(θ) exp(-c D / cosθ_t), uniform over the floor (1e-4)."""
     result = wc.render(_flat_scene(elevation_deg, depth_m), device=device)
-    theta = np.radians(90.0 - elevation_deg)
-    n = 1.333
-    cos_t = np.sqrt(1.0 - (np.sin(theta) / n) ** 2)
-    t_fresnel = fresnel_t_angles(np.array([theta]), 1.0, n)[0]
-    expected = result.sun_irradiance * np.cos(theta) * t_fresnel * np.exp(
-        -result.attenuation_per_m * depth_m / cos_t)
+    expected = flat_floor_irradiance(result, elevation_deg, depth_m)
     floor = result.floor_irradiance.astype(np.float64)
     assert np.all(result.attenuation_per_m > 0)  # the pure-water path is really exercised
     # The issue asks for 0.5 %; float32 geometry reaches ~1e-5, so hold it to 1e-4.
@@ -191,7 +181,7 @@ def test_huge_footprints_stay_bounded_and_conserve_flux(device):
                                  "optics.water_type": "none", "optics.wavelengths.bins": 2})
     renderer = wc.Renderer(scene, device)
     result = renderer.render(0.0)
-    assert renderer.floor.coarse_count.numpy()[0] > 0
+    assert renderer.method.floor.coarse_count.numpy()[0] > 0
     np.testing.assert_allclose(result.floor_flux_w_nm, result.transmitted_flux_w_nm, rtol=1e-4)
 
 
@@ -205,11 +195,7 @@ def test_dispersion_flat_water_and_energy(device):
     result = wc.render(_flat_scene(35.0, 5.0, **{"optics.dispersion": True}), device=device)
     n = spectra.quan_fry_index(result.wavelengths_nm, 35.0, 20.0)
     np.testing.assert_allclose(result.ior, n)
-    theta = np.radians(55.0)
-    cos_t = np.sqrt(1.0 - (np.sin(theta) / n) ** 2)
-    t_fresnel = np.array([fresnel_t_angles(np.array([theta]), 1.0, nk)[0] for nk in n])
-    attenuation = np.exp(-result.attenuation_per_m * 5.0 / cos_t)
-    expected = result.sun_irradiance * np.cos(theta) * t_fresnel * attenuation
+    expected = flat_floor_irradiance(result, 35.0, 5.0, ior=n)
     floor = result.floor_irradiance.astype(np.float64)
     np.testing.assert_allclose(floor, np.broadcast_to(expected[:, None, None], floor.shape), rtol=1e-4)
 

@@ -8,7 +8,7 @@ import pytest
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, fresnel_t_angles
 
 BASE = {"water.resolution": 64, "optics.wavelengths": "rgb", "sun.angular_diameter_deg": 0.0}
 
@@ -18,11 +18,11 @@ def test_window_is_the_crop_of_the_whole_map(centre):
     """A 4 m window of the 16 m ocean at the whole map's texel size equals that map's crop, also
     across the patch's periodic seam (x = ±8 m): each footprint lands at its nearest image."""
     full = wc.render(
-        wc.load_scene("configs/ocean.toml", {**BASE, "caustics.map_resolution": 128}), device="cpu"
+        wc.load_scene(CONFIGS / "ocean.toml", {**BASE, "caustics.map_resolution": 128}), device="cpu"
     )
     win = wc.render(
         wc.load_scene(
-            "configs/ocean.toml",
+            CONFIGS / "ocean.toml",
             {
                 **BASE,
                 "caustics.map_resolution": 32,
@@ -81,7 +81,7 @@ def test_window_statistics_use_its_texels():
     """Statistics on a window use the window's texel size and centre (the default probe)."""
     r = wc.render(
         wc.load_scene(
-            "configs/ocean.toml",
+            CONFIGS / "ocean.toml",
             {
                 **BASE,
                 "caustics.map_resolution": 40,
@@ -123,11 +123,11 @@ def test_window_errors_are_one_line(overrides, needle):
     """A window larger than the sea, a centre without a window, a window with another method, a
     malformed centre and a probe off the window are refused naming the key."""
     with pytest.raises(ConfigError, match=needle) as err:
-        wc.load_scene("configs/ocean.toml", overrides)
+        wc.load_scene(CONFIGS / "ocean.toml", overrides)
     assert "\n" not in str(err.value)
     with pytest.raises(ConfigError, match="reaches past"):
         wc.load_scene(
-            "configs/pool.toml", {"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.8, 0.0]}
+            CONFIGS / "pool.toml", {"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.8, 0.0]}
         )
 
 
@@ -135,10 +135,11 @@ def test_a_window_as_wide_as_the_patch_wraps_and_keeps_the_flux():
     """On a periodic sea a window the size of the patch is the patch, shifted: it wraps, keeps
     every watt (floor = transmitted, water_type none), and equals the whole map rolled."""
     base = {**BASE, "caustics.map_resolution": 64, "optics.water_type": "none"}
-    full = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
+    full = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu")
     shifted = wc.render(
         wc.load_scene(
-            "configs/ocean.toml", {**base, "caustics.map_extent_m": 16.0, "caustics.map_center_m": [3.0, 0.0]}
+            CONFIGS / "ocean.toml",
+            {**base, "caustics.map_extent_m": 16.0, "caustics.map_center_m": [3.0, 0.0]},
         ),
         device="cpu",
     )

@@ -13,7 +13,7 @@ from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.errors import ConfigError
 from warpcaustics.kernels.caustics import multiple as mc_kernels
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, fresnel_t_angles
 
 BASE = {
     "water.model": "flat",
@@ -81,7 +81,7 @@ def contrast_without_noise(scene_overrides: dict) -> tuple[np.ndarray, np.ndarra
     maps = []
     for seed in (1, 2):
         r = wc.render(
-            wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 0.0, **scene_overrides,
+            wc.load_scene(CONFIGS / "ocean.toml", {"sun.angular_diameter_deg": 0.0, **scene_overrides,
                                                  "optics.mc_seed": seed}), device="cpu"
         )
         maps.append(r.floor_irradiance.astype(np.float64))
@@ -115,7 +115,7 @@ def test_multiple_scattering_errors_are_one_line():
     with pytest.raises(ConfigError, match="optics.scattering"):
         wc.load_scene(None, {**BASE, "caustics.method": "beams"})
     with pytest.raises(ConfigError, match="periodic sea"):
-        wc.load_scene("configs/pool.toml", {"optics.scattering": "multiple"})
+        wc.load_scene(CONFIGS / "pool.toml", {"optics.scattering": "multiple"})
 
 
 def test_the_walk_into_a_window_fills_the_whole_maps_texels():
@@ -124,8 +124,8 @@ def test_the_walk_into_a_window_fills_the_whole_maps_texels():
     whole map's texel there (1e-5, float32 sums), and every watt on the floor is tallied alike."""
     base = {"water.resolution": 32, "optics.wavelengths": "rgb", "optics.water_type": "coastal_ocean",
             "floor.depth_m": 3.0, "optics.scattering": "multiple", "caustics.map_resolution": 32}
-    whole = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu")
-    window = wc.render(wc.load_scene("configs/ocean.toml", {**base, "caustics.map_extent_m": 8.0,
+    whole = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu")
+    window = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, "caustics.map_extent_m": 8.0,
                                                             "caustics.map_center_m": [4.0, -2.0]}),
                        device="cpu")
     blocks = window.floor_irradiance.reshape(3, 16, 2, 16, 2).mean(axis=(2, 4))
@@ -151,7 +151,7 @@ def sky_walk(absorption: np.ndarray, scattering: np.ndarray, depth_m: float = 2.
     renderer = wc.Renderer(scene, device="cpu")
     e_sky = scene.sky_irradiance(renderer.sun_irradiance)
     walk = sky_walker(scene, renderer, absorption, scattering)
-    visible = renderer.sky_visible
+    visible = renderer.light.sky_visible
     visible.fill_(1.0)
     floor, st = walk.run_sky(renderer.water.at(0.0), visible)
     return scene, walk, floor, st, e_sky
@@ -268,10 +268,11 @@ def test_no_direction_is_tied_to_a_part_of_every_cell(light, threshold):
         surface = renderer.water.at(0.0)
         if light == "sky":
             walk = sky_walker(scene, renderer, np.zeros(3), np.zeros(3))
-            renderer.sky_visible.fill_(1.0)
-            floor, _ = walk.run_sky(surface, renderer.sky_visible)
+            renderer.light.sky_visible.fill_(1.0)
+            floor, _ = walk.run_sky(surface, renderer.light.sky_visible)
         else:
-            walk = MultipleScattering(scene.config, renderer.sun_directions, 1.333, renderer.sun_irradiance,
+            walk = MultipleScattering(scene.config, renderer.light.sun_directions, 1.333,
+                                      renderer.sun_irradiance,
                                       np.zeros(3), np.zeros(3), "cpu")
             renderer.visible.fill_(1.0)
             floor, _ = walk.run(surface, renderer.visible)

@@ -7,12 +7,12 @@ import pytest
 
 import warpcaustics as wc
 
+from helpers import CONFIGS, ROOT
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_every_subpackage_is_listed():
@@ -36,7 +36,7 @@ def test_kernels_import_as_subpackage():
     assert "kernels" not in sys.modules
 
 
-@pytest.mark.parametrize("config", sorted((ROOT / "configs").glob("*.toml")), ids=lambda p: p.name)
+@pytest.mark.parametrize("config", sorted(CONFIGS.glob("*.toml")), ids=lambda p: p.name)
 def test_shipped_configs_render(config, tmp_path):
     """Each file in configs/ validates and renders (at a reduced size) with flux conserved; a study
     file runs its study (at a reduced size)."""

@@ -8,7 +8,10 @@ import pytest
 @pytest.mark.parametrize("intersection", ["exact", "newton"])
 def test_numpy_photons_match_warp(intersection):
     """The float64 numpy photon splatting and the Warp photon stage give the same floor map."""
-    from benchmarks.photons import PhotonCase, numpy_photons, relative_l1
+    from warpcaustics.reference import relative_l1
+    from warpcaustics.reference.photons import numpy_photons
+
+    from benchmarks.photons import PhotonCase
 
     case = PhotonCase(32, 2, 32, intersection, "cpu")
     warp_map = case.run_warp()

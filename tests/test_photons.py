@@ -1,6 +1,8 @@
 """Photon caustics: analytic flat water, flux conservation, Shah's iteration against the exact BVH
 hits, occlusion, the camera G-buffer and light shafts, and agreement with the flux-ratio map."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,28 +11,14 @@ from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.optics import spectra
 from warpcaustics.optics.phase import PhaseFunction
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, flat_floor_irradiance, flat_water_scene, fresnel_t_angles
 
 PHOTONS = {"caustics.method": "photons"}
 
 
 def _flat(elevation_deg, depth_m, water_type="pure", **extra):
-    overrides = {
-        **PHOTONS,
-        "water.model": "flat",
-        "water.resolution": 32,
-        "water.extent_m": 8.0,
-        "caustics.map_resolution": 32,
-        "caustics.photon_subdivisions": 2,
-        "sun.elevation_deg": elevation_deg,
-        "sun.azimuth_deg": 37.0,
-        "sun.angular_diameter_deg": 0.0,  # the analytic references are a point sun's
-        "floor.depth_m": depth_m,
-        "optics.water_type": water_type,
-        "optics.wavelengths.bins": 8,
-    }
-    overrides.update(extra)
-    return wc.load_scene(None, overrides)
+    return flat_water_scene(elevation_deg, depth_m, water_type,
+                            **{**PHOTONS, "caustics.photon_subdivisions": 2, **extra})
 
 
 @pytest.mark.parametrize("intersection", ["exact", "newton"])
@@ -43,14 +31,7 @@ def test_flat_water_photons_match_analytic_irradiance(device, intersection, elev
     """
     depth = 3.0
     result = wc.render(_flat(elevation_deg, depth, **{"caustics.intersection": intersection}), device=device)
-    theta = np.radians(90.0 - elevation_deg)
-    cos_t = np.sqrt(1.0 - (np.sin(theta) / 1.333) ** 2)
-    expected = (
-        result.sun_irradiance
-        * np.cos(theta)
-        * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
-        * np.exp(-result.attenuation_per_m * depth / cos_t)
-    )
+    expected = flat_floor_irradiance(result, elevation_deg, depth)
     floor = result.floor_irradiance.astype(np.float64)
     # Newton starts on the floor plane, so on flat water its hits are exact from the start: both
     # modes agree to float32 (measured ≤ 6.5e-7 and ≤ 8.2e-7, docs/validation.md).
@@ -60,7 +41,7 @@ def test_flat_water_photons_match_analytic_irradiance(device, intersection, elev
 def test_photon_flux_is_conserved_on_a_rough_ocean(device):
     """water_type = none: flux deposited on the floor = flux the photons carry through the surface."""
     scene = wc.load_scene(
-        "configs/ocean.toml",
+        CONFIGS / "ocean.toml",
         {
             **PHOTONS,
             "water.resolution": 64,
@@ -82,7 +63,7 @@ def test_photon_flux_is_conserved_in_a_walled_pool_with_an_object(device):
     """In a pool every transmitted photon lands on the floor, a wall or the object: their fluxes
     add up to what entered the water (water_type = none)."""
     scene = wc.load_scene(
-        "configs/pool.toml",
+        CONFIGS / "pool.toml",
         {
             **PHOTONS,
             "water.resolution": 48,
@@ -109,7 +90,7 @@ def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
     share closer than one light-view texel); and that texel's size [m]. ``scene_overrides`` may
     name a ``config`` (default the ocean) and the ``time_s`` rendered."""
     overrides = dict(scene_overrides)
-    config = overrides.pop("config", "configs/ocean.toml")
+    config = overrides.pop("config", CONFIGS / "ocean.toml")
     time_s = overrides.pop("time_s", 0.0)
     base = {
         **PHOTONS,
@@ -122,29 +103,29 @@ def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
     }
     exact = wc.Renderer(wc.load_scene(config, {**base, "caustics.intersection": "exact"}), device)
     exact.render(time_s)
-    hit = exact.photons.hit.numpy().copy()
-    face = exact.photons.face.numpy().copy()
-    on_receiver = exact.receivers.face_receiver_np[np.maximum(face, 0)] == receiver
+    hit = exact.method.caustics[0].hit.numpy().copy()
+    face = exact.method.caustics[0].face.numpy().copy()
+    on_receiver = exact.method.receivers.face_receiver_np[np.maximum(face, 0)] == receiver
     out = []
     for k in iterations:
         newton = {**base, "caustics.intersection": "newton", "caustics.newton_iterations": k}
         r = wc.Renderer(wc.load_scene(config, newton), device)
         r.render(time_s)
-        ok = (face >= 0) & on_receiver & (r.photons.face.numpy() >= 0)
-        err = np.linalg.norm(r.photons.hit.numpy()[ok] - hit[ok], axis=1)
+        ok = (face >= 0) & on_receiver & (r.method.caustics[0].face.numpy() >= 0)
+        err = np.linalg.norm(r.method.caustics[0].hit.numpy()[ok] - hit[ok], axis=1)
         out.append(
             {
                 "mean": float(err.mean()),
                 "median": float(np.median(err)),
                 "p95": float(np.percentile(err, 95)),
-                "within_texel": float(np.mean(err < r.photons.view.texel_m)),
+                "within_texel": float(np.mean(err < r.method.caustics[0].view.texel_m)),
             }
         )
-    return out, r.photons.view.texel_m
+    return out, r.method.caustics[0].view.texel_m
 
 
 SLOPE = {
-    "config": "configs/pool.toml",
+    "config": CONFIGS / "pool.toml",
     "time_s": 0.6,
     "floor.shape": "slope",
     "floor.slope_deg": 15.0,
@@ -185,7 +166,7 @@ def test_newton_hits_approach_the_exact_hits_on_a_mesh():
     assert errors[-1]["within_texel"] > 0.95
 
 
-def pool_flux_by_intersection(elevation_deg: float, config: str = "configs/pool.toml",
+def pool_flux_by_intersection(elevation_deg: float, config: str | Path = CONFIGS / "pool.toml",
                               device: str = "cpu") -> dict:
     """Floor and wall flux (bands summed) [W nm^-1] of a walled pool 0.6 s after its drops with
     exact and with Newton hits (k = 3, 1024² light view), sun at ``elevation_deg``, no absorption;
@@ -204,8 +185,7 @@ def pool_flux_by_intersection(elevation_deg: float, config: str = "configs/pool.
 
 
 @pytest.mark.parametrize(("config", "elevation_deg"),
-                         [("configs/pool.toml", 20.0), ("configs/pool.toml", 70.0),
-                          ("configs/wavepool.toml", 30.0)])
+                         [("pool.toml", 20.0), ("pool.toml", 70.0), ("wavepool.toml", 30.0)])
 def test_newton_puts_the_pools_light_on_the_same_receivers_as_exact_hits(config, elevation_deg):
     """Shah's light view looks along the sun's refracted direction and passes through the walls of a
     pool where it meets them from outside (light enters through the water, not through them), so
@@ -216,7 +196,7 @@ def test_newton_puts_the_pools_light_on_the_same_receivers_as_exact_hits(config,
     (Viewed along the sun in air, two thirds of the floor's flux went to the walls at 40° in
     pool.toml, and all of it at 20°.) wavepool.toml has the larger waves: crests send some light
     (0.06 % at 30°) onto the walls above the water at rest."""
-    f = pool_flux_by_intersection(elevation_deg, config)
+    f = pool_flux_by_intersection(elevation_deg, CONFIGS / config)
     for part in ("floor", "walls"):
         assert abs(f["newton"][part] - f["exact"][part]) < 5e-3 * f["transmitted"], part
     assert f["exact"]["floor"] + f["exact"]["walls"] == pytest.approx(f["transmitted"], rel=1e-4)
@@ -358,11 +338,11 @@ def test_photons_agree_with_the_flux_ratio_map():
     """Ocean (128² surface, 32² map): photons at 4×4 per cell (256 per texel) within 3 % relative L1
     of the flux-ratio map; one photon per cell (16 per texel) agrees less well."""
     base = {"water.resolution": 128, "caustics.map_resolution": 32, "optics.wavelengths": "rgb"}
-    reference = wc.render(wc.load_scene("configs/ocean.toml", base), device="cpu").floor_irradiance
+    reference = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu").floor_irradiance
     l1 = []
     for s in (1, 4):
         f = wc.render(
-            wc.load_scene("configs/ocean.toml", {**base, **PHOTONS, "caustics.photon_subdivisions": s}),
+            wc.load_scene(CONFIGS / "ocean.toml", {**base, **PHOTONS, "caustics.photon_subdivisions": s}),
             device="cpu",
         ).floor_irradiance
         l1.append(np.abs(f - reference).sum() / np.abs(reference).sum())
@@ -477,7 +457,8 @@ def test_mesh_files_and_spectral_albedo_files(tmp_path):
             rtol=1e-5,
         )
     centres = result.wavelengths_nm
-    np.testing.assert_allclose(files.receivers.albedo[3], 0.1 + 0.8 * (centres - 380.0) / 400.0, rtol=1e-6)
+    np.testing.assert_allclose(files.method.receivers.albedo[3], 0.1 + 0.8 * (centres - 380.0) / 400.0,
+                               rtol=1e-6)
     with pytest.raises(ConfigError, match=r"receivers\[0\].albedo_file = .* at most 1"):
         (tmp_path / "bad.csv").write_text("wavelength_nm,reflectance\n380,0.5\n780,1.5\n")
         wc.load_scene(tmp_path / "scene.toml", {**PHOTONS, "receivers": [{"albedo_file": "bad.csv"}]})
@@ -502,14 +483,7 @@ def test_camera_sees_the_floor_beyond_the_patch_with_the_right_attenuation():
     }
     result = wc.render(_flat(60.0, 3.0, **overrides), device="cpu")
     g = result.camera_gbuffer
-    theta = np.radians(30.0)
-    cos_t = np.sqrt(1.0 - (np.sin(theta) / 1.333) ** 2)
-    floor = (
-        result.sun_irradiance
-        * np.cos(theta)
-        * fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
-        * np.exp(-result.attenuation_per_m * 3.0 / cos_t)
-    )
+    floor = flat_floor_irradiance(result, 60.0, 3.0)
     x = g["position"][..., 0]
     for inside in (True, False):
         seen = (g["receiver"] == 0) & ((x < 3.9) if inside else (x > 4.1))
@@ -528,7 +502,7 @@ def test_rippled_floor_under_a_periodic_sea_keeps_the_flux():
     """Ripples that tile the patch under a rough ocean (water_type none): the flux on the floor,
     summed over its true (rippled) area, equals the flux that entered the water."""
     scene = wc.load_scene(
-        "configs/ocean.toml",
+        CONFIGS / "ocean.toml",
         {
             **PHOTONS,
             "water.resolution": 64,
@@ -602,12 +576,12 @@ def test_scenes_photons_cannot_render_are_refused():
     }
     with pytest.raises(ConfigError, match="outside the pool's walls"):
         wc.Renderer(
-            wc.load_scene("configs/pool.toml", {**pool, "camera.position_m": [-3.0, 0.0, -0.5]}), "cpu"
+            wc.load_scene(CONFIGS / "pool.toml", {**pool, "camera.position_m": [-3.0, 0.0, -0.5]}), "cpu"
         )
     with pytest.raises(ConfigError, match="below the floor"):
         wc.Renderer(
             wc.load_scene(
-                "configs/pool.toml",
+                CONFIGS / "pool.toml",
                 {**pool, "camera.position_m": [0.0, 0.0, -2.0], "camera.look_at_m": [1.0, 0.0, -2.0]},
             ),
             "cpu",
@@ -620,7 +594,7 @@ def test_vtk_files_read_back_with_pyvista(tmp_path):
     import pyvista as pv
 
     scene = wc.load_scene(
-        "configs/pool.toml",
+        CONFIGS / "pool.toml",
         {
             **PHOTONS,
             "water.resolution": 32,
@@ -658,7 +632,7 @@ def test_preview_draws_a_png(tmp_path):
     from warpcaustics.io.preview import preview_png
 
     scene = wc.load_scene(
-        "configs/pool.toml",
+        CONFIGS / "pool.toml",
         {
             **PHOTONS,
             "water.resolution": 32,
@@ -688,7 +662,7 @@ def test_albedo_and_relief_areas_follow_their_definitions():
     red = albedo_spectrum((0.8, 0.1, 0.1), bins)
     assert red[-1] > 2 * red[0]  # a red surface reflects long wavelengths more than short ones
     scene = wc.load_scene(
-        "configs/pool.toml",
+        CONFIGS / "pool.toml",
         {**PHOTONS, "floor.shape": "slope", "floor.slope_deg": 12.0, "caustics.map_resolution": 16},
     )
     area = floor_texel_area(scene.config, None)

@@ -8,6 +8,8 @@ import warpcaustics as wc
 from warpcaustics.config import DropConfig
 from warpcaustics.water.pool import ShallowWaterPool
 
+from helpers import CONFIGS, fresnel_t_angles, subnormal_count
+
 DEPTH_M = 1.5
 
 
@@ -214,8 +216,6 @@ def test_walled_pool_floor_flux(device):
 
 
 def fresnel_t(theta):
-    from conftest import fresnel_t_angles
-
     return fresnel_t_angles(np.array([theta]), 1.0, 1.333)[0]
 
 
@@ -260,14 +260,14 @@ def test_pool_over_a_floor_relief_keeps_still_water_still_and_its_volume(device)
     stays exactly still (gravity pushes on ∇η, not on ∇h), and after a drop the volume is kept."""
     overrides = {"caustics.method": "photons", "water.resolution": 64, "caustics.map_resolution": 64,
                  "floor.shape": "slope", "floor.slope_deg": 10.0, "floor.slope_azimuth_deg": 30.0}
-    still = wc.Renderer(wc.load_scene("configs/pool.toml", {**overrides, "water.drops": []}), device)
+    still = wc.Renderer(wc.load_scene(CONFIGS / "pool.toml", {**overrides, "water.drops": []}), device)
     depth = still.water.floor_depth.numpy()
     assert depth.max() - depth.min() > 0.5  # the depth map really varies
     result = still.render(1.0)
     assert still.water.substeps > 100
     assert np.abs(result.surface_positions[..., 2]).max() < 1e-6
     pool = ShallowWaterPool.from_config(
-        wc.load_scene("configs/pool.toml", {**overrides, "water.drops": [
+        wc.load_scene(CONFIGS / "pool.toml", {**overrides, "water.drops": [
             {"time_s": 0.0, "x_m": 0.5, "y_m": 0.2, "radius_m": 0.2, "height_m": 0.1}]}).config, device)
     before = pool.volume_m3()
     for _ in range(500):
@@ -278,7 +278,7 @@ def test_pool_over_a_floor_relief_keeps_still_water_still_and_its_volume(device)
 
 def test_pool_refuses_a_floor_that_reaches_the_water():
     """A relief that breaks the surface is a one-line error naming floor.shape, not a crash."""
-    scene = wc.load_scene("configs/pool.toml", {"caustics.method": "photons", "floor.shape": "slope",
+    scene = wc.load_scene(CONFIGS / "pool.toml", {"caustics.method": "photons", "floor.shape": "slope",
                                                 "floor.slope_deg": 50.0})
     with pytest.raises(wc.WarpcausticsError, match="floor.shape = 'slope' reaches the water surface"):
         wc.Renderer(scene, "cpu")
@@ -334,7 +334,7 @@ def test_slow_faces_rest_instead_of_going_subnormal(monkeypatch):
     import benchmarks.pool_step as twin
     from benchmarks.pool_step import _dt
 
-    scene = wc.load_scene("configs/pool.toml", {"water.resolution": 128})
+    scene = wc.load_scene(CONFIGS / "pool.toml", {"water.resolution": 128})
     pool = ShallowWaterPool.from_config(scene.config, "cpu")
     dt = _dt(pool)
     h, u, v = (a.numpy().copy() for a in (pool.h, pool.u, pool.v))
@@ -342,13 +342,8 @@ def test_slow_faces_rest_instead_of_going_subnormal(monkeypatch):
     for _ in range(64):
         pool.step(dt)
         h, u, v = twin.numpy_step(h, u, v, pool.floor_depth.numpy(), dt, pool.cell_m, pool.viscosity)
-    tiny = np.finfo(np.float32).tiny
-
-    def subnormal(a):
-        return np.count_nonzero((np.abs(a) < tiny) & (a != 0))
-
-    assert subnormal(u) + subnormal(v) > 0  # what the rest speed avoids
-    assert subnormal(pool.u.numpy()) + subnormal(pool.v.numpy()) == 0
+    assert subnormal_count(u) + subnormal_count(v) > 0  # what the rest speed avoids
+    assert subnormal_count(pool.u.numpy()) + subnormal_count(pool.v.numpy()) == 0
     np.testing.assert_array_equal(pool.h.numpy(), h)
     assert np.abs(pool.u.numpy() - u).max() < 10 * REST_SPEED
     assert np.abs(pool.v.numpy() - v).max() < 10 * REST_SPEED

@@ -7,12 +7,14 @@ import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 from warpcaustics.water import ProceduralWater
 
+from helpers import CONFIGS
+
 PARAMS = dict(amplitude=0.01, frequency=10.0, factor=1.0, speed_rad_s=2.0, octaves=4)
 
 
 def chapter_wave(x, y, t, *, amplitude, frequency, factor, speed_rad_s, octaves, scale_m):
     """float64 transcription of the chapter's ``wave(x, y, timer)`` in unit coordinates x/ℓ, scaled
-    back to metres (written from the chapter, independently of kernels/procedural.py)."""
+    back to metres (written from the chapter, independently of kernels/water/procedural.py)."""
     u, v = np.asarray(x, np.float64) / scale_m, np.asarray(y, np.float64) / scale_m
     d = np.sqrt(u * u + v * v)
     z = np.zeros_like(u)
@@ -80,7 +82,7 @@ def test_open_patch_floor_keeps_the_transmitted_flux():
     patch lands on the floor except what is bent out across its edge. That part grows with the
     amplitude: with A = 1e-4 (slopes ≤ 0.01) it is 2.8e-4 of the flux, with A = 1e-6 it must be
     ≤ 1e-5 (there are no walls to catch or lose more)."""
-    scene = wc.load_scene("configs/procedural.toml", overrides={
+    scene = wc.load_scene(CONFIGS / "procedural.toml", overrides={
         "water.procedural_amplitude": 1e-6, "water.resolution": 64, "sun.elevation_deg": 90.0,
         "sun.angular_diameter_deg": 0.0,  # a disk's tilted rays would also cross the edge
         "optics.water_type": "none", "caustics.map_resolution": 64,
@@ -93,11 +95,11 @@ def test_open_patch_floor_keeps_the_transmitted_flux():
 def test_procedural_config_errors():
     """Bad procedural settings fail with one line naming the key."""
     with pytest.raises(ConfigError, match="water.procedural_octaves"):
-        wc.load_scene("configs/procedural.toml", overrides={"water.procedural_octaves": 0})
+        wc.load_scene(CONFIGS / "procedural.toml", overrides={"water.procedural_octaves": 0})
     with pytest.raises(ConfigError, match="water.procedural_frequency"):
-        wc.load_scene("configs/procedural.toml", overrides={"water.procedural_frequency": -1.0})
+        wc.load_scene(CONFIGS / "procedural.toml", overrides={"water.procedural_frequency": -1.0})
     with pytest.raises(ConfigError, match="caustics.beam_levels"):
-        wc.load_scene("configs/procedural.toml", overrides={"caustics.beam_levels": 1,
+        wc.load_scene(CONFIGS / "procedural.toml", overrides={"caustics.beam_levels": 1,
                                                             "caustics.method": "beams"})
 
 
@@ -108,7 +110,7 @@ def test_open_patch_loses_the_light_bent_past_its_edge():
     import math
 
     depth, extent, el, az = 1.5, 4.0, 40.0, 25.0
-    scene = wc.load_scene("configs/procedural.toml", {
+    scene = wc.load_scene(CONFIGS / "procedural.toml", {
         "water.procedural_amplitude": 0.0, "water.resolution": 64, "sun.elevation_deg": el,
         "sun.azimuth_deg": az, "floor.depth_m": depth, "optics.water_type": "none",
         "caustics.map_resolution": 64, "optics.wavelengths": {"min_nm": 500.0, "max_nm": 600.0, "bins": 1}})

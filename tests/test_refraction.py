@@ -6,7 +6,7 @@ import warp as wp
 
 from warpcaustics.kernels import geometry
 
-from conftest import fresnel_t_angles
+from helpers import SHARED_WATER_DATA, fresnel_t_angles
 
 
 @wp.kernel
@@ -87,14 +87,12 @@ def test_dispersion_follows_quan_fry(device):
     """With dispersion, the refraction angle at 450 and 650 nm matches Snell with Quan & Fry's n(λ)
     to 1e-6 rad; n(λ) itself equals the shared data's tabulated Quan–Fry values (20 °C, 35 ‰)."""
     import csv
-    from pathlib import Path
 
     from warpcaustics.optics import spectra
     from warpcaustics.optics.refraction import refract_to_floor
     from warpcaustics.water import HeightfieldWater
 
-    table = (Path(__file__).resolve().parents[2] / "shared" / "data" / "water"
-             / "n_water_quan_fry_1995_computed.csv")
+    table = SHARED_WATER_DATA / "n_water_quan_fry_1995_computed.csv"
     if not table.exists():  # the shared data sit beside the checkout in CI and development
         pytest.skip("shared/data not beside this checkout")
     rows = {float(r["wavelength_nm"]): float(r["n_rel_air_T20_S35"]) for r in csv.DictReader(table.open())}

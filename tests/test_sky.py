@@ -9,7 +9,7 @@ from scipy import integrate
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 
-from conftest import fresnel_t_angles
+from helpers import fresnel_t_angles
 
 BASE = {
     "water.model": "flat",
@@ -126,4 +126,5 @@ def test_grid_methods_solve_the_sky_a_direction_at_a_time(method, rtol):
                                atol=1e-6 * sun_only.floor_irradiance.max())
     np.testing.assert_array_equal(renderer.render(0.0).floor_irradiance, r.floor_irradiance)
     if method == "eikonal":
-        np.testing.assert_array_equal(renderer.approximate.texture(), sun_renderer.approximate.texture())
+        np.testing.assert_array_equal(renderer.method.approximate.texture(),
+                                      sun_renderer.method.approximate.texture())

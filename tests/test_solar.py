@@ -11,6 +11,8 @@ import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 from warpcaustics.optics.solar import sun_position
 
+from helpers import CONFIGS
+
 
 def _spa_example() -> dict:
     """The expected values of the NREL SPA example as pvlib ships them
@@ -40,7 +42,7 @@ def test_sun_position_matches_the_spa_reference_example():
 def test_config_takes_a_date_time_and_place():
     """sun.datetime with latitude and longitude resolves into elevation and azimuth in the config
     (overrides replace the file's angles); in the morning the sun is east of south (+x, −y)."""
-    scene = wc.load_scene("configs/ocean.toml", {"sun.datetime": "2009-07-14T09:00:00+00:00",
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"sun.datetime": "2009-07-14T09:00:00+00:00",
                                                  "sun.latitude_deg": 43.7, "sun.longitude_deg": 7.3})
     sun = scene.config.sun
     assert 20.0 < sun.elevation_deg < 60.0

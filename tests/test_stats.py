@@ -12,6 +12,8 @@ import warpcaustics as wc
 from warpcaustics.batch import stats
 from warpcaustics.errors import ConfigError
 
+from helpers import CONFIGS
+
 
 def _spectrum(wl):
     """A smooth made-up spectral irradiance [W m⁻² nm⁻¹] (a test input, not data)."""
@@ -102,7 +104,7 @@ def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
     from warpcaustics.cli import main
 
     out = tmp_path / "anim"
-    code = main(["render", "configs/ocean.toml", "--out", str(out), "--frames", "4", "--fps", "10",
+    code = main(["render", str(CONFIGS / "ocean.toml"), "--out", str(out), "--frames", "4", "--fps", "10",
                  "--quiet",
                  "--set", "water.resolution=32", "--set", "caustics.map_resolution=32",
                  "--set", "stats.wavelength_nm=510", "--set", "stats.collector_mm=3000",
@@ -136,10 +138,10 @@ def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
 def test_stats_config_errors(monkeypatch):
     """A probe off the map, and NetCDF without xarray, fail at load with one line naming the key."""
     with pytest.raises(ConfigError, match=r"stats.probes\[0\]"):
-        wc.load_scene("configs/ocean.toml", {"stats.probes": [{"x_m": 20.0, "y_m": 0.0}]})
+        wc.load_scene(CONFIGS / "ocean.toml", {"stats.probes": [{"x_m": 20.0, "y_m": 0.0}]})
     monkeypatch.setitem(__import__("sys").modules, "xarray", None)
     with pytest.raises(ConfigError, match="output.netcdf"):
-        wc.load_scene("configs/ocean.toml", {"output.netcdf": True})
+        wc.load_scene(CONFIGS / "ocean.toml", {"output.netcdf": True})
 
 
 def test_collector_wider_than_the_map_folds_onto_a_periodic_map():
@@ -171,7 +173,7 @@ def test_sky_and_direct_parts_have_their_own_statistics():
     import warpcaustics as wc
     from warpcaustics.batch.stats import band_integrated, frame_statistics
 
-    scene = wc.load_scene("configs/ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 32,
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 32,
                                                  "sky.model": "uniform", "sky.diffuse_fraction": 0.3,
                                                  "sky.directions": 4, "stats.collector_mm": 300.0})
     r = wc.render(scene, device="cpu")

@@ -1,12 +1,13 @@
 """The water-type study: its tables, and its effective attenuation against Beer–Lambert."""
 
 import csv
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from warpcaustics.cli import main
+
+from helpers import CONFIGS
 
 
 def test_study_on_still_water_recovers_the_beam_attenuation(tmp_path, capsys):
@@ -67,9 +68,8 @@ def test_nested_overrides_set_keys_not_sections(tmp_path):
     import warpcaustics as wc
     from warpcaustics.batch.study import load_study
 
-    root = Path(__file__).resolve().parents[1]
     study = tmp_path / "study.toml"
-    study.write_text(f"scene = '{root / 'configs' / 'ocean.toml'}'\nwater_types = ['none']\n"
+    study.write_text(f"scene = '{CONFIGS / 'ocean.toml'}'\nwater_types = ['none']\n"
                      "depths_m = [1.0, 2.0]\nsun_elevations_deg = [60.0]\n"
                      "[overrides.water]\nresolution = 32\n")
     loaded = load_study(study)

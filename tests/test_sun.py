@@ -71,9 +71,7 @@ def test_floor_scales_with_the_sun():
 
 def test_d65_sun_has_the_d65_shape():
     """The d65 sun is colour-science's CIE D65 averaged over each bin, up to the overall scale."""
-    from warpcaustics.optics.colour import _colour
-
-    d65 = _colour().SDS_ILLUMINANTS["D65"]
+    d65 = spectra.colour_science().SDS_ILLUMINANTS["D65"]
     ours = spectra.sun_irradiance(BINS, _sun(spectrum="d65"))
     reference = BINS.average(d65.wavelengths, d65.values, "D65")
     np.testing.assert_allclose(ours / reference, (ours / reference).mean(), rtol=1e-12)

@@ -8,6 +8,7 @@ import pytest
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 
+from helpers import CONFIGS
 from test_lens import APEX_M, FOCAL_M, IOR, RADIUS_OF_CURVATURE_M
 
 IMAGE_RADIUS_M = IOR * RADIUS_OF_CURVATURE_M / (IOR - 1.0) * math.radians(0.53 / 2) / IOR
@@ -32,7 +33,7 @@ def focus_maps():
     {diameter: (scene, (K, M, M) map)}, and the texel centres."""
     out = {}
     for diameter in (0.0, 0.53):
-        scene = wc.load_scene("configs/lens.toml", _at_focus({"caustics.map_resolution": 2048,
+        scene = wc.load_scene(CONFIGS / "lens.toml", _at_focus({"caustics.map_resolution": 2048,
                                                               "sun.angular_diameter_deg": diameter}))
         r = wc.render(scene, device="cpu")
         out[diameter] = (scene, r.floor_irradiance)
@@ -68,7 +69,7 @@ def test_disk_widens_the_lens_focus_to_the_suns_image():
     spots = {}
     for diameter in (0.0, 0.53):
         scene = wc.load_scene(
-            "configs/lens.toml",
+            CONFIGS / "lens.toml",
             _at_focus({"caustics.map_resolution": 200, "caustics.map_extent_m": 0.05,
                        "sun.angular_diameter_deg": diameter, "sun.disk_samples": 64}),
         )
@@ -104,7 +105,7 @@ def test_photons_run_a_pass_per_disk_direction(focus_maps):
     for diameter in (0.0, 0.53):
         overrides = _at_focus({"caustics.method": "photons", "caustics.map_resolution": 2048,
                                "sun.angular_diameter_deg": diameter})
-        r = wc.render(wc.load_scene("configs/lens.toml", overrides), device="cpu")
+        r = wc.render(wc.load_scene(CONFIGS / "lens.toml", overrides), device="cpu")
         e = r.floor_irradiance[0].astype(np.float64)
         maps["photons", diameter] = e[np.ix_(centre, centre)] - e[0, 0]  # above the flat water's
         flux[diameter] = e.sum() * r.texel_area_m2
@@ -133,7 +134,7 @@ def test_beams_average_a_pass_per_disk_direction():
     for method, diameter in (("beams", 0.53), ("fluxratio", 0.53), ("beams", 0.0)):
         overrides = _at_focus({"caustics.method": method, "caustics.map_resolution": 1024,
                                "sun.angular_diameter_deg": diameter, "sun.disk_samples": 8})
-        r = wc.render(wc.load_scene("configs/lens.toml", overrides), device="cpu")
+        r = wc.render(wc.load_scene(CONFIGS / "lens.toml", overrides), device="cpu")
         e = r.floor_irradiance[0].astype(np.float64)
         x, _ = r.map_coordinates()
         centre = np.abs(x) < 0.02
@@ -168,19 +169,21 @@ def test_grid_methods_move_their_map_by_the_disk_parallax(focus_maps):
         assert radii[0] == pytest.approx(radii[1], abs=2.0 / 2048), share
     ocean = {"water.resolution": 64, "caustics.map_resolution": 64, "caustics.method": "eikonal",
              "optics.wavelengths": "rgb", "sun.angular_diameter_deg": 0.0}
-    point = wc.render(wc.load_scene("configs/ocean.toml", ocean), device="cpu").floor_irradiance
-    disk = wc.render(wc.load_scene("configs/ocean.toml", {**ocean, "sun.angular_diameter_deg": 0.53}),
+    point = wc.render(wc.load_scene(CONFIGS / "ocean.toml", ocean), device="cpu").floor_irradiance
+    disk = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**ocean, "sun.angular_diameter_deg": 0.53}),
                      device="cpu").floor_irradiance
     np.testing.assert_allclose(disk.mean(axis=(1, 2)), point.mean(axis=(1, 2)), rtol=1e-6)
     assert np.abs(disk - point).max() > 0.0
 
 
-def test_the_sun_maps_disk_must_be_the_suns():
-    """The sun map draws the disk itself (caustics.sunmap_disk_deg): the default sun and the
-    default drawn disk agree; a different sun disk is refused naming both keys."""
-    wc.load_scene("configs/ocean.toml", {"caustics.method": "sunmap"})
-    with pytest.raises(ConfigError, match="sunmap_disk_deg"):
-        wc.load_scene("configs/ocean.toml", {"sun.angular_diameter_deg": 1.0, "caustics.method": "sunmap"})
+def test_the_sun_maps_disk_is_the_suns():
+    """The sun map draws the sun's own disk (sun.angular_diameter_deg), so every sun disk goes with
+    it; the key it used to have (caustics.sunmap_disk_deg) is refused naming the sun's."""
+    for diameter in (0.0, 0.53, 2.0):
+        wc.load_scene(CONFIGS / "ocean.toml", {"sun.angular_diameter_deg": diameter,
+                                               "caustics.method": "sunmap"})
+    with pytest.raises(ConfigError, match="merged into sun.angular_diameter_deg"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"caustics.sunmap_disk_deg": 1.0, "caustics.method": "sunmap"})
 
 
 @pytest.mark.parametrize("periodic", [True, False])

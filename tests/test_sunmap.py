@@ -10,7 +10,7 @@ from warpcaustics.caustics.sunmap import SunMapCaustics
 from warpcaustics.errors import ConfigError
 from warpcaustics.water import HeightfieldWater, ProceduralWater
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, fresnel_t_angles
 
 IOR = 1.333
 DISK_DEG, HALO_DEG = 0.53, 5.3
@@ -25,7 +25,7 @@ def _scene(**overrides):
         "caustics.map_resolution": 64,
         "optics.ior": IOR,
         "optics.wavelengths": {"min_nm": 450.0, "max_nm": 650.0, "bins": 2},
-        "sun.angular_diameter_deg": 0.0,  # the flux-ratio references are a point sun's
+        "sun.angular_diameter_deg": DISK_DEG,  # the disk the sun map draws
     }
     base.update(overrides)
     return wc.load_scene(None, base)
@@ -55,7 +55,9 @@ def brightness_of(gamma_deg):
 def test_flat_water_sun_map_is_uniform(elevation):
     """Still water sends every backward ray to the sun's centre: brightness 1 everywhere, and the
     scaled map equals the flat-water irradiance E·cosθ·T(θ)·e^{−cD/cosθt} of the flux-ratio map."""
-    result = wc.render(_scene(**{"sun.elevation_deg": elevation, "sun.azimuth_deg": 20.0}), device="cpu")
+    # a point sun: the flux-ratio reference is a point sun's (the sun map draws it as a halo alone)
+    result = wc.render(_scene(**{"sun.elevation_deg": elevation, "sun.azimuth_deg": 20.0,
+                                 "sun.angular_diameter_deg": 0.0}), device="cpu")
     np.testing.assert_array_equal(result.sunmap_brightness, 1.0)
     assert result.comparison.method == "fluxratio"
     theta = math.radians(90.0 - elevation)
@@ -161,7 +163,7 @@ def test_compare_command_on_the_lens(tmp_path, capsys):
     from warpcaustics.cli import main
 
     out = tmp_path / "cmp"
-    code = main(["compare", "configs/lens.toml", "--out", str(out), "--methods", "sunmap,beams",
+    code = main(["compare", str(CONFIGS / "lens.toml"), "--out", str(out), "--methods", "sunmap,beams",
                  "--set", "caustics.map_resolution=64",
                  "--set", "optics.wavelengths={min_nm = 450.0, max_nm = 650.0, bins = 2}"])
     assert code == 0
@@ -173,5 +175,5 @@ def test_compare_command_on_the_lens(tmp_path, capsys):
     for name in ("compare.csv", "compare.png", "fluxratio/frame_0000.exr", "sunmap/frame_0000.exr",
                  "sunmap/frame_0000_fluxratio.exr", "beams/run.json"):
         assert (out / name).is_file(), name
-    assert main(["compare", "configs/lens.toml", "--out", str(out), "--methods", "raytrace"]) == 2
+    assert main(["compare", str(CONFIGS / "lens.toml"), "--out", str(out), "--methods", "raytrace"]) == 2
     assert "not a floor-caustics method" in capsys.readouterr().err

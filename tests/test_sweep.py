@@ -7,14 +7,13 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import pytest
 
 from warpcaustics.batch.sweep import load_sweep, read_manifest, run_sweep
 from warpcaustics.errors import ConfigError
 
-ROOT = Path(__file__).resolve().parents[1]
+from helpers import CONFIGS, ROOT
 
 TINY = """
 base = "{base}"
@@ -37,7 +36,7 @@ fps = 4.0
 def _sweep(tmp_path, types='"pure", "clear_ocean"', frames=1, name="sweep.toml"):
     path = tmp_path / name
     path.write_text(
-        TINY.format(base=(ROOT / "configs" / "ocean.toml").as_posix(), types=types, frames=frames)
+        TINY.format(base=(CONFIGS / "ocean.toml").as_posix(), types=types, frames=frames)
     )
     return path
 
@@ -94,7 +93,7 @@ def test_a_stateless_frames_run_json_names_its_own_files(tmp_path):
     its files are numbered (frame k in frame_000k.*), so the record points at files that exist."""
     path = tmp_path / "anim.toml"
     path.write_text(
-        f'base = "{(ROOT / "configs" / "ocean.toml").as_posix()}"\n[set]\n"water.resolution" = 16\n'
+        f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[set]\n"water.resolution" = 16\n'
         '"caustics.map_resolution" = 16\n"optics.wavelengths" = "rgb"\n[frames]\ncount = 2\nfps = 4.0\n'
     )
     sweep = load_sweep(path)
@@ -167,7 +166,7 @@ def test_sigkill_midway_then_rerun_finishes_each_task_once(tmp_path):
     assert len(_csv_rows(out)) == 24
 
 
-@pytest.mark.parametrize("path", sorted((ROOT / "configs" / "sweeps").glob("*.toml")), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", sorted((CONFIGS / "sweeps").glob("*.toml")), ids=lambda p: p.name)
 def test_shipped_sweeps_expand(path):
     """Each sweep in configs/sweeps/ loads, and every one of its variants is a valid scene."""
     sweep = load_sweep(path)
@@ -194,10 +193,10 @@ def test_interrupted_pool_animation_resumes_from_its_checkpoint(tmp_path, monkey
     import numpy as np
 
     from warpcaustics import pipeline
-    from warpcaustics.batch.sweep import run_task
+    from warpcaustics.batch.worker import run_task
 
     path = tmp_path / "pool.toml"
-    path.write_text(POOL.format(base=(ROOT / "configs" / "pool.toml").as_posix()))
+    path.write_text(POOL.format(base=(CONFIGS / "pool.toml").as_posix()))
     sweep = load_sweep(path)
     assert len(sweep.tasks) == 1 and sweep.tasks[0].stateful and len(sweep.tasks[0].times_s) == 4
     task = sweep.tasks[0]

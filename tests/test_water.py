@@ -7,6 +7,8 @@ import warp as wp
 from warpcaustics import water
 from warpcaustics.kernels.water import heightfield as hf_kernels
 
+from helpers import CONFIGS, subnormal_count
+
 
 @pytest.mark.parametrize("n", [64, 256])
 @pytest.mark.parametrize("direction", ["forward", "inverse"])
@@ -138,19 +140,14 @@ def test_negligible_amplitudes_become_zero_not_subnormal(device, monkeypatch):
     import warpcaustics as wc
 
     n = 512
-    cfg = wc.load_scene("configs/ocean.toml", {"water.resolution": n}).config
+    cfg = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": n}).config
     k = water.wavenumbers(n, cfg.water.extent_m)
     kx, ky = np.meshgrid(k, k)
     h0 = water.initial_spectrum(water.ocean_spectrum(cfg, kx, ky), cfg.water.extent_m, seed=cfg.water.seed)
-    tiny = np.finfo(np.float32).tiny
-
-    def subnormal(a):
-        return np.count_nonzero((np.abs(a) < tiny) & (a != 0))
-
-    assert subnormal(h0.astype(np.complex64).view(np.float32)) > 0.01 * n * n  # what is avoided
+    assert subnormal_count(h0.astype(np.complex64).view(np.float32)) > 0.01 * n * n  # what is avoided
     ocean = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device)
     for arr in (ocean.h0, ocean.h0_minus_conj):
-        assert subnormal(arr.numpy()) == 0
+        assert subnormal_count(arr.numpy()) == 0
     t = 1.7
     surface = ocean.at(t)
     # float64 synthesis of the raw spectrum (h̃0 travels along +k: Tessendorf eq. 26, t → −t)
@@ -169,9 +166,9 @@ def test_negligible_amplitudes_become_zero_not_subnormal(device, monkeypatch):
     np.testing.assert_allclose(surface.normals.numpy(), expected, atol=1e-5)
 
     choppy = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device, choppiness=1.0).at(t)
-    monkeypatch.setattr(water, "negligible_to_zero", lambda h: h)
+    monkeypatch.setattr("warpcaustics.water.ocean.negligible_to_zero", lambda h: h)
     unzeroed = water.FFTOcean(h0, cfg.water.extent_m, cfg.floor.depth_m, device, choppiness=1.0)
-    assert subnormal(unzeroed.h0.numpy()) > 0
+    assert subnormal_count(unzeroed.h0.numpy()) > 0
     raw = unzeroed.at(t)
     for name in ("positions", "normals", "jacobian"):
         np.testing.assert_array_equal(getattr(choppy, name).numpy(), getattr(raw, name).numpy(), err_msg=name)
@@ -329,3 +326,77 @@ def test_choppy_single_wave_sharpens_its_crest(device):
     crest = np.argmax(z[0])
     # just before the crest the vertices move forward (+x), just after it backward: towards it
     assert shift[(crest - 2) % n] > 0 > shift[(crest + 2) % n]
+
+
+WATER_MODEL_SCENES = {"flat": "flat.toml", "heightfield": "lens.toml", "fft": "ocean.toml",
+                      "pool": "pool.toml", "wavepool": "wavepool.toml", "procedural": "procedural.toml"}
+"""One example scene per ``water.model`` (``lens.toml``'s file fixes its size; the others run at 32²)."""
+
+
+def _water_model_scene(model: str):
+    import warpcaustics as wc
+
+    overrides = {} if model == "heightfield" else {"water.resolution": 32}
+    scene = wc.load_scene(CONFIGS / WATER_MODEL_SCENES[model], overrides)
+    assert scene.config.water.model.value == model
+    return scene
+
+
+def _held_array_bytes(*roots) -> int:
+    """Bytes of the distinct ``wp.array``s reachable from ``roots`` through the attributes of
+    warpcaustics objects, lists, tuples and dicts (an array met twice counts once)."""
+    seen_objects, seen_arrays, total, stack = set(), set(), 0, list(roots)
+    while stack:
+        obj = stack.pop()
+        if isinstance(obj, wp.array):
+            if obj.ptr not in seen_arrays:
+                seen_arrays.add(obj.ptr)
+                total += obj.capacity
+        elif id(obj) in seen_objects:
+            continue
+        elif isinstance(obj, dict):
+            seen_objects.add(id(obj))
+            stack.extend(obj.values())
+        elif isinstance(obj, (list, tuple)):
+            seen_objects.add(id(obj))
+            stack.extend(obj)
+        elif type(obj).__module__.startswith("warpcaustics") and hasattr(obj, "__dict__"):
+            seen_objects.add(id(obj))
+            stack.extend(vars(obj).values())
+    return total
+
+
+def test_every_water_model_is_registered():
+    """Each ``water.model`` value names a class in the registry, and make_water builds that class."""
+    from warpcaustics.config import WaterModel
+
+    assert set(water.WATER_MODELS) == set(WaterModel) == set(WATER_MODEL_SCENES)
+    for model in WaterModel:
+        scene = _water_model_scene(model.value)
+        built = water.make_water(scene.config, "cpu", scene.heights, scene.floor_relief)
+        assert type(built) is water.WATER_MODELS[model]
+
+
+@pytest.mark.parametrize("model", sorted(WATER_MODEL_SCENES))
+def test_water_bytes_is_what_the_model_allocates(device, model):
+    """water_bytes on a device equals the bytes of the device arrays the model holds after stepping,
+    plus the Surface it returned (the estimate the renderer checks free memory against)."""
+    scene = _water_model_scene(model)
+    n = scene.water_resolution or scene.heights.shape[0]
+    model_water = water.make_water(scene.config, device, scene.heights, scene.floor_relief)
+    surface = model_water.at(0.05)  # the pools step: whatever a substep allocates is held now
+    assert surface.resolution == n
+    assert water.water_bytes(scene.config, n, device) == _held_array_bytes(model_water, surface)
+
+
+@pytest.mark.parametrize("model", sorted(WATER_MODEL_SCENES))
+def test_water_bytes_counts_the_cuda_fft_scratch(model):
+    """On CUDA the FFT ocean holds one more N×N complex array than on the CPU, the transposes'
+    scratch (FFTOcean.__init__ allocates it only there); every other model holds the same arrays.
+    Checked from the device's name, so it runs without a GPU; CUDA is also the default."""
+    scene = _water_model_scene(model)
+    n = scene.water_resolution or scene.heights.shape[0]
+    scratch = n * n * wp.types.type_size_in_bytes(wp.vec2) if model == "fft" else 0
+    cpu = water.water_bytes(scene.config, n, "cpu")
+    assert water.water_bytes(scene.config, n, "cuda:0") - cpu == scratch
+    assert water.water_bytes(scene.config, n) == cpu + scratch

@@ -10,9 +10,7 @@ import warpcaustics as wc
 from warpcaustics.config import JerlovSource, OpticsConfig, WaterType
 from warpcaustics.optics import spectra
 
-from conftest import fresnel_t_angles
-
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "water"
+from helpers import SHARED_WATER_DATA, fresnel_t_angles
 
 
 @pytest.mark.parametrize(("water_type", "published_b"), [
@@ -61,7 +59,7 @@ def test_jerlov_package_kd_matches_jerlov_1976_table():
 
     import jerlov
 
-    table = SHARED / "kd_jerlov_1976_tableXXVII.csv"
+    table = SHARED_WATER_DATA / "kd_jerlov_1976_tableXXVII.csv"
     if not table.exists():
         pytest.skip("shared/data not beside this checkout")
     rows = list(csv.DictReader(table.open()))
@@ -144,7 +142,7 @@ def test_bio_optical_model_terms():
     """Case-1 water: with no chlorophyll and no CDOM it is pure seawater; the particle absorption at a
     tabulated wavelength is A_p·Chl^E_p of Bricaud et al. 1998 (read here from shared/data), CDOM adds
     a(440)·e^(−S(λ−440)), and particle scattering adds 0.416·Chl^0.766 (Morel & Maritorena 2001)."""
-    table = SHARED / "ap_aph_bricaud_1998_Ap_Ep_Aphi_Ephi.csv"
+    table = SHARED_WATER_DATA / "ap_aph_bricaud_1998_Ap_Ep_Aphi_Ephi.csv"
     if not table.exists():
         pytest.skip("shared/data not beside this checkout")
     row = next(r for r in csv.DictReader(table.open()) if r["wavelength_nm"] == "440")
@@ -175,16 +173,16 @@ def test_shipped_data_are_the_shared_files_and_load_unchanged():
     """Every CSV shipped in warpcaustics/data is byte-identical to its source in shared/data (where
     the provenance is written), and the loaders return the CSV's own numbers."""
     data = Path(spectra.DATA_DIR)
-    if not SHARED.exists():
+    if not SHARED_WATER_DATA.exists():
         pytest.skip("shared/data not beside this checkout")
     shipped = sorted(data.glob("*.csv"))
     assert len(shipped) >= 6
     for path in shipped:
-        assert path.read_bytes() == (SHARED / path.name).read_bytes(), path.name
-    rows = list(csv.DictReader((SHARED / "aw_pope_fry_1997.csv").open()))
+        assert path.read_bytes() == (SHARED_WATER_DATA / path.name).read_bytes(), path.name
+    rows = list(csv.DictReader((SHARED_WATER_DATA / "aw_pope_fry_1997.csv").open()))
     wl, a = spectra.pure_absorption_table()
     np.testing.assert_array_equal(wl, [float(r["wavelength_nm"]) for r in rows])
     np.testing.assert_array_equal(a, [float(r["a_w_per_m"]) for r in rows])
-    rows = list(csv.DictReader((SHARED / "solar_astm_g173_03.csv").open()))
+    rows = list(csv.DictReader((SHARED_WATER_DATA / "solar_astm_g173_03.csv").open()))
     wl, e = spectra.sun_table()
     np.testing.assert_array_equal(e, [float(r["E_direct_circumsolar_W_m2_nm"]) for r in rows])

@@ -8,7 +8,7 @@ import pytest
 import warpcaustics as wc
 from warpcaustics.errors import ConfigError
 
-from conftest import fresnel_t_angles
+from helpers import CONFIGS, fresnel_t_angles
 
 IOR = 1.333
 
@@ -66,7 +66,7 @@ def test_texture_stays_finite_and_bounded_for_1000_steps():
                                           "caustics.wave3d_resolution": 48})
     renderer = wc.Renderer(scene, device="cpu")
     renderer.render(0.0)
-    wave = renderer.approximate
+    wave = renderer.method.approximate
     surface = renderer.water.at(0.0)
     highest = float(surface.positions.numpy()[..., 2].max())
     wave.run(surface, highest, steps=1000)
@@ -84,7 +84,7 @@ def test_only_the_layers_the_wave_can_reach_are_stepped():
     counted are fewer than a full grid's."""
     renderer = wc.Renderer(_scene(), device="cpu")
     renderer.render(0.0)
-    wave = renderer.approximate
+    wave = renderer.method.approximate
     surface = renderer.water.at(0.0)
     wave.run(surface, 0.0, steps=10)
     top = int(wave.top.numpy().max())
@@ -97,7 +97,7 @@ def test_only_the_layers_the_wave_can_reach_are_stepped():
 def test_wave_floor_flux_matches_the_flux_ratio_map():
     """Non-absorbing water under the default ocean (64² grid): the wave's floor flux is within 2 %
     of the flux-ratio map's (measured +0.5 % at 128²): energy is carried, not made."""
-    scene = wc.load_scene("configs/ocean.toml", {
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {
         "caustics.method": "wave3d", "water.resolution": 64, "caustics.map_resolution": 64,
         "caustics.wave3d_resolution": 64, "optics.water_type": "none", "floor.depth_m": 2.0,
         "optics.wavelengths": {"min_nm": 500.0, "max_nm": 600.0, "bins": 1}})
