@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import time
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import CONFIGS, device_record, median_time, point_sun_scene
 
 FULL = [64, 128, 256]
 QUICK = [64]
@@ -32,13 +32,13 @@ def measure(n: int, device: str, repeats: int) -> dict:
 
     from benchmarks.sunmap import flux_ratio_pass
 
-    scene = point_sun_scene("configs/mercier_pool.toml", {
+    scene = point_sun_scene(CONFIGS / "mercier_pool.toml", {
         "caustics.eikonal_resolution": n, "water.resolution": n, "caustics.map_resolution": 2 * n})
     renderer = Renderer(scene, device)
     renderer.render(TIME_S)  # warm-up: JIT compile, first launches; the pool is now at TIME_S
     surface = renderer.water.at(TIME_S)
     _, highest = height_range(surface, device)
-    eik = renderer.approximate
+    eik = renderer.method.approximate
     eikonal_s = median_time(lambda: eik.run(surface, highest), repeats, device)
     fluxratio_s = median_time(flux_ratio_pass(renderer, surface, highest), repeats, device)
     nodes = n * n * eik.stats.layers
@@ -59,14 +59,14 @@ def _wave(n: int, device: str) -> dict:
     from warpcaustics.optics.refraction import height_range
     from warpcaustics.pipeline import Renderer
 
-    scene = point_sun_scene("configs/mercier_pool.toml", {
+    scene = point_sun_scene(CONFIGS / "mercier_pool.toml", {
         "caustics.method": "wave3d", "caustics.wave3d_resolution": n, "water.resolution": n,
         "caustics.map_resolution": 2 * n})
     renderer = Renderer(scene, device)
     renderer.water.at(TIME_S)
     surface = renderer.water.at(TIME_S)
     _, highest = height_range(surface, device)
-    wave = renderer.approximate
+    wave = renderer.method.approximate
     wave.run(surface, highest, steps=2)  # warm-up: JIT compile
     wp.synchronize_device(device)
     t0 = time.perf_counter()

@@ -10,7 +10,7 @@ from __future__ import annotations
 import resource
 import time
 
-from benchmarks.run import point_sun_scene
+from benchmarks.run import CONFIGS, point_sun_scene
 
 
 def _rss_mib() -> float:
@@ -18,8 +18,8 @@ def _rss_mib() -> float:
 
 
 def _scene(n: int, m: int, bins: int):
-    return point_sun_scene("configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m,
-                                                  "optics.wavelengths.bins": bins})
+    return point_sun_scene(CONFIGS / "ocean.toml", {"water.resolution": n, "caustics.map_resolution": m,
+                                                   "optics.wavelengths.bins": bins})
 
 
 def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
@@ -40,9 +40,9 @@ def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
     def stages():
         _, highest = height_range(surface, device)
         visible = sun_visibility(surface, scene.sun_direction, highest, device, out=renderer.visible)
-        r = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction,
-                             -cfg.floor.depth_m, device, out=renderer.refracted)
-        renderer.floor.run(surface, r, scene.sun_direction)
+        r = refract_to_floor(surface, visible, renderer.light.group_ior, scene.sun_direction,
+                             -cfg.floor.depth_m, device, out=renderer.method.refracted)
+        renderer.method.floor.run(surface, r, scene.sun_direction)
         wp.synchronize_device(device)
 
     stage_times, frame_times = [], []
@@ -55,7 +55,8 @@ def measure_warp(n: int, m: int, bins: int, device: str, repeats: int) -> dict:
         frame_times.append(time.perf_counter() - t0)
     return {"stages_s": float(np.median(stage_times)), "frame_s": float(np.median(frame_times)),
             "peak_rss_mib": _rss_mib(), "rss_before_mib": rss0,
-            "device_bytes_estimate": scene_bytes(scene), "device_name": str(wp.get_device(device).name)}
+            "device_bytes_estimate": scene_bytes(scene, device),
+            "device_name": str(wp.get_device(device).name)}
 
 
 def measure_numpy(n: int, m: int, bins: int, repeats: int) -> dict:

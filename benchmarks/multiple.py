@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import CONFIGS, device_record, median_time, point_sun_scene
 
 FULL = [(128, 4), (256, 4)]
 QUICK = [(64, 4)]
@@ -22,7 +22,7 @@ def measure(n: int, samples: int, device: str, repeats: int) -> dict:
     from benchmarks.sunmap import flux_ratio_pass
 
     scene = point_sun_scene(
-        "configs/ocean.toml",
+        CONFIGS / "ocean.toml",
         {
             "water.resolution": n,
             "caustics.map_resolution": 2 * n,
@@ -37,7 +37,7 @@ def measure(n: int, samples: int, device: str, repeats: int) -> dict:
     result = renderer.render(0.0)  # warm-up
     surface = renderer.water.at(0.0)
     _, highest = height_range(surface, device)
-    walk_s = median_time(lambda: renderer.multiple.run(surface, renderer.visible), repeats, device)
+    walk_s = median_time(lambda: renderer.method.multiple.run(surface, renderer.visible), repeats, device)
     flux_ratio_s = median_time(flux_ratio_pass(renderer, surface, highest), repeats, device)
     photons = result.multiple_scattering_stats["photons"]
     return {

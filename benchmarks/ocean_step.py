@@ -18,7 +18,9 @@ def _ocean(n: int, device: str):
     import warpcaustics as wc
     from warpcaustics.water import FFTOcean
 
-    scene = wc.load_scene("configs/ocean.toml", {"water.resolution": n, "water.choppiness": 1.0})
+    from benchmarks.run import CONFIGS
+
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": n, "water.choppiness": 1.0})
     return FFTOcean.from_config(scene.config, device)
 
 

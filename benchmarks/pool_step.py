@@ -1,6 +1,6 @@
 """One shallow-water pool substep: Warp vs a vectorised numpy implementation of the same scheme.
 
-The same staggered grid and the same operations as ``kernels/pool.py``: semi-Lagrangian
+The same staggered grid and the same operations as ``kernels/water/pool.py``: semi-Lagrangian
 advection of u and v (bilinear, clamped), gravity and viscosity on the faces, conservative upwind
 update of the depths. Both start from the same state (a pool sloshing after drops).
 ``python -m benchmarks.pool_step [--quick]`` runs it alone (``benchmarks.run`` runs it too).
@@ -34,7 +34,7 @@ def _laplacian(f):
 
 
 def _at_rest_if_slow(wet, velocity):
-    """kernels/pool.py:accelerated: zero where dry or slower than REST_SPEED (NaN kept)."""
+    """kernels/water/pool.py:accelerated: zero where dry or slower than REST_SPEED (NaN kept)."""
     return np.where(wet & ~(np.abs(velocity) < np.float32(REST_SPEED)), velocity, np.float32(0))
 
 
@@ -73,7 +73,9 @@ def _pool(n: int, device: str):
     import warpcaustics as wc
     from warpcaustics.water.pool import ShallowWaterPool
 
-    scene = wc.load_scene("configs/pool.toml", {"water.resolution": n})
+    from benchmarks.run import CONFIGS
+
+    scene = wc.load_scene(CONFIGS / "pool.toml", {"water.resolution": n})
     pool = ShallowWaterPool.from_config(scene.config, device)
     dt = _dt(pool)
     for _ in range(64):  # a sloshing state after the first drop, the same for both sides

@@ -45,7 +45,7 @@ CAMERA_SCENES = {"ocean_floor": 0.0, "pool_pots": 1.0, "buried_in_sand": 1.0}
 
 def main() -> int:
     import warpcaustics as wc
-    from warpcaustics.io.output import write_png
+    from warpcaustics.io.png import write_png
 
     images = ROOT / "docs" / "images"
     ocean = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml"), device="cpu")
@@ -89,7 +89,7 @@ def _method_pictures(images: Path) -> None:
 
 def _beam_pictures(images: Path) -> None:
     import warpcaustics as wc
-    from warpcaustics.io.output import write_png
+    from warpcaustics.io.png import write_png
 
     rows = []
     for name in ("pool_pots", "ocean_floor"):
@@ -116,7 +116,7 @@ def _bounds_plot(renderer, path: Path) -> None:
 
     from benchmarks.beams import prism_ends
 
-    stage, camera = renderer.beams, renderer.camera
+    stage, camera = renderer.method.caustics[0], renderer.method.camera
     cam = camera.cam
     pos = np.array(cam.position, np.float64)
     right, up, fwd = (np.array(a, np.float64) for a in (cam.right, cam.up, cam.forward))

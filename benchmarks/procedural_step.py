@@ -41,7 +41,9 @@ def _water(n: int, device: str):
     import warpcaustics as wc
     from warpcaustics.water import ProceduralWater
 
-    scene = wc.load_scene("configs/procedural.toml", {"water.resolution": n})
+    from benchmarks.run import CONFIGS
+
+    scene = wc.load_scene(CONFIGS / "procedural.toml", {"water.resolution": n})
     return ProceduralWater.from_config(scene.config, device), scene.config.water.extent_m
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = ROOT / "configs"  # paths from this file, so that nothing depends on the working directory
 
 # (water N, floor map M, spectral bins); numpy runs only where it finishes in reasonable time.
 FULL = [(256, 512, 16, True), (512, 1024, 16, True), (1024, 2048, 16, False)]

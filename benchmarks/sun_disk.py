@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import CONFIGS, device_record, median_time, point_sun_scene
 
 FULL = (256, 512, (8, 16, 32))
 QUICK = (128, 256, (8,))
@@ -39,7 +39,7 @@ def measure(n: int, m: int, samples: int, device: str, repeats: int) -> dict:
     )
     for name, extra in cases:
         scene = point_sun_scene(
-            "configs/ocean.toml", {"water.resolution": n, "caustics.map_resolution": m, **extra}
+            CONFIGS / "ocean.toml", {"water.resolution": n, "caustics.map_resolution": m, **extra}
         )
         renderer = Renderer(scene, device)
         renderer.render(0.0)  # warm-up

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.run import device_record, median_time, point_sun_scene
+from benchmarks.run import ROOT, device_record, median_time, point_sun_scene
 
 FULL = [(256, 512), (512, 1024)]
 QUICK = [(128, 256)]
@@ -21,19 +21,19 @@ SCENES = ("configs/ocean.toml", "configs/procedural.toml")
 def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     """Times of the two floor maps of one frame (the water surface is computed once, outside)."""
     from warpcaustics.pipeline import Renderer
-    scene = point_sun_scene(config, {"caustics.method": "sunmap", "water.resolution": n,
-                                     "caustics.map_resolution": m})
+    scene = point_sun_scene(ROOT / config, {"caustics.method": "sunmap", "water.resolution": n,
+                                            "caustics.map_resolution": m})
     renderer = Renderer(scene, device)
     result = renderer.render(0.5)  # warm-up: JIT compile, first launches
     surface = renderer.water.at(0.5)
     flux_ratio = flux_ratio_pass(renderer, surface, float(surface.positions.numpy()[..., 2].max()))
 
     def sun_map():
-        renderer.approximate.run(surface, renderer.water, 0.5)
+        renderer.method.approximate.run(surface, renderer.water, 0.5)
 
     fluxratio_s = median_time(flux_ratio, repeats, device)
     sunmap_s = median_time(sun_map, repeats, device)
-    from warpcaustics.io.output import map_correlation, relative_l1
+    from warpcaustics.io.comparison import map_correlation, relative_l1
 
     return {"config": config, "water_n": n, "map_m": m, "bins": len(result.wavelengths_nm),
             "fluxratio_s": fluxratio_s, "sunmap_s": sunmap_s,
@@ -55,9 +55,9 @@ def flux_ratio_pass(renderer, surface, highest_m: float):
     visible = sun_visibility(surface, scene.sun_direction, highest_m, device, out=renderer.visible)
 
     def flux_ratio():
-        refracted = refract_to_floor(surface, visible, renderer.group_ior, scene.sun_direction,
-                                     -scene.config.floor.depth_m, device, out=renderer.refracted)
-        renderer.floor.run(surface, refracted, scene.sun_direction)
+        refracted = refract_to_floor(surface, visible, renderer.light.group_ior, scene.sun_direction,
+                                     -scene.config.floor.depth_m, device, out=renderer.method.refracted)
+        renderer.method.floor.run(surface, refracted, scene.sun_direction)
 
     return flux_ratio
 

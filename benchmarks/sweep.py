@@ -42,7 +42,8 @@ base = "{base}"
 
 def run(quick: bool, device: str = "cpu") -> dict:
     from warpcaustics.batch.sweep import load_sweep, run_sweep
-    from warpcaustics.io.output import save_frame, write_run_json
+    from warpcaustics.io.frame import save_frame
+    from warpcaustics.io.run_json import write_run_json
     from warpcaustics.pipeline import Renderer
     from warpcaustics.scene import load_scene
 

@@ -21,7 +21,7 @@ def main() -> int:
     import warpcaustics as wc
     from warpcaustics import reference, water
 
-    from conftest import fresnel_t_angles
+    from helpers import flat_floor_irradiance
     from test_floor_physics import _flat_scene, _rough_ocean, _transmitted_flux_float64
     from test_lens import APEX_M, FOCAL_M, N
 
@@ -29,10 +29,7 @@ def main() -> int:
     for el in (15.0, 40.0, 65.0, 90.0):
         for depth in (0.5, 5.0, 30.0):
             r = wc.render(_flat_scene(el, depth), device="cpu")
-            th = np.radians(90 - el)
-            ct = np.sqrt(1 - (np.sin(th) / 1.333) ** 2)
-            e = r.sun_irradiance * np.cos(th) * fresnel_t_angles(np.array([th]), 1, 1.333)[0] * np.exp(
-                -r.attenuation_per_m * depth / ct)
+            e = flat_floor_irradiance(r, el, depth)
             err = np.abs(r.floor_irradiance / e[:, None, None] - 1).max()
             print(f"elevation {el:5.1f}°  depth {depth:5.1f} m   max relative error {err:.2e}")
 
@@ -165,7 +162,7 @@ def main() -> int:
     from warpcaustics.optics import colour as colour_out
     from warpcaustics.optics.spectra import SpectralBins
 
-    d65 = colour_out._colour().SDS_ILLUMINANTS["D65"]
+    d65 = colour_out.colour_science().SDS_ILLUMINANTS["D65"]
     for width in (1.0, 5.0, 18.75):
         bins = SpectralBins.uniform(380.0, 780.0, int(round(400 / width)))
         xyz = colour_out.spectral_to_xyz(bins.average(d65.wavelengths, d65.values, "D65")[:, None, None],
@@ -252,17 +249,14 @@ def _photons() -> None:
 
     import warpcaustics as wc
 
-    from conftest import fresnel_t_angles
+    from helpers import flat_floor_irradiance
 
     print("\n## Photons on flat water vs E_sun cosθ T(θ) exp(-c D / cosθ_t)  (pure water, 8 bins, 3 m)")
     for mode in ("exact", "newton"):
         worst = 0.0
         for el in (20.0, 55.0, 90.0):
             r = wc.render(_flat(el, 3.0, **{"caustics.intersection": mode}), device="cpu")
-            th = np.radians(90 - el)
-            ct = np.sqrt(1 - (np.sin(th) / 1.333) ** 2)
-            e = r.sun_irradiance * np.cos(th) * fresnel_t_angles(np.array([th]), 1, 1.333)[0] * np.exp(
-                -r.attenuation_per_m * 3.0 / ct)
+            e = flat_floor_irradiance(r, el, 3.0)
             worst = max(worst, float(np.abs(r.floor_irradiance / e[:, None, None] - 1).max()))
         print(f"{mode:6s}: max relative error over elevations 20°, 55°, 90° and all texels {worst:.1e}")
 
@@ -299,7 +293,7 @@ def _photons() -> None:
     from test_photons import pool_flux_by_intersection
 
     for config, el in (("pool", 20.0), ("pool", 40.0), ("pool", 70.0), ("wavepool", 30.0)):
-        f = pool_flux_by_intersection(el, f"configs/{config}.toml")
+        f = pool_flux_by_intersection(el, ROOT / "configs" / f"{config}.toml")
         share = {mode: {part: f[mode][part] / f["transmitted"] for part in ("floor", "walls")}
                  for mode in ("exact", "newton")}
         print(f"{config}.toml, sun {el:2.0f}°: floor {share['exact']['floor']:.2%} exact, "
@@ -335,7 +329,7 @@ def _camera_floor() -> None:
 
     import warpcaustics as wc
 
-    from conftest import fresnel_t_angles
+    from helpers import fresnel_t_angles
 
     print("\n## Camera: uniformly lit grey floor seen obliquely (flat water, water_type none)")
     r = wc.render(_flat(60.0, 3.0, "none", **{
@@ -362,7 +356,6 @@ def _beams() -> None:
         PRISM_DIRECTION,
         PRISM_ENDS,
         _flat,
-        _flat_floor_irradiance,
         _prism_chord,
         _sphere_bins,
         _straight_prism_chords,
@@ -372,11 +365,13 @@ def _beams() -> None:
 
     import warpcaustics as wc
 
+    from helpers import flat_floor_irradiance
+
     print("\n## Beams on flat water vs E_sun cosθ T(θ) exp(-c D / cosθ_t)  (pure water, 8 bins, 3 m)")
     worst = 0.0
     for el in (5.0, 20.0, 55.0, 90.0):
         r = wc.render(_flat(el, 3.0), device="cpu")
-        e = _flat_floor_irradiance(r, el, 3.0)
+        e = flat_floor_irradiance(r, el, 3.0)
         worst = max(worst, float(np.abs(r.floor_irradiance / e[:, None, None] - 1).max()))
     print(f"max relative error over elevations 5°, 20°, 55°, 90° and all texels {worst:.1e}")
 
