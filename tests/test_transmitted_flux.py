@@ -52,3 +52,16 @@ def test_transmitted_flux_does_not_depend_on_the_water():
     clear = wc.render(flat_water_scene(ELEVATION_DEG, 2.0, "none"), device="cpu")
     turbid = wc.render(flat_water_scene(ELEVATION_DEG, 9.0, "turbid_harbor"), device="cpu")
     np.testing.assert_array_equal(clear.transmitted_flux_w_nm, turbid.transmitted_flux_w_nm)
+
+
+def test_transmitted_flux_with_dispersion_is_per_band():
+    """With dispersion each band enters with its own Fresnel transmittance: E_sun cosθ T(θ, n(λ)) L²
+    per band, for the flux ratio (per index group) as for photons."""
+    theta = np.radians(90.0 - ELEVATION_DEG)
+    for method in ("fluxratio", "photons"):
+        result = wc.render(flat_water_scene(ELEVATION_DEG, DEPTH_M, "pure", **{
+            "optics.dispersion": True, "caustics.method": method}), device="cpu")
+        t = np.array([fresnel_t_angles(np.array([theta]), 1.0, n)[0] for n in result.ior])
+        expected = result.sun_irradiance * np.cos(theta) * t * result.extent_m**2
+        assert np.ptp(result.ior) > 1e-3  # the bands really differ
+        np.testing.assert_allclose(result.transmitted_flux_w_nm, expected, rtol=2e-5, err_msg=method)

@@ -136,17 +136,18 @@ def triangle_flux(
     extent_m: float,
     periodic: int,
     flux_w_nm: wp.array4d[wp.float32],
-    entering_w_nm: wp.array4d[wp.float32],
+    entering_m2: wp.array4d[wp.float32],
 ):
     """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at every wavelength k,
-    and the flux that enters the water through it (before attenuation).
+    and its share of the light that enters the water (before attenuation).
 
     ``flux_w_nm`` is (Q, Q, 2, K) with Q quads per side (N periodic, N+1 walled): a triangle's
     wavelengths are contiguous for the deposit.
 
     ``E_sun(k) * A_perp * mean_i(T_i exp(-c(k) l_i))``, with ``A_perp`` the triangle's area
     projected perpendicular to the sun (0 for triangles facing away from it);
-    ``entering_w_nm``: ``E_sun(k) * A_perp * mean_i(T_i)``.
+    ``entering_m2`` (G, Q, Q, 2): ``A_perp * mean_i(T_i)`` per index group, the flux entering the
+    water through the triangle per unit irradiance [m²] (no K axis: the host multiplies by E(k)).
     """
     iy, ix, half = wp.tid()
     n = positions.shape[0]
@@ -166,8 +167,9 @@ def triangle_flux(
             + transmittance[g, y2, x2] * wp.exp(-c * path_m[g, y2, x2])
         ) / 3.0
         flux_w_nm[iy, ix, half, k] = sun_irradiance[k] * a_perp * mean_t
-        mean_t0 = (transmittance[g, y0, x0] + transmittance[g, y1, x1] + transmittance[g, y2, x2]) / 3.0
-        entering_w_nm[iy, ix, half, k] = sun_irradiance[k] * a_perp * mean_t0
+        if k % wavelengths_per_group == 0:
+            mean_t0 = (transmittance[g, y0, x0] + transmittance[g, y1, x1] + transmittance[g, y2, x2]) / 3.0
+            entering_m2[g, iy, ix, half] = a_perp * mean_t0
 
 
 @wp.func

@@ -18,7 +18,7 @@ from warpcaustics.water import Surface
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
-    triangle_flux = 2 * k * 2 * (n + 1) * (n + 1) * 4  # delivered to the floor and entering the water
+    triangle_flux = (k + groups) * 2 * (n + 1) * (n + 1) * 4  # delivered per band; entering per group
     return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
 
 
@@ -27,8 +27,9 @@ class FloorCaustics:
 
     def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True,
-                 window: tuple[float, tuple[float, float]] | None = None):
-        """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch."""
+                 window: tuple[float, tuple[float, float]] | None = None, groups: int = 1):
+        """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch.
+        ``groups``: refractive-index groups (K with dispersion, else 1)."""
         k = len(sun_irradiance)
         m = map_resolution
         self.device = device
@@ -40,8 +41,11 @@ class FloorCaustics:
         self.flux = wp.empty((quads, quads, 2, k), dtype=wp.float32, device=device)
         """Flux per triangle and wavelength (Q, Q, 2, K) delivered to the floor [W nm^-1], Q quads per
         side."""
-        self.entering = wp.empty((quads, quads, 2, k), dtype=wp.float32, device=device)
-        """Flux per triangle and wavelength (Q, Q, 2, K) entering the water [W nm^-1]."""
+        self.entering = wp.empty((groups, quads, quads, 2), dtype=wp.float32, device=device)
+        """Per index group and triangle (G, Q, Q, 2): the flux entering the water per unit irradiance,
+        A⊥·mean T [m²]."""
+        self.last_irradiance = self.sun_irradiance
+        """The (K,) irradiance the last :meth:`run` used."""
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
@@ -76,6 +80,7 @@ class FloorCaustics:
         last run's map (the directions of a sun disk, each with its share in ``sun_irradiance``);
         ``irradiance`` (K,) replaces ``sun_irradiance`` for this run (a direction of the sky)."""
         quads = self.flux.shape[0]
+        self.last_irradiance = self.sun_irradiance if irradiance is None else irradiance
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
         k = self.sun_irradiance.shape[0]
@@ -85,7 +90,7 @@ class FloorCaustics:
         wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
                           wp.vec3(*np.asarray(sun_dir, np.float32)),
-                          self.sun_irradiance if irradiance is None else irradiance,
+                          self.last_irradiance,
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux, self.entering], device=self.device)
@@ -99,6 +104,13 @@ class FloorCaustics:
         wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
                   outputs=[self.irradiance], device=self.device)
         return self.irradiance
+
+    def entering_flux(self) -> np.ndarray:
+        """(K,) flux the last :meth:`run`'s triangles let into the water, before attenuation
+        [W nm^-1] (float64 sums of the per-triangle A⊥·mean T)."""
+        per_group = self.entering.numpy().sum(axis=(1, 2, 3), dtype=np.float64)
+        e = self.last_irradiance.numpy().astype(np.float64)
+        return e * np.repeat(per_group, len(e) // len(per_group))
 
 
 class FluxRatioStage(CausticStage):
@@ -126,7 +138,8 @@ class FluxRatioStage(CausticStage):
                                                light.optics.scattering_per_m, device, **sky)
         disk_share = light.sun_irradiance / len(light.sun_directions)
         self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
-                                   device, periodic=water.periodic, window=window)
+                                   device, periodic=water.periodic, window=window,
+                                   groups=len(light.group_ior))
 
     @classmethod
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
@@ -205,7 +218,7 @@ class FluxRatioStage(CausticStage):
                                          -self.scene.config.floor.depth_m, self.device, out=self.refracted)
         with frame.watch.stage(stages[1]):
             floor = self.floor.run(frame.surface, refracted, direction, clear=clear, irradiance=irradiance)
-            flux = np.stack([self.floor.entering.numpy().sum(axis=(0, 1, 2), dtype=np.float64),
+            flux = np.stack([self.floor.entering_flux(),
                              self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
         return floor, flux
 
