@@ -365,7 +365,8 @@ def _stage_time(n: int, m: int, device: str, repeats: int) -> dict:
     surface = renderer.water.at(0.0)
 
     def run():
-        renderer.method.caustics[0].run(surface, renderer.visible)
+        renderer.method.caustics[0].trace(surface, renderer.visible, scene.sun_direction,
+                                          renderer.light.sun_irradiance)
         wp.synchronize_device(device)
 
     s = median_time(run, repeats)

@@ -63,11 +63,23 @@ class PhotonCase:
     def photon_count(self) -> int:
         return int(self.renderer.method.caustics[0].weight.shape[0])
 
+    def pass_stats(self) -> dict:
+        """The photon counts of one pass of the sun (``RenderResult.photon_stats``)."""
+        from warpcaustics.caustics.stage import Stopwatch
+
+        r = self.renderer
+        sun, irradiance = self.scene.sun_direction, r.light.sun_irradiance
+        done = r.method.caustics[0].light_pass(self.surface, self.visible, sun, irradiance,
+                                               Stopwatch(self.device), stage="photons")
+        return done.stats
+
     def run_warp(self) -> np.ndarray:
         """The Warp photon stage once, device synchronised; the (K, M, M) map on the host."""
         import warp as wp
 
-        irr = self.renderer.method.caustics[0].run(self.surface, self.visible)
+        r = self.renderer
+        irr = r.method.caustics[0].trace(self.surface, self.visible, self.scene.sun_direction,
+                                         r.light.sun_irradiance)
         wp.synchronize_device(self.device)
         return irr.numpy().copy()
 
@@ -149,7 +161,7 @@ def run(quick: bool, device: str) -> dict:
                                   numpy_repeats, device)
         warp_s, numpy_s = (float(np.median(times[side])) for side in ("warp", "numpy"))
         count = case.photon_count
-        stats = vars(case.renderer.method.caustics[0].stats())
+        stats = case.pass_stats()
         row = {"photons": count, "photon_stats": stats, "warp_s": warp_s, "numpy_s": numpy_s,
                "warp_photons_per_s": count / warp_s, "numpy_photons_per_s": count / numpy_s,
                "speedup_warp_vs_numpy": numpy_s / warp_s,

@@ -71,3 +71,38 @@ def test_a_result_is_not_changed_by_the_next_frame(method, extra):
     assert not np.array_equal(second.floor_irradiance, first.floor_irradiance)  # the sea moved
     for key, value in _arrays(first).items():
         np.testing.assert_array_equal(value, kept[key], err_msg=key)
+
+
+@pytest.mark.parametrize("method", ["photons", "beams"])
+def test_a_light_pass_owes_nothing_to_the_pass_before(method):
+    """A caustics object's buffers are its workspace, not its state: a sun pass traced after a sky
+    pass (another direction, another irradiance) reads back to the bit what the same pass reads on
+    a fresh object, floor, faces, counts and camera alike, and the sky pass's record is untouched."""
+    from warpcaustics.caustics.stage import Stopwatch
+    from warpcaustics.optics.refraction import height_range, sun_visibility
+
+    scene = wc.load_scene(CONFIGS / "pool_pots.toml", {
+        **SMALL, "caustics.method": method, "camera.width": 16, "camera.height": 12,
+        "sky.model": "uniform", "sky.diffuse_fraction": 0.3, "sky.directions": 2})
+    used, fresh = (wc.Renderer(scene, device="cpu") for _ in range(2))
+    surface = used.water.at(0.0)
+    _, highest = height_range(surface, "cpu")
+    sun, sky = used.light.passes()[0], used.light.passes()[-1]
+    assert sky[2] and not np.allclose(sky[0], sun[0])
+
+    def light_pass(renderer, light):
+        seen = sun_visibility(surface, light[0], highest, "cpu")
+        return renderer.method.caustics[0].light_pass(surface, seen, light[0], light[1], Stopwatch("cpu"),
+                                                      stage="test", camera=renderer.method.camera)
+
+    sky_pass = light_pass(used, sky)
+    kept = {k: np.copy(v) for k, v in vars(sky_pass).items() if not isinstance(v, dict)}
+    after, alone = light_pass(used, sun), light_pass(fresh, sun)
+    assert after.face_flux_w_nm.size and after.camera_radiance is not None and after.floor.max() > 0
+    for key, value in vars(alone).items():
+        if isinstance(value, dict):
+            assert getattr(after, key) == value, key
+        else:
+            np.testing.assert_array_equal(getattr(after, key), value, err_msg=key)
+    for key, value in kept.items():
+        np.testing.assert_array_equal(getattr(sky_pass, key), value, err_msg=key)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.receiver_stage import ReceiverStage
+from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
 from warpcaustics.config import BeamInterpolation, Config, FloorShape
 from warpcaustics.kernels.caustics import beams as beam_kernels
 from warpcaustics.kernels.scene.camera import PinholeCamera
@@ -137,6 +137,14 @@ class TileBins:
     def inputs(self) -> list:
         return [self.grid, self.start, self.count, self.items]
 
+    def screen_bins(self, tile_pixels: int) -> beam_kernels.ScreenBins:
+        """The lists and oriented boxes as the volume pass reads them (screen tiles of ``tile_pixels``)."""
+        out = beam_kernels.ScreenBins()
+        out.grid, out.start, out.count, out.items = self.inputs()
+        out.tile_pixels = tile_pixels
+        out.box_axis, out.box_lo, out.box_hi = self.box_axis, self.box_lo, self.box_hi
+        return out
+
 
 @dataclass
 class BeamStats:
@@ -176,23 +184,15 @@ def face_samples(receivers: Receivers) -> tuple[np.ndarray, np.ndarray]:
     return points.reshape(-1, 3), np.repeat(normal, FACE_SAMPLES, axis=0)
 
 
-class BeamCaustics:
-    """Owns the beam stage's device buffers for one scene, reused from frame to frame."""
+class BeamCaustics(PassCaustics):
+    """The beam stage's device buffers for one scene, reused from pass to pass and frame to frame."""
 
-    def __init__(
-        self,
-        cfg: Config,
-        receivers: Receivers,
-        n: int,
-        sun_irradiance: np.ndarray,
-        attenuation_per_m: np.ndarray,
-        group_ior: np.ndarray,
-        sun_dir: np.ndarray,
-        device: str,
-        *,
-        periodic: bool,
-        relief: np.ndarray | None,
-    ):
+    timing_name = "beams"
+    stats_key = "beam_stats"
+
+    def __init__(self, setup: CausticsSetup):
+        cfg, receivers, n, device = setup.cfg, setup.receivers, setup.n, setup.device
+        periodic, group_ior, relief = setup.periodic, setup.group_ior, setup.relief
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -202,18 +202,20 @@ class BeamCaustics:
         self.ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
         count = beam_count(n, self.groups, periodic)
         self.beams_per_group = count // self.groups
-        k = len(sun_irradiance)
+        k = len(setup.sun_irradiance)
         self.k = k
         m = cfg.caustics.map_resolution
         self.m = m
         self.extent_m = float(cfg.water.extent_m)
         self.sun_irradiance = wp.array(
-            np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device
+            np.asarray(setup.sun_irradiance, np.float32), dtype=wp.float32, device=device
         )
+        """The current pass's irradiance (K,) on a plane perpendicular to its light [W m^-2 nm^-1]."""
         self.attenuation_per_m = wp.array(
-            np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
+            np.asarray(setup.attenuation_per_m, np.float32), dtype=wp.float32, device=device
         )
-        self.sun_dir = wp.vec3(*np.asarray(sun_dir, np.float32))
+        self.sun_dir = wp.vec3(*np.asarray(setup.sun_dir, np.float32))
+        """The current pass's light direction."""
         self.smooth = cfg.caustics.beam_interpolation is BeamInterpolation.SMOOTH
         self.plane_z = -cfg.floor.depth_m
         self.base = wp.empty((count, 3), dtype=wp.vec3, device=device)
@@ -292,29 +294,21 @@ class BeamCaustics:
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
 
-    timing_name = "beams"
-    """The stage's entry in RenderResult.timings_s and its RenderResult.method."""
-    stats_key = "beam_stats"
-
     def attach_camera(self, camera) -> None:
         """Refine adaptive beams near ``camera``'s screen footprint."""
         self.camera = camera
 
-    def render_camera(self, camera, shafts: bool) -> None:
+    def _render_camera(self, camera, shafts: bool) -> None:
         """Shade ``camera``'s image with this pass's beams (and their shafts)."""
         camera.render_beams(self, shafts)
 
-    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
-        """Build the next :meth:`run`'s beams for light from ``direction`` (3,) (towards a point of
-        the sun's disk or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
-        [W m⁻² nm⁻¹]; the renderer adds the passes up."""
-        self.sun_dir = wp.vec3(*np.asarray(direction, np.float32))
-        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
-
     # --- per frame --------------------------------------------------------------------------
 
-    def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:
-        """Build and bin the beams; fill :attr:`irradiance` (floor) and :attr:`face_flux`."""
+    def trace(self, surface: Surface, visible: wp.array2d, direction: np.ndarray,
+              irradiance: np.ndarray) -> wp.array3d:
+        """Build and bin a pass's beams; fill :attr:`irradiance` (floor) and :attr:`face_flux`."""
+        self.sun_dir = wp.vec3(*np.asarray(direction, np.float32))
+        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
         dev = self.device
         self.dropped.zero_()
         leaves = self.uniform_leaves if not self.levels else self._refine(surface)
@@ -358,7 +352,7 @@ class BeamCaustics:
             inputs=[
                 *self.floor_bins.inputs(),
                 self.texels_per_tile,
-                *self._beam_inputs(),
+                self.gather_beams(),
                 self.corner_z,
                 self.texel_area,
             ],
@@ -436,25 +430,16 @@ class BeamCaustics:
         self.level_counts = {int(lv): int(np.count_nonzero(ordered[:, 2] == lv)) for lv in range(top + 1)}
         return wp.array(ordered, dtype=wp.vec3i, device=dev)
 
-    def _beam_inputs(self) -> list:
-        return [
-            self.base,
-            self.direction,
-            self.transmit,
-            self.ends,
-            self.weight,
-            self.area_coef,
-            self.beams_per_group,
-            self.k // self.groups,
-            self.sun_irradiance,
-            self.attenuation_per_m,
-            self.extent_m,
-            int(self.periodic),
-            self.receivers.mesh.id,
-            int(self.occluders),
-            self.quads,
-            int(self.smooth),
-        ]
+    def gather_beams(self) -> beam_kernels.Beams:
+        """The beams of the pass being traced as the gathers read them (floor, points, shafts)."""
+        bm = beam_kernels.Beams()
+        for name in ("base", "direction", "transmit", "ends", "weight", "area_coef", "beams_per_group",
+                     "sun_irradiance", "attenuation_per_m", "extent_m", "quads"):
+            setattr(bm, name, getattr(self, name))
+        bm.wavelengths_per_group = self.k // self.groups
+        bm.periodic, bm.smooth, bm.occluders = int(self.periodic), int(self.smooth), int(self.occluders)
+        bm.mesh = self.receivers.mesh.id
+        return bm
 
     def _bin_horizontal(self, bins: TileBins, lo_z: float, hi_z: float) -> None:
         wp.launch(
@@ -477,20 +462,20 @@ class BeamCaustics:
 
     def points(self, points: wp.array, normals: wp.array, ids: wp.array, out: wp.array2d) -> wp.array2d:
         """Irradiance (K, P) [W m^-2 nm^-1] on receivers at ``points`` with unit ``normals`` (ids < 0
-        are skipped and get 0) from the last :meth:`run`'s beams."""
+        are skipped and get 0) from the beams of the pass being traced."""
         if not self._points_binned:  # binned on first use: a flat floor alone does not need it
             self._bin_horizontal(self.point_bins, *self.query_z)
             self._points_binned = True
         wp.launch(
             beam_kernels.point_irradiance,
             dim=points.shape[0],
-            inputs=[*self.point_bins.inputs(), *self._beam_inputs(), points, normals, ids],
+            inputs=[*self.point_bins.inputs(), self.gather_beams(), points, normals, ids],
             outputs=[out],
             device=self.device,
         )
         return out
 
-    def face_flux_w_nm(self) -> np.ndarray:
+    def _face_flux_w_nm(self) -> np.ndarray:
         """(F_other, K) flux on each non-floor face [W nm^-1]: mean sample irradiance × area."""
         if not self.face_count:
             return np.zeros((0, self.k))
@@ -498,7 +483,7 @@ class BeamCaustics:
         area = self.receivers.face_area_m2[self.receivers.floor_face_count :]
         return (values.mean(axis=2) * area[None, :]).T
 
-    def transmitted_flux(self) -> np.ndarray:
+    def _transmitted_flux(self) -> np.ndarray:
         """(K,) flux the beams carry into the water before attenuation [W nm^-1] (float64)."""
         used = self.groups * self.beams_per_group  # adaptive beams fill only part of the buffers
         w = self.weight.numpy()[:used].astype(np.float64)
@@ -507,7 +492,7 @@ class BeamCaustics:
         e = self.sun_irradiance.numpy().astype(np.float64)
         return e * np.repeat(per_group, len(e) // self.groups)
 
-    def stats(self) -> BeamStats:
+    def _stats(self) -> BeamStats:
         w = self.weight.numpy()
         return BeamStats(
             beams=self.groups * self.beams_per_group,
@@ -522,8 +507,8 @@ class BeamStage(ReceiverStage):
 
     name = "beams"
 
-    def make_caustics(self, args: tuple) -> list:
-        return [BeamCaustics(*args, periodic=self.water.periodic, relief=self.scene.floor_relief)]
+    def make_caustics(self, setup: CausticsSetup) -> list[PassCaustics]:
+        return [BeamCaustics(setup)]
 
     @classmethod
     def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from warpcaustics.caustics.beams import BeamCaustics, BeamStage
 from warpcaustics.caustics.photons import PhotonCaustics, PhotonStage
-from warpcaustics.caustics.receiver_stage import ReceiverStage
+from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
 
 
 class BothStage(ReceiverStage):
@@ -13,10 +13,8 @@ class BothStage(ReceiverStage):
 
     name = "both"
 
-    def make_caustics(self, args: tuple) -> list:
-        periodic = self.water.periodic
-        return [BeamCaustics(*args, periodic=periodic, relief=self.scene.floor_relief),
-                PhotonCaustics(*args, periodic=periodic)]
+    def make_caustics(self, setup: CausticsSetup) -> list[PassCaustics]:
+        return [BeamCaustics(setup), PhotonCaustics(setup)]
 
     @classmethod
     def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:

@@ -11,12 +11,12 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.receiver_stage import ReceiverStage
+from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
 from warpcaustics.config import Config, Intersection
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
 from warpcaustics.optics.refraction import still_water_refraction
-from warpcaustics.scene.receivers import WALLS_ID, Receivers
+from warpcaustics.scene.receivers import WALLS_ID
 from warpcaustics.water import Surface
 
 PHOTON_BYTES = 12 + 12 + 4 + 12 + 4
@@ -78,24 +78,16 @@ def light_view_frame(points: np.ndarray, view_dir: np.ndarray, resolution: int):
     return origin, u, v, texel
 
 
-class PhotonCaustics:
-    """Owns the photon stage's device buffers for one scene, reused from frame to frame."""
+class PhotonCaustics(PassCaustics):
+    """The photon stage's device buffers for one scene, reused from pass to pass and frame to frame."""
 
-    def __init__(
-        self,
-        cfg: Config,
-        receivers: Receivers,
-        n: int,
-        sun_irradiance: np.ndarray,
-        attenuation_per_m: np.ndarray,
-        group_ior: np.ndarray,
-        sun_dir: np.ndarray,
-        device: str,
-        *,
-        periodic: bool,
-    ):
-        """``sun_dir``: the sun's centre (the light view for the Newton guesses looks along its
-        refracted direction, and it is the photons' direction until :meth:`set_light`)."""
+    timing_name = "photons"
+    stats_key = "photon_stats"
+
+    def __init__(self, setup: CausticsSetup):
+        """The light view for the Newton guesses looks along the sun's centre's refracted direction."""
+        cfg, receivers, n, device = setup.cfg, setup.receivers, setup.n, setup.device
+        periodic, group_ior = setup.periodic, setup.group_ior
         self.cfg = cfg
         self.device = device
         self.receivers = receivers
@@ -109,13 +101,14 @@ class PhotonCaustics:
         """Refractive index of each index group (one, or one per band with dispersion)."""
         count = photon_count(cfg, n, groups, periodic)
         self.photons_per_group = count // groups
-        k = len(sun_irradiance)
+        k = len(setup.sun_irradiance)
         m = cfg.caustics.map_resolution
         self.sun_irradiance = wp.array(
-            np.asarray(sun_irradiance, np.float32), dtype=wp.float32, device=device
+            np.asarray(setup.sun_irradiance, np.float32), dtype=wp.float32, device=device
         )
+        """The current pass's irradiance (K,) on a plane perpendicular to its light [W m^-2 nm^-1]."""
         self.attenuation_per_m = wp.array(
-            np.asarray(attenuation_per_m, np.float32), dtype=wp.float32, device=device
+            np.asarray(setup.attenuation_per_m, np.float32), dtype=wp.float32, device=device
         )
         self.origin = wp.empty(count, dtype=wp.vec3, device=device)
         self.direction = wp.empty(count, dtype=wp.vec3, device=device)
@@ -132,7 +125,7 @@ class PhotonCaustics:
         self.floor_inv_area = wp.array(
             (1.0 / receivers.floor_texel_area_m2).astype(np.float32), dtype=wp.float32, device=device
         )
-        sun = np.asarray(sun_dir, np.float64)
+        sun = np.asarray(setup.sun_dir, np.float64)
         self.light_dir = wp.vec3(*sun.astype(np.float32))  # the photons' direction (set per pass)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
@@ -173,8 +166,13 @@ class PhotonCaustics:
             )
         return view
 
-    def run(self, surface: Surface, visible: wp.array2d) -> wp.array3d:
-        """Emit, trace and deposit every photon; fills :attr:`irradiance` and :attr:`face_flux`."""
+    def trace(self, surface: Surface, visible: wp.array2d, direction: np.ndarray,
+              irradiance: np.ndarray) -> wp.array3d:
+        """Emit, trace and deposit every photon of a pass; fills :attr:`irradiance` and
+        :attr:`face_flux`. One direction per pass: a photon's lattice neighbours must share its
+        direction, or the camera's lattice splats draw a pattern."""
+        self.light_dir = wp.vec3(*np.asarray(direction, np.float32))
+        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
         dev = self.device
         s = self.subdivisions
         ior = self.ior
@@ -246,38 +244,23 @@ class PhotonCaustics:
         )
         return self.irradiance
 
-    timing_name = "photons"
-    """The stage's entry in RenderResult.timings_s and its RenderResult.method."""
-    stats_key = "photon_stats"
-
-    def attach_camera(self, camera) -> None:
-        """The camera needs nothing of the photons before they are traced."""
-
-    def render_camera(self, camera, shafts: bool) -> None:
+    def _render_camera(self, camera, shafts: bool) -> None:
         """Splat this pass's photons into ``camera``'s image, each over its lattice cell."""
         spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         camera.render(self, spacing, shafts)
 
-    def face_flux_w_nm(self) -> np.ndarray:
+    def _face_flux_w_nm(self) -> np.ndarray:
         """(F_other, K) flux on each non-floor face [W nm^-1] (float64)."""
         other = self.receivers.face_count - self.receivers.floor_face_count
         return self.face_flux.numpy()[:other].astype(np.float64)
 
-    def set_light(self, direction: np.ndarray, irradiance: np.ndarray) -> None:
-        """Emit the next :meth:`run`'s photons from ``direction`` (3,) (towards a point of the sun's
-        disk, or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
-        [W m⁻² nm⁻¹]; the renderer adds the passes up. One direction per pass: a photon's lattice
-        neighbours must share its direction, or the camera's lattice splats draw a pattern."""
-        self.light_dir = wp.vec3(*np.asarray(direction, np.float32))
-        self.sun_irradiance.assign(np.asarray(irradiance, np.float32))
-
-    def transmitted_flux(self) -> np.ndarray:
+    def _transmitted_flux(self) -> np.ndarray:
         """(K,) flux the photons carry into the water before attenuation [W nm^-1] (float64)."""
         w = self.weight.numpy().astype(np.float64).reshape(self.groups, -1).sum(axis=1)
         e = self.sun_irradiance.numpy().astype(np.float64)
         return e * np.repeat(w, len(e) // self.groups)
 
-    def stats(self) -> PhotonStats:
+    def _stats(self) -> PhotonStats:
         w = self.weight.numpy()
         return PhotonStats(
             emitted=len(w),
@@ -291,8 +274,8 @@ class PhotonStage(ReceiverStage):
 
     name = "photons"
 
-    def make_caustics(self, args: tuple) -> list:
-        return [PhotonCaustics(*args, periodic=self.water.periodic)]
+    def make_caustics(self, setup: CausticsSetup) -> list[PassCaustics]:
+        return [PhotonCaustics(setup)]
 
     @classmethod
     def caustics_bytes(cls, scene, n: int, k: int, groups: int, faces: int) -> int:

@@ -3,6 +3,9 @@ meshes), the under-water camera fed, one light pass per direction of the sun's d
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import numpy as np
 
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
@@ -67,12 +70,85 @@ def receiver_face_estimate(scene, periodic: bool) -> int:
     return floor + sum(len(m.triangles) for m in scene.receiver_meshes) + walls
 
 
+@dataclass(frozen=True)
+class CausticsSetup:
+    """What a receiver method's caustics object is built from, once per scene."""
+
+    cfg: object
+    receivers: Receivers
+    n: int
+    """Water resolution (vertices per side)."""
+    sun_irradiance: np.ndarray
+    """(K,) the sun's irradiance on a plane perpendicular to it [W m^-2 nm^-1]."""
+    attenuation_per_m: np.ndarray
+    """(K,) beam attenuation c(λ) [m^-1]."""
+    group_ior: np.ndarray
+    """One refractive index per index group."""
+    sun_dir: np.ndarray
+    """(3,) towards the sun's centre."""
+    device: str
+    periodic: bool
+    relief: np.ndarray | None
+    """The floor's relief heights (None: flat or analytic)."""
+
+
+@dataclass
+class LightPass:
+    """One light pass of a caustics object, read back to the host before the next pass starts: the
+    object's device buffers are its workspace, and nothing a caller gets refers to them."""
+
+    floor: np.ndarray
+    """(K, M, M) floor irradiance [W m^-2 nm^-1] (float64)."""
+    transmitted: np.ndarray
+    """(K,) flux entering the water before attenuation [W nm^-1]."""
+    face_flux_w_nm: np.ndarray
+    """(F_other, K) flux on each non-floor face [W nm^-1]."""
+    stats: dict
+    """The method's counts (``RenderResult.photon_stats`` / ``beam_stats``)."""
+    camera_radiance: np.ndarray | None = None
+    """(K, H, W) the camera's radiance from this pass (float64), None without a camera."""
+
+
+class PassCaustics:
+    """Base of a receiver method's caustics object (photons, beams): built once per scene from a
+    :class:`CausticsSetup`, then one :meth:`light_pass` per light direction. Subclasses implement
+    :meth:`trace` (the device work), :meth:`_render_camera`, :meth:`_transmitted_flux`,
+    :meth:`_face_flux_w_nm` and :meth:`_stats`, which read the buffers of the pass just traced."""
+
+    timing_name: ClassVar[str] = ""
+    """The stage's entry in RenderResult.timings_s and its RenderResult.method."""
+    stats_key: ClassVar[str] = ""
+    """Its counts' RenderResult field."""
+
+    def attach_camera(self, camera) -> None:
+        """Called once when the scene has a camera (before any pass)."""
+
+    def trace(self, surface, visible, direction: np.ndarray, irradiance: np.ndarray):
+        """The device work of a pass of light from ``direction`` (3,) (towards a point of the sun's
+        disk, or of the sky) carrying ``irradiance`` (K,) on a plane perpendicular to it
+        [W m⁻² nm⁻¹]; returns the (K, M, M) floor map on the device (benchmarks time this alone)."""
+        raise NotImplementedError
+
+    def light_pass(self, surface, visible, direction: np.ndarray, irradiance: np.ndarray, watch, *,
+                   stage: str, camera=None, camera_stage: str = "camera", shafts: bool = False) -> LightPass:
+        """Trace one pass, shade ``camera`` with it, and read everything back (timed as ``stage``,
+        ``camera_stage`` and ``readback`` on ``watch``)."""
+        with watch.stage(stage):
+            floor = self.trace(surface, visible, direction, irradiance)
+        radiance = None
+        if camera is not None:
+            with watch.stage(camera_stage):
+                self._render_camera(camera, shafts)
+                radiance = camera.radiance.numpy().astype(np.float64)
+        with watch.stage("readback"):
+            return LightPass(floor.numpy().astype(np.float64), self._transmitted_flux(),
+                             self._face_flux_w_nm(), vars(self._stats()), radiance)
+
+
 class ReceiverStage(CausticStage):
     """A method that lights every receiver and feeds the camera. Subclasses say which caustics
-    objects run (:meth:`make_caustics`, each with ``set_light``, ``run``, ``render_camera``,
-    ``transmitted_flux``, ``face_flux_w_nm``, ``stats``, ``timing_name`` and ``stats_key``) and
-    their memory (:meth:`caustics_bytes`); the first one's maps are the result, a second one's
-    its comparison."""
+    objects run (:meth:`make_caustics`: :class:`PassCaustics`) and their memory
+    (:meth:`caustics_bytes`); the first one's maps are the result, a second one's its comparison."""
 
     def __init__(self, scene, water, light: Lighting, device: str):
         super().__init__(scene, water, light, device)
@@ -81,9 +157,10 @@ class ReceiverStage(CausticStage):
         self.receivers = Receivers(cfg, light.bins, device, periodic=periodic, relief=scene.floor_relief,
                                    meshes=scene.receiver_meshes, water_top_z=WALL_TOP_M,
                                    base_dir=scene.base_dir)
-        args = (cfg, self.receivers, scene.water_resolution, light.sun_irradiance, light.attenuation_per_m,
-                light.group_ior, scene.sun_direction, device)
-        self.caustics = self.make_caustics(args)
+        setup = CausticsSetup(cfg, self.receivers, scene.water_resolution, light.sun_irradiance,
+                              light.attenuation_per_m, light.group_ior, scene.sun_direction, device,
+                              periodic, scene.floor_relief)
+        self.caustics = self.make_caustics(setup)
         self.floor_top_z = self.receivers.floor_top_z
         if periodic:
             lights = [scene.sun_direction] + list(light.sky_directions if light.sky_directions is not None
@@ -98,9 +175,8 @@ class ReceiverStage(CausticStage):
             for caustics in self.caustics:
                 caustics.attach_camera(self.camera)
 
-    def make_caustics(self, args: tuple) -> list:
-        """The caustics objects of this method, built from (cfg, receivers, N, sun irradiance,
-        attenuation, index groups, sun direction, device)."""
+    def make_caustics(self, setup: CausticsSetup) -> list[PassCaustics]:
+        """The caustics objects of this method."""
         raise NotImplementedError
 
     @classmethod
@@ -149,7 +225,6 @@ class ReceiverStage(CausticStage):
         # with a second method, the first one's camera time is its own entry
         camera_stage = "camera" if last else f"camera_{caustics.timing_name}"
         for direction, irradiance, from_sky in self.light.passes():
-            caustics.set_light(direction, irradiance)
             if from_sky:
                 with watch.stage("sky"):
                     seen = sun_visibility(frame.surface, direction, frame.highest, self.device,
@@ -157,23 +232,19 @@ class ReceiverStage(CausticStage):
             else:
                 seen = frame.visible  # crests shade by the sun's centre
             # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are
-            with watch.stage("sky" if from_sky else caustics.timing_name):
-                floor = caustics.run(frame.surface, seen)
-            part = {}
-            if self.camera is not None:
-                with watch.stage("sky" if from_sky else camera_stage):
-                    caustics.render_camera(self.camera, cfg.caustics.shafts)
-                    part["camera_radiance"] = self.camera.radiance.numpy().astype(np.float64)
-            with watch.stage("readback"):
-                part["floor"] = floor.numpy().astype(np.float64)
-                part["transmitted"] = caustics.transmitted_flux()
-                part["face_flux_w_nm"] = caustics.face_flux_w_nm()
-                counts = vars(caustics.stats())
+            done = caustics.light_pass(frame.surface, seen, direction, irradiance, watch,
+                                       stage="sky" if from_sky else caustics.timing_name, camera=self.camera,
+                                       camera_stage="sky" if from_sky else camera_stage,
+                                       shafts=cfg.caustics.shafts)
+            part = {"floor": done.floor, "transmitted": done.transmitted,
+                    "face_flux_w_nm": done.face_flux_w_nm}
+            if done.camera_radiance is not None:
+                part["camera_radiance"] = done.camera_radiance
             total = totals[from_sky]
             for key, value in part.items():
                 total[key] = total[key] + value if key in total else value
             key = caustics.stats_key
-            extra[key] = {k: extra.get(key, {}).get(k, 0) + v for k, v in counts.items()}
+            extra[key] = {k: extra.get(key, {}).get(k, 0) + v for k, v in done.stats.items()}
         sun, sky = totals[False], totals[True]
         combined = {key: sun[key] + sky[key] if key in sky else sun[key] for key in sun}
         extra["face_flux_w_nm"] = combined["face_flux_w_nm"]

@@ -245,22 +245,16 @@ class UnderwaterCamera:
             bins.bin()
             self._pairs.zero_()
             sb = beam_kernels.ShaftBeams()
-            for name in ("base", "direction", "transmit", "ends", "weight", "area_coef", "extent_m", "quads",
-                         "beams_per_group", "sun_irradiance", "attenuation_per_m"):
-                setattr(sb, name, getattr(beams, name))
-            sb.copies, sb.smooth, sb.wavelengths_per_group = copies, int(beams.smooth), k // beams.groups
+            sb.beams, sb.copies = beams.gather_beams(), copies
             sb.scattering_per_m = self.scattering_per_m
             ph = self.phase
             sb.phase_kind, sb.hg_g, sb.cone_phase = ph.kind, ph.g, ph.cone_phase
             sb.angles_rad, sb.log_phase = ph.angles_rad, ph.log_phase
-            kernel, dim = beam_kernels.scan_plane_radiance, (h, w)
-            if self.shaft_threads == "tile":
-                kernel, dim = beam_kernels.scan_plane_radiance_tiles, (bins.grid.ny, bins.grid.nx)
+            per_tile = int(self.shaft_threads == "tile")
             wp.launch(
-                kernel,
-                dim=dim,
-                inputs=[*bins.inputs(), SCREEN_TILE_PIXELS, self.cam, self.rays, self.depth, sb,
-                        bins.box_axis, bins.box_lo, bins.box_hi],
+                beam_kernels.scan_plane_radiance,
+                dim=(bins.grid.ny, bins.grid.nx) if per_tile else (h, w),
+                inputs=[bins.screen_bins(SCREEN_TILE_PIXELS), self.cam, self.rays, self.depth, sb, per_tile],
                 outputs=[self.shafts, self._pairs],
                 device=dev,
             )

@@ -32,19 +32,22 @@ from warpcaustics.kernels.caustics.beams.irradiance import point_irradiance
 from warpcaustics.kernels.caustics.beams.raster import TileGrid, bin_tiles, horizontal_spans, screen_spans
 from warpcaustics.kernels.caustics.beams.section import (
     BeamCorners,
+    Beams,
     clamped_sample,
     edge_corners,
     inside_triangle,
 )
 from warpcaustics.kernels.caustics.beams.volume import (
+    ScreenBins,
     ShaftBeams,
     scan_chord,
     scan_plane_radiance,
-    scan_plane_radiance_tiles,
 )
 
 __all__ = [
     "BeamCorners",
+    "Beams",
+    "ScreenBins",
     "ShaftBeams",
     "TileGrid",
     "bin_tiles",
@@ -59,7 +62,6 @@ __all__ = [
     "refine_quads",
     "scan_chord",
     "scan_plane_radiance",
-    "scan_plane_radiance_tiles",
     "screen_spans",
     "vertex_rays",
 ]

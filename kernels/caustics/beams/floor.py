@@ -8,6 +8,7 @@ from warpcaustics.kernels.caustics.beams.irradiance import add_beam_irradiance, 
 from warpcaustics.kernels.caustics.beams.raster import TileGrid, tile_index
 from warpcaustics.kernels.caustics.beams.section import (
     MIN_AREA_FRACTION,
+    Beams,
     BeamSample,
     clamped_sample,
     copy_range,
@@ -44,17 +45,7 @@ def texel_normals(corner: wp.vec2, texel_m: float, a3: wp.vec3, zb: float, zc: f
 
 
 @wp.func
-def texel_copies(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    b: int,
-    z_lo: float,
-    z_hi: float,
-    corner: wp.vec2,
-    texel_m: float,
-    extent_m: float,
-    periodic: int,
-):
+def texel_copies(bm: Beams, b: int, z_lo: float, z_hi: float, corner: wp.vec2, texel_m: float):
     """(kx0, kx1, ky0, ky1): the copies of the texel that beam b may reach. Its sections between the
     texel's lowest and highest corners bound its cuts through both triangles (sections are linear
     in z)."""
@@ -65,11 +56,11 @@ def texel_copies(
             zz = z_lo
             if k == 1:
                 zz = z_hi
-            sv = section_vertex(base[b, e], direction[b, e], zz)
+            sv = section_vertex(bm.base[b, e], bm.direction[b, e], zz)
             lo = wp.min(lo, sv)
             hi = wp.max(hi, sv)
-    kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, extent_m, periodic)
-    ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, extent_m, periodic)
+    kx0, kx1 = copy_range(lo[0], hi[0], corner[0], texel_m, bm.extent_m, bm.periodic)
+    ky0, ky1 = copy_range(lo[1], hi[1], corner[1], texel_m, bm.extent_m, bm.periodic)
     return kx0, kx1, ky0, ky1
 
 
@@ -148,46 +139,24 @@ def floor_point(
 
 
 @wp.func
-def piece_sample(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    area_coef: wp.array[wp.vec3],
-    b: int,
-    p: wp.vec3,
-) -> BeamSample:
+def piece_sample(bm: Beams, b: int, p: wp.vec3) -> BeamSample:
     """Beam b at a piece's centroid p; a centroid on the section's boundary to rounding is clamped in."""
-    s = sample_beam(base, direction, transmit, ends, area_coef, b, p)
+    s = sample_beam(bm, b, p)
     if s.inside == 0:
-        s = clamped_sample(load_corners(base, direction, transmit, ends, area_coef, b), p)
+        s = clamped_sample(load_corners(bm, b), p)
     return s
 
 
 @wp.func
-def piece_density(
-    weight: wp.array[wp.float32],
-    transmit: wp.array2d[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    base: wp.array2d[wp.vec3],
-    b: int,
-    s: BeamSample,
-    cut: float,
-    n: wp.vec3,
-    p: wp.vec3,
-    quads: int,
-    periodic: int,
-    smooth: int,
-    scale: float,
-):
+def piece_density(bm: Beams, b: int, s: BeamSample, cut: float, n: wp.vec3, p: wp.vec3, scale: float):
     """(scale, density) of a piece with centroid p, its flux going over the texel's true area
     (``scale``: the piece's share of that area). Flat: the beam's flux w Σλ T spread evenly over
     its cut through this plane (area ``cut`` [m²]; exact flux, as a section on a flat floor).
     Smooth: its irradiance on the plane, E_h |d·n| / |d_z|, times the piece's true area."""
-    if smooth == 0:
-        return scale, weight[b] * s.transmit / wp.max(cut, MIN_AREA_FRACTION * s.area)
+    if bm.smooth == 0:
+        return scale, bm.weight[b] * s.transmit / wp.max(cut, MIN_AREA_FRACTION * s.area)
     cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
-    density = flux_density(weight, transmit, area_coef, base, b, s, p[2], quads, periodic, smooth)
+    density = flux_density(bm, b, s, p[2], bm.periodic)
     return scale * cos_factor / n[2], density
 
 
@@ -198,22 +167,7 @@ def floor_texels(
     tile_count: wp.array[wp.int32],
     tile_items: wp.array[wp.int32],
     texels_per_tile: int,
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    weight: wp.array[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    extent_m: float,
-    periodic: int,
-    mesh: wp.uint64,
-    occluders: int,
-    quads: int,
-    smooth: int,
+    bm: Beams,
     corner_z: wp.array2d[wp.float32],
     texel_area_m2: wp.array2d[wp.float32],
     out: wp.array2d[wp.float32],
@@ -229,6 +183,7 @@ def floor_texels(
     planes, each normalised on its own); ``smooth``: the interpolated irradiance on the plane at
     the centroid times the piece's area."""
     ty, tx = wp.tid()
+    extent_m = bm.extent_m
     m = texels_per_tile * grid.nx
     texel_m = extent_m / float(m)
     point = ty * m + tx
@@ -252,21 +207,21 @@ def floor_texels(
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
-        kx0, kx1, ky0, ky1 = texel_copies(base, direction, b, z_lo, z_hi, corner, texel_m, extent_m, periodic)
+        kx0, kx1, ky0, ky1 = texel_copies(bm, b, z_lo, z_hi, corner, texel_m)
         for piece in range(pieces):
             n = n_lower
             if piece == 1:
                 n = n_upper
-            if not edges_cross_down(direction, b, n):
+            if not edges_cross_down(bm.direction, b, n):
                 continue  # a grazing or back-facing triangle
             for ky in range(ky0, ky1 + 1):
                 for kx in range(kx0, kx1 + 1):  # every periodic copy of the texel the cut may cover
                     shift = wp.vec2(float(kx) * extent_m, float(ky) * extent_m)
                     # The copy's own plane (a tilted plane does not repeat with the period).
                     a_copy = a3 + wp.vec3(shift[0], shift[1], 0.0)
-                    q0 = plane_cut(base[b, 0], direction[b, 0], a_copy, n)
-                    q1 = plane_cut(base[b, 1], direction[b, 1], a_copy, n)
-                    q2 = plane_cut(base[b, 2], direction[b, 2], a_copy, n)
+                    q0 = plane_cut(bm.base[b, 0], bm.direction[b, 0], a_copy, n)
+                    q1 = plane_cut(bm.base[b, 1], bm.direction[b, 1], a_copy, n)
+                    q2 = plane_cut(bm.base[b, 2], bm.direction[b, 2], a_copy, n)
                     rx, ry, rn = clip_cut(q0, q1, q2, corner + shift, texel_m, flat, piece)
                     if rn < 3:
                         continue
@@ -274,23 +229,10 @@ def floor_texels(
                     if not (share > 0.0):
                         continue
                     p = floor_point(corner, polygon_centroid(rx, ry, rn), texel_m, za, n, shift)
-                    s = piece_sample(base, direction, transmit, ends, area_coef, b, p)
-                    if not lit(mesh, occluders, s, p):
+                    s = piece_sample(bm, b, p)
+                    if not lit(bm.mesh, bm.occluders, s, p):
                         continue
                     cut = 0.5 * wp.abs(cross2(q1 - q0, q2 - q0))  # the beam's cut through the plane [m²]
                     scale = share * texel_m * texel_m * inv_area
-                    scale, density = piece_density(
-                        weight, transmit, area_coef, base, b, s, cut, n, p, quads, periodic, smooth, scale
-                    )
-                    add_beam_irradiance(
-                        out,
-                        point,
-                        scale,
-                        b,
-                        s,
-                        density,
-                        beams_per_group,
-                        wavelengths_per_group,
-                        sun_irradiance,
-                        attenuation_per_m,
-                    )
+                    scale, density = piece_density(bm, b, s, cut, n, p, scale)
+                    add_beam_irradiance(out, point, scale, bm, b, s, density)

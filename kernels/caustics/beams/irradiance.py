@@ -7,6 +7,7 @@ import warp as wp
 from warpcaustics.kernels.caustics.beams.build import corner_offset
 from warpcaustics.kernels.caustics.beams.raster import TileGrid, tile_of
 from warpcaustics.kernels.caustics.beams.section import (
+    Beams,
     BeamSample,
     copy_range,
     lit,
@@ -20,19 +21,11 @@ wp.set_module_options({"enable_backward": False})
 
 
 @wp.func
-def ring_density(
-    weight: wp.array[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    base: wp.array2d[wp.vec3],
-    g: int,
-    vx: int,
-    vy: int,
-    quads: int,
-    periodic: int,
-    z: float,
-) -> float:
+def ring_density(bm: Beams, g: int, vx: int, vy: int, periodic: int, z: float) -> float:
     """Wave-front density at lattice vertex (vx, vy) and height z: the flux weight of the (up to
-    six) carrying beams around the vertex over the area of their sections, Σ w / Σ |A(z)|."""
+    six) carrying beams around the vertex over the area of their sections, Σ w / Σ |A(z)|
+    (``periodic``: the lattice wraps)."""
+    quads = bm.quads
     num = float(0.0)
     den = float(0.0)
     for r in range(6):
@@ -63,35 +56,26 @@ def ring_density(
         elif qx < 0 or qy < 0 or qx >= quads or qy >= quads:
             continue
         bb = ((g * quads + qy) * quads + qx) * 2 + half
-        if weight[bb] > 0.0:
-            num += weight[bb]
-            den += safe_area(area_coef[bb], z, (base[bb, 0][2] + base[bb, 1][2] + base[bb, 2][2]) / 3.0)
+        if bm.weight[bb] > 0.0:
+            num += bm.weight[bb]
+            base_z = (bm.base[bb, 0][2] + bm.base[bb, 1][2] + bm.base[bb, 2][2]) / 3.0
+            den += safe_area(bm.area_coef[bb], z, base_z)
     if den <= 0.0:
         return 0.0
     return num / den
 
 
 @wp.func
-def flux_density(
-    weight: wp.array[wp.float32],
-    transmit: wp.array2d[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    base: wp.array2d[wp.vec3],
-    b: int,
-    s: BeamSample,
-    z: float,
-    quads: int,
-    periodic: int,
-    smooth: int,
-) -> float:
+def flux_density(bm: Beams, b: int, s: BeamSample, z: float, periodic: int) -> float:
     """Horizontal flux density at a point of beam b per unit solar irradiance, before attenuation
     [-]. ``smooth == 0``: the beam's own ``w Σλ_i T_i / |A(z)|`` (each section receives exactly its
     flux). ``smooth == 1`` (Ernst et al. 2005's interpolation across beams): ``Σ λ_i T_i ρ_i`` with
     ρ_i the wave-front density of the beams around vertex i at this height, so the irradiance is
     continuous from beam to beam and no triangle edges show; flux is then conserved only to the
-    interpolation's accuracy (docs/validation.md)."""
-    if smooth == 0:
-        return weight[b] * s.transmit / s.area
+    interpolation's accuracy (docs/validation.md). ``periodic``: the lattice wraps."""
+    if bm.smooth == 0:
+        return bm.weight[b] * s.transmit / s.area
+    quads = bm.quads
     per_group = quads * quads * 2
     g = b / per_group
     rest = b - g * per_group
@@ -101,30 +85,21 @@ def flux_density(
     total = float(0.0)
     for c in range(3):
         o = corner_offset(half, c)
-        rho = ring_density(weight, area_coef, base, g, qx + o[0], qy + o[1], quads, periodic, z)
-        total += s.lam[c] * transmit[b, c] * rho
+        rho = ring_density(bm, g, qx + o[0], qy + o[1], periodic, z)
+        total += s.lam[c] * bm.transmit[b, c] * rho
     return total
 
 
 @wp.func
 def add_beam_irradiance(
-    out: wp.array2d[wp.float32],
-    point: int,
-    scale: float,
-    b: int,
-    s: BeamSample,
-    density: float,
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
+    out: wp.array2d[wp.float32], point: int, scale: float, bm: Beams, b: int, s: BeamSample, density: float
 ):
     """out[k, point] += scale · E_sun(k) · density · exp(−c(k) ℓ) for the bands of b's group."""
-    g = b / beams_per_group
+    g = b / bm.beams_per_group
     f = scale * density
-    for j in range(wavelengths_per_group):
-        k = g * wavelengths_per_group + j
-        out[k, point] = out[k, point] + f * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * s.path_m)
+    for j in range(bm.wavelengths_per_group):
+        k = g * bm.wavelengths_per_group + j
+        out[k, point] = out[k, point] + f * bm.sun_irradiance[k] * wp.exp(-bm.attenuation_per_m[k] * s.path_m)
 
 
 @wp.kernel
@@ -133,22 +108,7 @@ def point_irradiance(
     tile_start: wp.array[wp.int32],
     tile_count: wp.array[wp.int32],
     tile_items: wp.array[wp.int32],
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    weight: wp.array[wp.float32],
-    area_coef: wp.array[wp.vec3],
-    beams_per_group: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    extent_m: float,
-    periodic: int,
-    mesh: wp.uint64,
-    occluders: int,
-    quads: int,
-    smooth: int,
+    bm: Beams,
     points: wp.array[wp.vec3],
     normals: wp.array[wp.vec3],
     point_ids: wp.array[wp.int32],
@@ -169,32 +129,21 @@ def point_irradiance(
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
-        s0 = section_vertex(base[b, 0], direction[b, 0], p[2])
-        s1 = section_vertex(base[b, 1], direction[b, 1], p[2])
-        s2 = section_vertex(base[b, 2], direction[b, 2], p[2])
+        s0 = section_vertex(bm.base[b, 0], bm.direction[b, 0], p[2])
+        s1 = section_vertex(bm.base[b, 1], bm.direction[b, 1], p[2])
+        s2 = section_vertex(bm.base[b, 2], bm.direction[b, 2], p[2])
         lo = wp.min(wp.min(s0, s1), s2)
         hi = wp.max(wp.max(s0, s1), s2)
-        kx0, kx1 = copy_range(lo[0], hi[0], p[0], 0.0, extent_m, periodic)
-        ky0, ky1 = copy_range(lo[1], hi[1], p[1], 0.0, extent_m, periodic)
+        kx0, kx1 = copy_range(lo[0], hi[0], p[0], 0.0, bm.extent_m, bm.periodic)
+        ky0, ky1 = copy_range(lo[1], hi[1], p[1], 0.0, bm.extent_m, bm.periodic)
         for ky in range(ky0, ky1 + 1):
             for kx in range(kx0, kx1 + 1):  # every periodic copy of the point the section may hold
-                q = p + wp.vec3(float(kx) * extent_m, float(ky) * extent_m, 0.0)
-                s = sample_beam(base, direction, transmit, ends, area_coef, b, q)
+                q = p + wp.vec3(float(kx) * bm.extent_m, float(ky) * bm.extent_m, 0.0)
+                s = sample_beam(bm, b, q)
                 if s.inside == 0:
                     continue
-                if not lit(mesh, occluders, s, q):
+                if not lit(bm.mesh, bm.occluders, s, q):
                     continue
                 cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
-                density = flux_density(weight, transmit, area_coef, base, b, s, q[2], quads, periodic, smooth)
-                add_beam_irradiance(
-                    out,
-                    p_index,
-                    cos_factor,
-                    b,
-                    s,
-                    density,
-                    beams_per_group,
-                    wavelengths_per_group,
-                    sun_irradiance,
-                    attenuation_per_m,
-                )
+                density = flux_density(bm, b, s, q[2], bm.periodic)
+                add_beam_irradiance(out, p_index, cos_factor, bm, b, s, density)

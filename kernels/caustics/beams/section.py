@@ -124,25 +124,44 @@ class BeamSample:
     beyond_end_m: float
 
 
+@wp.struct
+class Beams:
+    """A pass's beams as the gathers read them (see the package docstring for the arrays), with
+    their spectrum and what the lookups need: ``beams_per_group`` beams per index group, each
+    group ``wavelengths_per_group`` bands of ``sun_irradiance`` and ``attenuation_per_m``; the
+    patch ``extent_m`` (``periodic``: the sea repeats), ``quads`` per side of the uniform grid
+    (``smooth`` interpolation reads the beams around a lattice vertex), and the receivers' BVH
+    ``mesh`` casting shadows where ``occluders`` is set."""
+
+    base: wp.array2d[wp.vec3]
+    direction: wp.array2d[wp.vec3]
+    transmit: wp.array2d[wp.float32]
+    ends: wp.array2d[wp.vec3]
+    weight: wp.array[wp.float32]
+    area_coef: wp.array[wp.vec3]
+    beams_per_group: int
+    wavelengths_per_group: int
+    sun_irradiance: wp.array[wp.float32]
+    attenuation_per_m: wp.array[wp.float32]
+    extent_m: float
+    periodic: int
+    quads: int
+    smooth: int
+    mesh: wp.uint64
+    occluders: int
+
+
 @wp.func
-def sample_beam(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    area_coef: wp.array[wp.vec3],
-    b: int,
-    p: wp.vec3,
-) -> BeamSample:
+def sample_beam(bm: Beams, b: int, p: wp.vec3) -> BeamSample:
     """The beam b at point p (already moved into the beam's periodic image)."""
     out = BeamSample()
     out.inside = 0
-    v0 = base[b, 0]
-    v1 = base[b, 1]
-    v2 = base[b, 2]
-    d0 = direction[b, 0]
-    d1 = direction[b, 1]
-    d2 = direction[b, 2]
+    v0 = bm.base[b, 0]
+    v1 = bm.base[b, 1]
+    v2 = bm.base[b, 2]
+    d0 = bm.direction[b, 0]
+    d1 = bm.direction[b, 1]
+    d2 = bm.direction[b, 2]
     z = p[2]
     inside, lam = inside_triangle(
         section_vertex(v0, d0, z), section_vertex(v1, d1, z), section_vertex(v2, d2, z), xy(p)
@@ -159,9 +178,9 @@ def sample_beam(
     out.lam = lam
     out.path_m = path
     out.d = wp.normalize(lam[0] * d0 + lam[1] * d1 + lam[2] * d2)
-    out.transmit = lam[0] * transmit[b, 0] + lam[1] * transmit[b, 1] + lam[2] * transmit[b, 2]
-    out.area = safe_area(area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
-    out.beyond_end_m = beyond_end(ends, b, p)
+    out.transmit = lam[0] * bm.transmit[b, 0] + lam[1] * bm.transmit[b, 1] + lam[2] * bm.transmit[b, 2]
+    out.area = safe_area(bm.area_coef[b], z, (v0[2] + v1[2] + v2[2]) / 3.0)
+    out.beyond_end_m = beyond_end(bm.ends, b, p)
     return out
 
 
@@ -239,17 +258,10 @@ def edge_corners(
 
 
 @wp.func
-def load_corners(
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    transmit: wp.array2d[wp.float32],
-    ends: wp.array2d[wp.vec3],
-    area_coef: wp.array[wp.vec3],
-    b: int,
-) -> BeamCorners:
-    c = edge_corners(base, direction, ends, b)
-    c.transmit = wp.vec3(transmit[b, 0], transmit[b, 1], transmit[b, 2])
-    c.coef = area_coef[b]
+def load_corners(bm: Beams, b: int) -> BeamCorners:
+    c = edge_corners(bm.base, bm.direction, bm.ends, b)
+    c.transmit = wp.vec3(bm.transmit[b, 0], bm.transmit[b, 1], bm.transmit[b, 2])
+    c.coef = bm.area_coef[b]
     return c
 
 

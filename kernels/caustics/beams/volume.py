@@ -8,6 +8,7 @@ from warpcaustics.kernels.caustics.beams.irradiance import flux_density
 from warpcaustics.kernels.caustics.beams.raster import TileGrid, in_frame, tile_index
 from warpcaustics.kernels.caustics.beams.section import (
     BeamCorners,
+    Beams,
     barycentrics,
     clamped_sample,
     copy_offset,
@@ -147,26 +148,13 @@ def framed_chord(c: BeamCorners, f: ChordFrame, shift: wp.vec3, o: wp.vec3, v: w
 
 @wp.struct
 class ShaftBeams:
-    """What the volume pass reads besides the camera and the tile lists: the beams (see the package
-    docstring; ``copies`` × ``copies`` periodic copies ``extent_m`` apart, ``quads`` per side of
-    the uniform grid for ``smooth`` interpolation), their index groups, and the medium: the sun's
-    irradiance, attenuation and scattering per band [1/m], the phase function (kind 0:
-    Henyey–Greenstein with ``hg_g``; 1: the table)."""
+    """What the volume pass reads besides the camera and the tile lists: the pass's beams
+    (:class:`Beams`), ``copies`` × ``copies`` periodic copies of each ``extent_m`` apart, and the
+    medium's scattering per band [1/m] and phase function (kind 0: Henyey–Greenstein with
+    ``hg_g``; 1: the table)."""
 
-    base: wp.array2d[wp.vec3]
-    direction: wp.array2d[wp.vec3]
-    transmit: wp.array2d[wp.float32]
-    ends: wp.array2d[wp.vec3]
-    weight: wp.array[wp.float32]
-    area_coef: wp.array[wp.vec3]
+    beams: Beams
     copies: int
-    extent_m: float
-    quads: int
-    smooth: int
-    beams_per_group: int
-    wavelengths_per_group: int
-    sun_irradiance: wp.array[wp.float32]
-    attenuation_per_m: wp.array[wp.float32]
     scattering_per_m: wp.array[wp.float32]
     phase_kind: int
     hg_g: float
@@ -211,7 +199,8 @@ def chord_radiance(
     if ds * ds >= 0.999999 * area_mid:
         pieces = wp.clamp(int(ds / wp.max(wp.sqrt(area_mid), 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
         piece = ds / float(pieces)
-    g = b / sb.beams_per_group
+    bm = sb.beams
+    g = b / bm.beams_per_group
     lattice_wraps = int(0)
     if sb.copies > 1:
         lattice_wraps = 1  # a periodic sea
@@ -223,16 +212,14 @@ def chord_radiance(
             continue
         cos_theta = -wp.dot(smp.d, v)
         phase = phase_value(sb.phase_kind, sb.hg_g, sb.angles_rad, sb.log_phase, sb.cone_phase, cos_theta)
-        density = flux_density(
-            sb.weight, sb.transmit, sb.area_coef, sb.base, b, smp, x[2], sb.quads, lattice_wraps, sb.smooth
-        )
+        density = flux_density(bm, b, smp, x[2], lattice_wraps)
         e_perp = density / wp.abs(smp.d[2])
         f = piece * phase * e_perp
-        for jj in range(sb.wavelengths_per_group):
-            k = g * sb.wavelengths_per_group + jj
+        for jj in range(bm.wavelengths_per_group):
+            k = g * bm.wavelengths_per_group + jj
             scattered = f * sb.scattering_per_m[k]
-            radiance[k, j, i] = radiance[k, j, i] + scattered * sb.sun_irradiance[k] * wp.exp(
-                -sb.attenuation_per_m[k] * (smp.path_m + s_m)
+            radiance[k, j, i] = radiance[k, j, i] + scattered * bm.sun_irradiance[k] * wp.exp(
+                -bm.attenuation_per_m[k] * (smp.path_m + s_m)
             )
     return 1
 
@@ -242,8 +229,8 @@ def copy_corners(sb: ShaftBeams, bc: int):
     """Beam copy ``bc = b · copies² + c``: the beam b, its shift and its corners."""
     per_beam = sb.copies * sb.copies
     b = bc / per_beam
-    corners = load_corners(sb.base, sb.direction, sb.transmit, sb.ends, sb.area_coef, b)
-    return b, copy_offset(bc % per_beam, sb.copies, sb.extent_m), corners
+    corners = load_corners(sb.beams, b)
+    return b, copy_offset(bc % per_beam, sb.copies, sb.beams.extent_m), corners
 
 
 @wp.func
@@ -252,43 +239,43 @@ def outside_box(q: wp.vec2, lo: wp.vec2, hi: wp.vec2) -> bool:
     return q[0] < lo[0] - 1.0e-3 or q[0] > hi[0] + 1.0e-3 or q[1] < lo[1] - 1.0e-3 or q[1] > hi[1] + 1.0e-3
 
 
-@wp.kernel
-def scan_plane_radiance(
-    grid: TileGrid,
-    tile_start: wp.array[wp.int32],
-    tile_count: wp.array[wp.int32],
-    tile_items: wp.array[wp.int32],
-    tile_pixels: int,
-    cam: PinholeCamera,
-    rays: wp.array2d[wp.vec3],
-    depth: wp.array2d[wp.float32],
-    sb: ShaftBeams,
-    box_axis: wp.array[wp.vec2],
-    box_lo: wp.array[wp.vec2],
-    box_hi: wp.array[wp.vec2],
-    radiance: wp.array3d[wp.float32],
-    pairs: wp.array[wp.int32],
+@wp.struct
+class ScreenBins:
+    """The beam copies binned into screen tiles of ``tile_pixels`` pixels (``grid``, each tile's list
+    ``items[start[t] : start[t] + count[t]]``) with each copy's oriented box (``box_axis``,
+    ``box_lo``, ``box_hi``, in pixels)."""
+
+    grid: TileGrid
+    start: wp.array[wp.int32]
+    count: wp.array[wp.int32]
+    items: wp.array[wp.int32]
+    tile_pixels: int
+    box_axis: wp.array[wp.vec2]
+    box_lo: wp.array[wp.vec2]
+    box_hi: wp.array[wp.vec2]
+
+
+@wp.func
+def pixel_chords(
+    bins: ScreenBins, cam: PinholeCamera, rays: wp.array2d[wp.vec3], depth: wp.array2d[wp.float32],
+    sb: ShaftBeams, j: int, i: int, radiance: wp.array3d[wp.float32], pairs: wp.array[wp.int32]
 ):
-    """Single-scattered radiance of the beams along each pixel's ray (K, H, W) [W m^-2 sr^-1
-    nm^-1], a thread per pixel (the GPU's form): the chords (:func:`chord_radiance`) of the beam
-    copies in the pixel's tile list whose oriented box holds the pixel centre. ``pairs`` counts
-    (pixel, beam copy) pairs: [0] in the tile lists, [1] inside the oriented box (scan plane
-    computed), [2] with a chord."""
-    j, i = wp.tid()
+    """Pixel (j, i)'s radiance from the beam copies of its tile whose oriented box holds its centre
+    (a thread per pixel: the GPU's form)."""
     for k in range(radiance.shape[0]):
         radiance[k, j, i] = 0.0
     v = rays[j, i]
     o = cam.position
     s_max = depth[j, i]
-    t = tile_index(grid, i / tile_pixels, j / tile_pixels)
-    start = tile_start[t]
+    t = tile_index(bins.grid, i / bins.tile_pixels, j / bins.tile_pixels)
+    start = bins.start[t]
     centre = wp.vec2(float(i) + 0.5, float(j) + 0.5)
-    count = tile_count[t]
+    count = bins.count[t]
     boxed = int(0)
     chords = int(0)
     for item in range(count):
-        bc = tile_items[start + item]
-        if outside_box(in_frame(centre, box_axis[bc]), box_lo[bc], box_hi[bc]):
+        bc = bins.items[start + item]
+        if outside_box(in_frame(centre, bins.box_axis[bc]), bins.box_lo[bc], bins.box_hi[bc]):
             continue  # the ray passes outside the beam's hull
         boxed += 1
         b, shift, corners = copy_corners(sb, bc)
@@ -299,29 +286,17 @@ def scan_plane_radiance(
     wp.atomic_add(pairs, 2, chords)
 
 
-@wp.kernel
-def scan_plane_radiance_tiles(
-    grid: TileGrid,
-    tile_start: wp.array[wp.int32],
-    tile_count: wp.array[wp.int32],
-    tile_items: wp.array[wp.int32],
-    tile_pixels: int,
-    cam: PinholeCamera,
-    rays: wp.array2d[wp.vec3],
-    depth: wp.array2d[wp.float32],
-    sb: ShaftBeams,
-    box_axis: wp.array[wp.vec2],
-    box_lo: wp.array[wp.vec2],
-    box_hi: wp.array[wp.vec2],
-    radiance: wp.array3d[wp.float32],
-    pairs: wp.array[wp.int32],
+@wp.func
+def tile_chords(
+    bins: ScreenBins, cam: PinholeCamera, rays: wp.array2d[wp.vec3], depth: wp.array2d[wp.float32],
+    sb: ShaftBeams, tj: int, ti: int, radiance: wp.array3d[wp.float32], pairs: wp.array[wp.int32]
 ):
-    """:func:`scan_plane_radiance` with a thread per tile (the CPU's form, same result to the bit):
-    the tile's list is walked once, not once per pixel, and each beam copy's oriented box is tested
-    at the tile's pixel centres. Every pixel still adds its beams in list order. (Narrowing each
-    copy's rows and per-row pixel spans to the box first cost more than the tests it saved: the
-    pass takes 0.94–0.98× the time without it at 160×120, same shafts.)"""
-    tj, ti = wp.tid()
+    """:func:`pixel_chords` for every pixel of tile (tj, ti) (a thread per tile: the CPU's form,
+    the same result to the bit): the tile's list is walked once, not once per pixel, and each beam
+    copy's oriented box is tested at the tile's pixel centres. Every pixel still adds its beams in
+    list order. (Narrowing each copy's rows and per-row pixel spans to the box first cost more than
+    the tests it saved: the pass takes 0.94–0.98× the time without it at 160×120, same shafts.)"""
+    tile_pixels = bins.tile_pixels
     x0 = ti * tile_pixels
     y0 = tj * tile_pixels
     x1 = wp.min(x0 + tile_pixels, radiance.shape[2])
@@ -331,16 +306,16 @@ def scan_plane_radiance_tiles(
             for k in range(radiance.shape[0]):
                 radiance[k, j, i] = 0.0
     o = cam.position
-    t = tile_index(grid, ti, tj)
-    start = tile_start[t]
-    count = tile_count[t]
+    t = tile_index(bins.grid, ti, tj)
+    start = bins.start[t]
+    count = bins.count[t]
     boxed = int(0)
     chords = int(0)
     for item in range(count):
-        bc = tile_items[start + item]
-        axis = box_axis[bc]
-        lo = box_lo[bc]
-        hi = box_hi[bc]
+        bc = bins.items[start + item]
+        axis = bins.box_axis[bc]
+        lo = bins.box_lo[bc]
+        hi = bins.box_hi[bc]
         b, shift, corners = copy_corners(sb, bc)
         frame = chord_frame(corners, shift, o)
         for j in range(y0, y1):
@@ -355,3 +330,28 @@ def scan_plane_radiance_tiles(
     wp.atomic_add(pairs, 0, count * (x1 - x0) * (y1 - y0))
     wp.atomic_add(pairs, 1, boxed)
     wp.atomic_add(pairs, 2, chords)
+
+
+@wp.kernel
+def scan_plane_radiance(
+    bins: ScreenBins,
+    cam: PinholeCamera,
+    rays: wp.array2d[wp.vec3],
+    depth: wp.array2d[wp.float32],
+    sb: ShaftBeams,
+    per_tile: int,
+    radiance: wp.array3d[wp.float32],
+    pairs: wp.array[wp.int32],
+):
+    """Single-scattered radiance of the beams along each pixel's ray (K, H, W) [W m^-2 sr^-1
+    nm^-1]: the chords (:func:`chord_radiance`) of the beam copies in the pixel's tile list whose
+    oriented box holds the pixel centre. Launched over the pixels (H, W) with ``per_tile = 0``
+    (:func:`pixel_chords`, the GPU's form) or over the screen tiles with ``per_tile = 1``
+    (:func:`tile_chords`, the CPU's; the same result to the bit). ``pairs`` counts (pixel, beam
+    copy) pairs: [0] in the tile lists, [1] inside the oriented box (scan plane computed), [2]
+    with a chord."""
+    j, i = wp.tid()
+    if per_tile == 0:
+        pixel_chords(bins, cam, rays, depth, sb, j, i, radiance, pairs)
+    else:
+        tile_chords(bins, cam, rays, depth, sb, j, i, radiance, pairs)
