@@ -15,6 +15,19 @@ from warpcaustics.errors import WarpcausticsError
 EXIT_USER_ERROR = 2
 
 
+def _device_arg(p: argparse.ArgumentParser, default: str = "") -> None:
+    p.add_argument("--device", metavar="DEVICE", help=f"cpu, cuda, cuda:N or auto{default}")
+
+
+def _set_arg(p: argparse.ArgumentParser, example: str = "") -> None:
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
+                   help=f"override a config key{example} (repeatable)")
+
+
+def _time_arg(p: argparse.ArgumentParser, what: str = "simulation time [s]") -> None:
+    p.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help=what)
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="warpcaustics",
@@ -27,12 +40,9 @@ def _parser() -> argparse.ArgumentParser:
                                    "spectral floor irradiance), frame_NNNN.png (preview), run.json.")
     r.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
     r.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
-    r.add_argument("--device", metavar="DEVICE",
-                   help="cpu, cuda, cuda:N or auto (default: $WARPCAUSTICS_DEVICE, then the config)")
-    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
-                   help="override a config key, e.g. --set sun.elevation_deg=45 (repeatable)")
-    r.add_argument("--time", type=float, default=0.0, metavar="SECONDS",
-                   help="simulation time of the first frame [s] (default 0)")
+    _device_arg(r, " (default: $WARPCAUSTICS_DEVICE, then the config)")
+    _set_arg(r, ", e.g. --set sun.elevation_deg=45")
+    _time_arg(r, "simulation time of the first frame [s] (default 0)")
     r.add_argument("--frames", type=int, default=1, metavar="N", help="number of frames (default 1)")
     r.add_argument("--fps", type=float, default=30.0, metavar="F",
                    help="frames per second of an animation (default 30)")
@@ -43,7 +53,7 @@ def _parser() -> argparse.ArgumentParser:
                                     "of a study TOML; write study.csv, kd.csv and a plot into DIR.")
     st.add_argument("study", metavar="STUDY", help="study TOML, e.g. configs/study.toml")
     st.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    st.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    _device_arg(st)
 
     sw = sub.add_parser("sweep", help="run a parameter sweep (resumable) with a local process pool",
                         description="Render every scene variant × frame of a sweep TOML into "
@@ -57,7 +67,7 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--address", metavar="ADDR",
                     help="with --executor ray: an existing cluster (e.g. auto or ray://host:10001); "
                          "default: a local Ray instance of --workers CPUs")
-    sw.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    _device_arg(sw)
     sw.add_argument("--quiet", action="store_true", help="no progress lines")
 
     pv = sub.add_parser("preview", help="an off-screen 3-D view (PNG) of a scene's frame",
@@ -65,10 +75,9 @@ def _parser() -> argparse.ArgumentParser:
                                     "floor and receivers coloured by irradiance, the water surface above.")
     pv.add_argument("config", metavar="CONFIG", help="TOML scene file")
     pv.add_argument("--out", required=True, metavar="FILE.png", help="the PNG to write")
-    pv.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help="simulation time [s]")
-    pv.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
-    pv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
-                    help="override a config key (repeatable)")
+    _time_arg(pv)
+    _device_arg(pv)
+    _set_arg(pv)
 
     cp = sub.add_parser("compare", help="one frame by every floor-caustics method, side by side",
                         description="Render one frame of CONFIG with each floor-caustics method (flux "
@@ -80,10 +89,9 @@ def _parser() -> argparse.ArgumentParser:
     cp.add_argument("--methods", default=",".join(FLOOR_METHODS), metavar="LIST",
                     help=f"comma-separated methods (default {','.join(FLOOR_METHODS)}; fluxratio, the "
                          "reference, is always included)")
-    cp.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help="simulation time [s]")
-    cp.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
-    cp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
-                    help="override a config key (repeatable)")
+    _time_arg(cp)
+    _device_arg(cp)
+    _set_arg(cp)
 
     rp = sub.add_parser("report", help="print a sweep's summary table and plot it",
                         description="Print DIR/summary.csv and write DIR/summary.png.")
@@ -100,7 +108,7 @@ def _parser() -> argparse.ArgumentParser:
                     help="comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); default both")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
-    fd.add_argument("--device", metavar="DEVICE", help="cpu, cuda, cuda:N or auto")
+    _device_arg(fd)
     fd.add_argument("--quick", action="store_true",
                     help="a coarse run of three points, to check the command (not a comparison)")
     fd.add_argument("--quiet", action="store_true", help="no progress lines")

@@ -172,43 +172,35 @@ def triangle_flux(
             entering_m2[g, iy, ix, half] = a_perp * mean_t0
 
 
+@wp.struct
+class TriangleDeposit:
+    """Where one surface triangle (iy, ix, half)'s flux goes: its flux ``flux_w_nm[iy, ix, half, k]``
+    for the bands ``k_begin`` … ``k_begin + k_count − 1`` of its index group, added to
+    ``floor_texels`` (M, M, K)."""
+
+    floor_texels: wp.array3d[wp.float32]
+    flux_w_nm: wp.array4d[wp.float32]
+    k_begin: int
+    k_count: int
+    iy: int
+    ix: int
+    half: int
+
+
 @wp.func
-def add_to_texel(
-    floor_texels: wp.array3d[wp.float32],
-    flux_w_nm: wp.array4d[wp.float32],
-    k_begin: int,
-    k_count: int,
-    iy: int,
-    ix: int,
-    half: int,
-    tx: int,
-    ty: int,
-    weight: float,
-):
+def add_to_texel(dep: TriangleDeposit, tx: int, ty: int, weight: float):
     """Add ``weight`` × the triangle's flux to texel (ty, tx) of each wavelength of its group
     (nothing for a texel index of −1: light that left a walled map)."""
     if tx < 0 or ty < 0:
         return
-    for j in range(k_count):
-        k = k_begin + j
-        wp.atomic_add(floor_texels, ty, tx, k, weight * flux_w_nm[iy, ix, half, k])
+    for j in range(dep.k_count):
+        k = dep.k_begin + j
+        wp.atomic_add(dep.floor_texels, ty, tx, k, weight * dep.flux_w_nm[dep.iy, dep.ix, dep.half, k])
 
 
 @wp.func
 def deposit_by_samples(
-    floor_texels: wp.array3d[wp.float32],
-    flux_w_nm: wp.array4d[wp.float32],
-    k_begin: int,
-    k_count: int,
-    iy: int,
-    ix: int,
-    half: int,
-    q0: wp.vec2,
-    e1: wp.vec2,
-    e2: wp.vec2,
-    m: int,
-    periodic: int,
-    inv_texel_area: float,
+    dep: TriangleDeposit, q0: wp.vec2, e1: wp.vec2, e2: wp.vec2, m: int, periodic: int, inv_texel_area: float
 ):
     """Deposit a footprint (q0, q0 + e1, q0 + e2) [texels] through the centroids of its
     SAMPLE_SUBDIVISIONS² congruent sub-triangles, each carrying an equal share of the flux."""
@@ -221,8 +213,7 @@ def deposit_by_samples(
                     continue  # the last row has no downward sub-triangle
                 off = 1.0 / 3.0 + float(flip) / 3.0
                 p = q0 + ((float(a) + off) / float(s)) * e1 + ((float(b) + off) / float(s)) * e2
-                add_to_texel(floor_texels, flux_w_nm, k_begin, k_count, iy, ix, half,
-                             texel_of(p[0], m, periodic), texel_of(p[1], m, periodic), weight)
+                add_to_texel(dep, texel_of(p[0], m, periodic), texel_of(p[1], m, periodic), weight)
 
 
 @wp.struct
@@ -269,6 +260,14 @@ def deposit_footprints(
         group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
     if group_flux <= 0.0:
         return  # facing away from the sun, fully reflected or fully absorbed: nothing to spread
+    dep = TriangleDeposit()
+    dep.floor_texels = floor_texels
+    dep.flux_w_nm = flux_w_nm
+    dep.k_begin = k_begin
+    dep.k_count = wavelengths_per_group
+    dep.iy = iy
+    dep.ix = ix
+    dep.half = half
     x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
     x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
     x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
@@ -305,8 +304,7 @@ def deposit_footprints(
     if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(floor_map.max_clipped):
         # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
         wp.atomic_add(coarse_count, 0, 1)
-        deposit_by_samples(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
-                           q0, e1, e2, m, wrap, inv_texel_area)
+        deposit_by_samples(dep, q0, e1, e2, m, wrap, inv_texel_area)
         return
     i_lo = int(u_lo)
     j_lo = int(v_lo)
@@ -322,8 +320,7 @@ def deposit_footprints(
         c = (q0 + q1 + q2) / 3.0
         tx = texel(i_lo + int(wp.floor(c[0])), m, wrap)
         ty = texel(j_lo + int(wp.floor(c[1])), m, wrap)
-        add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix, half,
-                     tx, ty, inv_texel_area)
+        add_to_texel(dep, tx, ty, inv_texel_area)
         return
     px = vec8()
     py = vec8()
@@ -347,8 +344,7 @@ def deposit_footprints(
             rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
             if rn >= 3:
                 w = polygon_area(rx, ry, rn) / area * inv_texel_area
-                add_to_texel(floor_texels, flux_w_nm, k_begin, wavelengths_per_group, iy, ix,
-                             half, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
+                add_to_texel(dep, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
 
 
 @wp.kernel

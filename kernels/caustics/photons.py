@@ -266,19 +266,34 @@ def trace_photons(
         face[i] = f
 
 
+@wp.struct
+class Photons:
+    """A pass's traced photons as the deposit and the camera read them: each photon's ``origin`` on
+    the surface, ``direction``, ``hit`` and receiver ``face`` (−1: none) and flux weight A⊥·T
+    [m²]; ``photons_per_group`` per index group, each group ``wavelengths_per_group`` bands of
+    ``sun_irradiance`` and ``attenuation_per_m``; the emission lattice (``quads`` per side,
+    ``subdivisions``² photons a quad) on the patch ``extent_m`` (``periodic``: the sea repeats),
+    and the receivers' first ``floor_face_count`` faces being the floor's."""
+
+    hit: wp.array[wp.vec3]
+    face: wp.array[wp.int32]
+    origin: wp.array[wp.vec3]
+    direction: wp.array[wp.vec3]
+    weight: wp.array[wp.float32]
+    photons_per_group: int
+    wavelengths_per_group: int
+    sun_irradiance: wp.array[wp.float32]
+    attenuation_per_m: wp.array[wp.float32]
+    quads: int
+    subdivisions: int
+    extent_m: float
+    periodic: int
+    floor_face_count: int
+
+
 @wp.kernel
 def deposit_photons(
-    hit: wp.array[wp.vec3],
-    face: wp.array[wp.int32],
-    origin: wp.array[wp.vec3],
-    weight: wp.array[wp.float32],
-    photons_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    wavelengths_per_group: int,
-    floor_face_count: int,
-    extent_m: float,
-    periodic: int,
+    ph: Photons,
     floor_inv_area: wp.array2d[wp.float32],
     floor_texels: wp.array3d[wp.float32],
     face_flux: wp.array2d[wp.float32],
@@ -286,32 +301,33 @@ def deposit_photons(
     """Add photon i's flux to the floor map texel under its hit (divided by that texel's true
     floor area: irradiance) or, for other receivers, to its face's flux (F_other, K) [W nm^-1]."""
     i = wp.tid()
-    f = face[i]
+    f = ph.face[i]
     if f < 0:
         return
-    g = i / photons_per_group
-    p = hit[i]
-    ell = wp.length(p - origin[i])
-    w = weight[i]
-    k0 = g * wavelengths_per_group
-    if f < floor_face_count:
+    g = i / ph.photons_per_group
+    p = ph.hit[i]
+    ell = wp.length(p - ph.origin[i])
+    w = ph.weight[i]
+    k0 = g * ph.wavelengths_per_group
+    extent_m = ph.extent_m
+    if f < ph.floor_face_count:
         m = floor_texels.shape[0]
-        tx = texel_of((p[0] + 0.5 * extent_m) * float(m) / extent_m, m, periodic)
-        ty = texel_of((p[1] + 0.5 * extent_m) * float(m) / extent_m, m, periodic)
+        tx = texel_of((p[0] + 0.5 * extent_m) * float(m) / extent_m, m, ph.periodic)
+        ty = texel_of((p[1] + 0.5 * extent_m) * float(m) / extent_m, m, ph.periodic)
         if tx < 0 or ty < 0:
             return
         scale = w * floor_inv_area[ty, tx]
-        for j in range(wavelengths_per_group):
+        for j in range(ph.wavelengths_per_group):
             k = k0 + j
             wp.atomic_add(
-                floor_texels, ty, tx, k, scale * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell)
+                floor_texels, ty, tx, k, scale * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
             )
     else:
-        for j in range(wavelengths_per_group):
+        for j in range(ph.wavelengths_per_group):
             k = k0 + j
             wp.atomic_add(
                 face_flux,
-                f - floor_face_count,
+                f - ph.floor_face_count,
                 k,
-                w * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell),
+                w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell),
             )

@@ -213,24 +213,10 @@ class PhotonCaustics(PassCaustics):
         )
         self.texels.zero_()
         self.face_flux.zero_()
-        k = self.sun_irradiance.shape[0]
         wp.launch(
             photon_kernels.deposit_photons,
             dim=self.weight.shape[0],
-            inputs=[
-                self.hit,
-                self.face,
-                self.origin,
-                self.weight,
-                self.photons_per_group,
-                self.sun_irradiance,
-                self.attenuation_per_m,
-                k // self.groups,
-                self.receivers.floor_face_count,
-                extent,
-                int(self.periodic),
-                self.floor_inv_area,
-            ],
+            inputs=[self.traced(), self.floor_inv_area],
             outputs=[self.texels, self.face_flux],
             device=dev,
         )
@@ -243,6 +229,17 @@ class PhotonCaustics(PassCaustics):
             device=dev,
         )
         return self.irradiance
+
+    def traced(self) -> photon_kernels.Photons:
+        """The photons of the pass being traced as the deposit and the camera read them."""
+        ph = photon_kernels.Photons()
+        for name in ("hit", "face", "origin", "direction", "weight", "photons_per_group", "sun_irradiance",
+                     "attenuation_per_m", "quads", "subdivisions"):
+            setattr(ph, name, getattr(self, name))
+        ph.wavelengths_per_group = self.sun_irradiance.shape[0] // self.groups
+        ph.extent_m, ph.periodic = float(self.cfg.water.extent_m), int(self.periodic)
+        ph.floor_face_count = self.receivers.floor_face_count
+        return ph
 
     def _render_camera(self, camera, shafts: bool) -> None:
         """Splat this pass's photons into ``camera``'s image, each over its lattice cell."""

@@ -21,13 +21,8 @@ def _check_consistency(cfg: Config) -> None:
     if w.max_nm <= w.min_nm:
         raise ConfigError(f"optics.wavelengths.max_nm = {w.max_nm} must exceed "
                           f"optics.wavelengths.min_nm = {w.min_nm}")
-    if cfg.water.model is WaterModel.HEIGHTFIELD and not cfg.water.file:
-        raise ConfigError("water.file is missing; water.model = 'heightfield' needs a .npy file of "
-                          "heights (set water.file = \"path.npy\")")
-    if cfg.water.model is not WaterModel.HEIGHTFIELD and cfg.water.file:
-        raise ConfigError(f"water.file = {cfg.water.file!r} is only read by water.model = "
-                          f"'heightfield' (model is {cfg.water.model.value!r}); remove it or change the "
-                          "model")
+    _check_file_key("water.file", cfg.water.file, "water.model", cfg.water.model, WaterModel.HEIGHTFIELD,
+                     "heights", "path.npy")
     if cfg.sun.spectrum is SunSpectrum.FILE and not cfg.sun.file:
         raise ConfigError("sun.file is missing; sun.spectrum = 'file' needs a CSV of wavelength [nm], "
                           "irradiance (set sun.file = \"sun.csv\")")
@@ -36,6 +31,18 @@ def _check_consistency(cfg: Config) -> None:
     if cfg.water.model is WaterModel.FFT and n is not None and (n & (n - 1)):
         raise ConfigError(f"water.resolution = {n} must be a power of two for water.model = 'fft' "
                           f"(e.g. {1 << max(2, round(math.log2(n)))})")
+
+
+def _check_file_key(key: str, file: str | None, selector: str, selected, reader, what: str,
+                    example: str) -> None:
+    """A file key is set exactly when its selector (``selector`` = ``selected``) is the value that
+    reads it (``reader``)."""
+    if selected is reader and not file:
+        raise ConfigError(f"{key} is missing; {selector} = {reader.value!r} needs a .npy file of {what} "
+                          f"(set {key} = \"{example}\")")
+    if selected is not reader and file:
+        raise ConfigError(f"{key} = {file!r} is only read by {selector} = {reader.value!r} (it is "
+                          f"{selected.value!r}); remove it or set {selector} = \"{reader.value}\"")
 
 
 def _check_vector(key: str, value: tuple[float, ...], lengths: tuple[int, ...]) -> None:
@@ -214,12 +221,8 @@ def _check_photon_scene(cfg: Config) -> None:
         raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" or \"beams\" "
                           f"(the method is "
                           f"{cfg.caustics.method.value!r})")
-    if cfg.floor.shape is FloorShape.FILE and not cfg.floor.file:
-        raise ConfigError("floor.file is missing; floor.shape = 'file' needs a .npy file of floor relief "
-                          "(set floor.file = \"floor.npy\")")
-    if cfg.floor.shape is not FloorShape.FILE and cfg.floor.file:
-        raise ConfigError(f"floor.file = {cfg.floor.file!r} is only read by floor.shape = 'file'; remove "
-                          "it or set floor.shape = \"file\"")
+    _check_file_key("floor.file", cfg.floor.file, "floor.shape", cfg.floor.shape, FloorShape.FILE,
+                     "floor relief", "floor.npy")
     _check_periodic_floor(cfg)
     _check_vector("floor.albedo", cfg.floor.albedo, (1, 3))
     for i, r in enumerate(cfg.receivers):

@@ -117,31 +117,19 @@ class UnderwaterCamera:
         return float(self.cfg.position_m[2])
 
     def render(self, photons: PhotonCaustics, photon_spacing_m: float, shafts: bool) -> wp.array3d:
-        """Splat ``photons``' last frame into the camera, add their shafts, shade: (K, H, W)
+        """Splat the photons of ``photons``' pass into the camera, add their shafts, shade: (K, H, W)
         radiance [W m^-2 sr^-1 nm^-1]."""
         dev = self.device
         k = photons.sun_irradiance.shape[0]
-        per_group = k // photons.groups
         count = photons.weight.shape[0]
+        traced = photons.traced()
         self.caustic.zero_()
         wp.launch(
             camera_kernels.splat_photons,
             dim=(count, 9),
             inputs=[
                 self.cam,
-                photons.hit,
-                photons.face,
-                photons.origin,
-                photons.weight,
-                photons.photons_per_group,
-                photons.sun_irradiance,
-                photons.attenuation_per_m,
-                per_group,
-                photons.quads,
-                photons.subdivisions,
-                int(photons.periodic),
-                float(photons.cfg.water.extent_m),
-                self.receivers.floor_face_count,
+                traced,
                 float(photon_spacing_m),
                 self.receivers.face_receiver,
                 self.receivers.face_normal,
@@ -165,21 +153,10 @@ class UnderwaterCamera:
                 dim=(count // stride, 9),
                 inputs=[
                     self.cam,
-                    photons.hit,
-                    photons.face,
-                    photons.origin,
-                    photons.direction,
-                    photons.weight,
+                    traced,
                     stride,
                     float(photon_spacing_m * photons.subdivisions),
-                    int(photons.periodic),
-                    float(photons.cfg.water.extent_m),
-                    self.receivers.floor_face_count,
-                    photons.photons_per_group,
-                    photons.sun_irradiance,
-                    photons.attenuation_per_m,
                     self.scattering_per_m,
-                    per_group,
                     ph.kind,
                     ph.g,
                     ph.angles_rad,
@@ -204,7 +181,7 @@ class UnderwaterCamera:
         return self._shade(photons.attenuation_per_m)
 
     def render_beams(self, beams, shafts: bool) -> wp.array3d:
-        """Light the receivers the camera sees by ``beams``' last frame (point-in-beam on the
+        """Light the receivers the camera sees by the beams of ``beams``' pass (point-in-beam on the
         G-buffer), add the scan-plane volume caustics, shade: (K, H, W) radiance."""
         from warpcaustics.caustics.beams import SCREEN_TILE_PIXELS, TileBins
         from warpcaustics.kernels.caustics import beams as beam_kernels

@@ -4,6 +4,7 @@ pixel pyramid, the pyramid collapsed, and a 3×3 blur.
 
 import warp as wp
 
+from warpcaustics.kernels.caustics.photons import Photons
 from warpcaustics.kernels.optics.phase import phase_value
 from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera, pixel_solid_angle, project
 
@@ -34,21 +35,10 @@ def level_offset(width: int, height: int, level: int) -> int:
 @wp.kernel
 def shaft_lines(
     cam: PinholeCamera,
-    hit: wp.array[wp.vec3],
-    face: wp.array[wp.int32],
-    origin: wp.array[wp.vec3],
-    direction: wp.array[wp.vec3],
-    weight: wp.array[wp.float32],
+    ph: Photons,
     stride: int,
     tube_width_m: float,
-    periodic: int,
-    extent_m: float,
-    floor_face_count: int,
-    photons_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
     scattering_per_m: wp.array[wp.float32],
-    wavelengths_per_group: int,
     phase_kind: int,
     hg_g: float,
     angles_rad: wp.array[wp.float32],
@@ -73,15 +63,16 @@ def shaft_lines(
     """
     t, copy = wp.tid()
     p = t * stride
-    f = face[p]
+    f = ph.face[p]
     if f < 0:
         return
-    if copy != 4 and (periodic == 0 or f >= floor_face_count):
+    if copy != 4 and (ph.periodic == 0 or f >= ph.floor_face_count):
         return
+    extent_m = ph.extent_m
     shift = wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
-    o = origin[p] + shift
-    x1 = hit[p] + shift
-    d = direction[p]
+    o = ph.origin[p] + shift
+    x1 = ph.hit[p] + shift
+    d = ph.direction[p]
     length = wp.length(x1 - o)
     a = project(cam, o)
     b = project(cam, x1)
@@ -99,8 +90,8 @@ def shaft_lines(
         pixels = wp.length(wp.vec2(b[0] - a[0], b[1] - a[1]))
     steps = wp.clamp(int(wp.ceil(2.0 * pixels)) + 1, 1, MAX_SHAFT_STEPS)
     dl = length / float(steps)
-    g = p / photons_per_group
-    w = weight[p] * float(stride) * dl
+    g = p / ph.photons_per_group
+    w = ph.weight[p] * float(stride) * dl
     angle = 2.0 * cam.tan_half_fov / float(cam.height)
     for step in range(steps):
         ell = (float(step) + 0.5) * dl
@@ -125,16 +116,16 @@ def shaft_lines(
                     + (j >> level) * level_size(cam.width, level)
                     + (i >> level)
                 )
-                for jj in range(wavelengths_per_group):
-                    k = g * wavelengths_per_group + jj
+                for jj in range(ph.wavelengths_per_group):
+                    k = g * ph.wavelengths_per_group + jj
                     wp.atomic_add(
                         pyramid,
                         k,
                         index,
                         geometry
-                        * sun_irradiance[k]
+                        * ph.sun_irradiance[k]
                         * scattering_per_m[k]
-                        * wp.exp(-attenuation_per_m[k] * (ell + s)),
+                        * wp.exp(-ph.attenuation_per_m[k] * (ell + s)),
                     )
 
 

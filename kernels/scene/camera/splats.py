@@ -4,6 +4,7 @@ lattice cell on its receiver, or a Gaussian where it has none.
 
 import warp as wp
 
+from warpcaustics.kernels.caustics.photons import Photons
 from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera, project
 
 wp.set_module_options({"enable_backward": False})
@@ -144,39 +145,20 @@ def photon_lattice(
 
 @wp.func
 def add_flux(
-    caustic: wp.array3d[wp.float32],
-    j: int,
-    i: int,
-    irradiance: float,
-    g: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    ell: float,
+    caustic: wp.array3d[wp.float32], j: int, i: int, irradiance: float, ph: Photons, g: int, ell: float
 ):
     """Add ``irradiance`` (per unit E_sun) × E_sun(λ) e^{-c(λ) ℓ} to pixel (j, i) in each band of
     group g."""
-    for jj in range(wavelengths_per_group):
-        k = g * wavelengths_per_group + jj
-        wp.atomic_add(caustic, k, j, i, irradiance * sun_irradiance[k] * wp.exp(-attenuation_per_m[k] * ell))
+    for jj in range(ph.wavelengths_per_group):
+        k = g * ph.wavelengths_per_group + jj
+        attenuation = wp.exp(-ph.attenuation_per_m[k] * ell)
+        wp.atomic_add(caustic, k, j, i, irradiance * ph.sun_irradiance[k] * attenuation)
 
 
 @wp.kernel
 def splat_photons(
     cam: PinholeCamera,
-    hit: wp.array[wp.vec3],
-    face: wp.array[wp.int32],
-    origin: wp.array[wp.vec3],
-    weight: wp.array[wp.float32],
-    photons_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
-    wavelengths_per_group: int,
-    quads: int,
-    subdivisions: int,
-    periodic: int,
-    extent_m: float,
-    floor_face_count: int,
+    ph: Photons,
     photon_spacing_m: float,
     face_receiver: wp.array[wp.int32],
     face_normal: wp.array[wp.vec3],
@@ -210,22 +192,24 @@ def splat_photons(
     of the neighbouring tiles), so the floor around the patch is lit and the patch edge does not
     show; the depth test drops copies that are not on the floor the camera sees."""
     p, copy = wp.tid()
-    f = face[p]
+    f = ph.face[p]
     if f < 0:
         return
-    if copy != 4 and (periodic == 0 or f >= floor_face_count):
+    extent_m = ph.extent_m
+    if copy != 4 and (ph.periodic == 0 or f >= ph.floor_face_count):
         return
-    x = hit[p] + wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
+    x = ph.hit[p] + wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
     c = project(cam, x)
-    ell = wp.length(hit[p] - origin[p])  # the copy's path is the photon's own
-    g = p / photons_per_group
-    w = weight[p]
+    ell = wp.length(ph.hit[p] - ph.origin[p])  # the copy's path is the photon's own
+    g = p / ph.photons_per_group
+    w = ph.weight[p]
     eu, ev, ok = photon_lattice(
-        hit, face, face_receiver, face_normal, p, quads, subdivisions, periodic, extent_m, photon_spacing_m
+        ph.hit, ph.face, face_receiver, face_normal, p, ph.quads, ph.subdivisions, ph.periodic, extent_m,
+        photon_spacing_m,
     )
     if ok != 0:
         n_lit = face_normal[f]  # the face's normal on the side the photon came from
-        if wp.dot(n_lit, origin[p] - hit[p]) < 0.0:
+        if wp.dot(n_lit, ph.origin[p] - ph.hit[p]) < 0.0:
             n_lit = -n_lit
         splat_tent(
             cam,
@@ -238,10 +222,8 @@ def splat_photons(
             normal,
             receiver,
             w,
+            ph,
             g,
-            wavelengths_per_group,
-            sun_irradiance,
-            attenuation_per_m,
             ell,
             caustic,
         )
@@ -254,10 +236,8 @@ def splat_photons(
         depth_tolerance,
         inv_footprint,
         w,
+        ph,
         g,
-        wavelengths_per_group,
-        sun_irradiance,
-        attenuation_per_m,
         ell,
         caustic,
     )
@@ -287,10 +267,8 @@ def splat_tent(
     normal: wp.array2d[wp.vec3],
     receiver: wp.array2d[wp.int32],
     w: float,
+    ph: Photons,
     g: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
     ell: float,
     caustic: wp.array3d[wp.float32],
 ):
@@ -352,17 +330,7 @@ def splat_tent(
                     beta = (a * pv - b * pu) / det
                     hat = wp.max(1.0 - wp.abs(alpha), 0.0) * wp.max(1.0 - wp.abs(beta), 0.0)
                     if hat > 0.0:
-                        add_flux(
-                            caustic,
-                            j,
-                            i,
-                            w * hat / area,
-                            g,
-                            wavelengths_per_group,
-                            sun_irradiance,
-                            attenuation_per_m,
-                            ell,
-                        )
+                        add_flux(caustic, j, i, w * hat / area, ph, g, ell)
 
 
 @wp.func
@@ -374,10 +342,8 @@ def splat_gaussian(
     depth_tolerance: float,
     inv_footprint: wp.array2d[wp.float32],
     w: float,
+    ph: Photons,
     g: int,
-    wavelengths_per_group: int,
-    sun_irradiance: wp.array[wp.float32],
-    attenuation_per_m: wp.array[wp.float32],
     ell: float,
     caustic: wp.array3d[wp.float32],
 ):
@@ -403,17 +369,7 @@ def splat_gaussian(
         for di in range(-r, r + 1):
             g_q = gaussian_on_surface(cam, depth, depth_slack, depth_tolerance, c, ci + di, cj + dj)
             if g_q > 0.0:
-                add_flux(
-                    caustic,
-                    cj + dj,
-                    ci + di,
-                    w * g_q / total,
-                    g,
-                    wavelengths_per_group,
-                    sun_irradiance,
-                    attenuation_per_m,
-                    ell,
-                )
+                add_flux(caustic, cj + dj, ci + di, w * g_q / total, ph, g, ell)
 
 
 @wp.func
