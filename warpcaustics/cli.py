@@ -146,13 +146,16 @@ def _render(args: argparse.Namespace) -> int:
     results = []
     from warpcaustics.batch.sweep import Progress
 
+    # run.json marks a complete run: an earlier run's must not stand beside this run's frames
+    (out / "run.json").unlink(missing_ok=True)
     progress = Progress(args.frames, args.quiet, unit="frame")
     try:
         for frame in range(args.frames):
             t0 = time.perf_counter()
             result = renderer.render(args.time + frame / args.fps)
             try:
-                save_frame(result, out, frame=frame)
+                with renderer.memory_errors():
+                    save_frame(result, out, frame=frame)
             except OSError as exc:
                 raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
                                         f"{exc.strerror or exc}") from None

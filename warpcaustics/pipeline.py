@@ -15,7 +15,7 @@ import warp as wp
 
 from warpcaustics import device as devices
 from warpcaustics.caustics.registry import METHODS
-from warpcaustics.caustics.stage import Frame, Lighting, Stopwatch, sky_bytes
+from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch, sky_bytes
 from warpcaustics.config import Scattering
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.optics import spectra
@@ -45,6 +45,25 @@ def scene_bytes(scene: Scene, device: str = "cuda") -> int:
     return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, n, keeps_sky_shading(cfg))
 
 
+HOST_BYTES_PER_PIXEL = 200
+"""Host memory post-processing takes per floor texel or camera pixel whatever the bands [bytes]: the
+float64 XYZ and RGB planes of the colour conversion and the writers' buffers (tracemalloc's peak of
+render + save_frame at M = 1024 with 4 and 16 bins: 195 + 4 K bytes a texel, docs/benchmarks.md)."""
+
+HOST_BYTES_PER_BAND = 28
+"""Host memory per texel or pixel and band [bytes]: the float64 read-backs a method sums its light
+passes in (24; photons at K = 8 peaked at 24 K) and the float32 result (4)."""
+
+
+def host_bytes(scene: Scene) -> int:
+    """Host memory one frame's read-back and post-processing need at their peak [bytes]."""
+    cfg = scene.config
+    k = len(spectra.bins_for(cfg.optics).centres_nm)
+    camera = cfg.camera.width * cfg.camera.height if cfg.camera.enabled else 0
+    pixels = cfg.caustics.map_resolution**2 + camera
+    return pixels * (HOST_BYTES_PER_PIXEL + HOST_BYTES_PER_BAND * k)
+
+
 class Renderer:
     """Renders frames of one scene on one device; holds the water model, the light and the caustic
     method's buffers.
@@ -58,8 +77,14 @@ class Renderer:
         self.scene = scene
         self.device = devices.resolve_device(device, config_value=cfg.device.value)
         self.bytes_needed = scene_bytes(scene, self.device)
+        self.host_bytes = host_bytes(scene)
+        """Host memory of a frame's read-back and post-processing [bytes] (on the CPU device as well)."""
         self.memory_fix = memory_fix(cfg)
-        devices.check_fits(self.device, self.bytes_needed, self.memory_fix)
+        if wp.get_device(self.device).is_cpu:
+            devices.check_fits(self.device, self.bytes_needed + self.host_bytes, self.memory_fix)
+        else:
+            devices.check_fits(self.device, self.bytes_needed, self.memory_fix)
+            devices.check_fits("cpu", self.host_bytes, self.memory_fix)
         with _memory_errors(self.device, self.bytes_needed, self.memory_fix):
             self.water = make_water(cfg, self.device, scene.heights, scene.floor_relief)
             n = scene.water_resolution
@@ -87,8 +112,13 @@ class Renderer:
         """Render the floor caustics at ``time_s`` [s]."""
         if not math.isfinite(time_s):
             raise WarpcausticsError(f"time_s = {time_s} is not a finite number of seconds")
-        with _memory_errors(self.device, self.bytes_needed, self.memory_fix):
+        with self.memory_errors():
             return self._render(float(time_s))
+
+    def memory_errors(self):
+        """A context in which a failed allocation — Warp's on the device, numpy's on the host (the
+        read-backs, the colour conversion, the writers) — becomes one line that states the need."""
+        return _memory_errors(self.device, self.bytes_needed + self.host_bytes, self.memory_fix)
 
     def _render(self, time_s: float) -> RenderResult:
         cfg = self.scene.config
@@ -108,6 +138,7 @@ class Renderer:
                       watch=watch)
         self.method.check_frame(frame)
         out = self.method.render(frame)
+        check_finite(out, time_s)
         with watch.stage("surface_readback"):
             positions = surface.positions.numpy()
             normals = surface.normals.numpy()
@@ -127,6 +158,25 @@ class Renderer:
         return result(out)
 
 
+FINITE_FIELDS = ("floor", "transmitted", "camera_radiance", "sky_floor_irradiance", "face_flux_w_nm")
+"""What a frame must hold as finite numbers: its floor map, flux, camera image, sky map, face flux."""
+
+
+def check_finite(out: StageOutput, time_s: float) -> None:
+    """Refuse a frame whose maps or images hold NaN or inf (a scene beyond what float32 resolves),
+    so that no such file is written and the run is not marked complete."""
+    for stage in (out, out.comparison):
+        if stage is None:
+            continue
+        for name in FINITE_FIELDS:
+            value = getattr(stage, name, None) if name in ("floor", "transmitted") else stage.extra.get(name)
+            if value is not None and not np.all(np.isfinite(value)):
+                raise WarpcausticsError(
+                    f"the {stage.method} {name.replace('_', ' ')} at t = {time_s:g} s is not finite (NaN or "
+                    "inf): the scene's numbers are beyond what the float32 kernels resolve; bring its "
+                    "lengths, depths and angles nearer to those of configs/")
+
+
 _MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelengths.bins"
 
 
@@ -141,6 +191,8 @@ def _memory_errors(device: str, needed: int, fix: str = _MEMORY_FIX):
     """Turn Warp's allocation failures into a one-line DeviceError that states the need."""
     try:
         yield
+    except MemoryError:  # numpy's _ArrayMemoryError among them
+        raise devices.out_of_memory(device, needed, fix) from None
     except RuntimeError as exc:
         text = str(exc).lower()
         if "alloc" in text or "out of memory" in text:

@@ -18,13 +18,14 @@ A sweep TOML names a base scene and the keys to vary::
 
 A task is a scene variant × frame for stateless water, and a whole variant (all its frames, in
 order) for the stateful pools. Its id hashes the resolved config, the frame time(s) and the package
-version, so a rerun recognises finished tasks. Each task renders into ``DIR/.<id>.tmp-<pid>/`` and
+version, so a rerun recognises finished tasks. Each task renders into ``DIR/.<id>.tmp/`` and
 that folder is renamed to ``DIR/<id>/`` only once complete. The driver alone appends to
 ``DIR/manifest.jsonl`` (one JSON object per line, flushed and fsynced): a task whose id is recorded
 as done and whose folder exists is skipped on a rerun; anything else runs again. Leftover
 temporary folders of a killed run are removed at the start. Workers are separate processes (Warp's
 CPU launches run on one core each), and they die with the driver (parent-death signal plus a parent
-check), so a killed sweep leaves nothing writing.
+check), so a killed sweep leaves nothing writing. A sweep removes only the temporary folders of
+its own tasks (their ids), never other entries of ``DIR`` by a pattern.
 
 This module reads and expands sweeps and drives them; ``batch/worker.py`` renders one task,
 ``batch/executors.py`` runs the tasks on a local process pool or on Ray.
@@ -46,6 +47,7 @@ from typing import Any
 
 from warpcaustics import __version__
 from warpcaustics.batch.executors import run_locally, run_on_ray
+from warpcaustics.batch.worker import task_tmp_dir
 from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.io.files import atomic_path, write_csv
@@ -142,6 +144,7 @@ def expand_sweep(
     (``warpcaustics field``)."""
     from warpcaustics.scene import load_scene
 
+    read_toml(base)  # a missing or unreadable base fails the whole sweep (exit 2), not each task
     axes = [[(k, v) for v in values] for k, values in grid.items()]
     if zipped:
         axes.append([tuple(zip(zipped, combo)) for combo in zip(*zipped.values())])
@@ -262,8 +265,8 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     out.mkdir(parents=True, exist_ok=True)
-    for leftover in out.glob(".*.tmp-*"):  # a killed run's half-written tasks
-        shutil.rmtree(leftover, ignore_errors=True)
+    for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
+        shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
     records = read_manifest(out)
     report = SweepReport()
     todo = []

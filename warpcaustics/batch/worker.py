@@ -22,6 +22,12 @@ if TYPE_CHECKING:
     from warpcaustics.batch.sweep import Task
 
 
+def task_tmp_dir(out_dir: str | Path, task_id: str) -> Path:
+    """The one temporary folder a task renders into, ``DIR/.<id>.tmp``: named by the task's id alone,
+    so the sweep that owns the task can remove it after a killed run without touching anything else."""
+    return Path(out_dir) / f".{task_id}.tmp"
+
+
 def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
     """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
     if task.stateful:
@@ -31,7 +37,7 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
 
     t0 = time.perf_counter()
     final = Path(out_dir) / task.id
-    tmp = Path(out_dir) / f".{task.id}.tmp-{os.getpid()}"
+    tmp = task_tmp_dir(out_dir, task.id)
     shutil.rmtree(tmp, ignore_errors=True)
     try:
         renderer = Renderer(load_scene(base, task.overrides), device)

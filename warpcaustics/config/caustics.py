@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _range
+from warpcaustics.config.fields import _coordinate, _length, _range
 
 
 class CausticsMethod(str, enum.Enum):
@@ -52,10 +52,10 @@ class CausticsConfig:
     intensity on the floor); those two also save the flux-ratio map beside theirs."""
     map_resolution: int = field(default=512, metadata=_range(1, 16384))
     """Texels M per side of the floor irradiance map over the water extent (or the window) [-]."""
-    map_extent_m: float = field(default=0.0, metadata=_range(0.0, None))
+    map_extent_m: float = field(default=0.0, metadata=_length())
     """Side of a square floor-map window [m] (``fluxratio``): millimetre texels over a small part
     of a large sea; 0 = the whole water extent."""
-    map_center_m: tuple[float, ...] = (0.0, 0.0)
+    map_center_m: tuple[float, ...] = field(default=(0.0, 0.0), metadata=_coordinate())
     """Centre (x, y) of the floor-map window [m]."""
     intersection: Intersection = Intersection.EXACT
     """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
@@ -75,7 +75,7 @@ class CausticsConfig:
     beam_levels: int = field(default=0, metadata=_range(0, 4))
     """Adaptive beams (Liktor & Dachsbacher 2011 §4.2): start from quads of 2^beam_levels surface
     cells and split where needed down to single cells; 0 = one beam pair per cell (uniform) [-]."""
-    beam_tolerance: float = field(default=0.25, metadata=_range(0.0, None))
+    beam_tolerance: float = field(default=0.25, metadata=_range(0.0, 1.0e3))
     """Split an adaptive quad where a vertex's refracted ray, followed to its receiver, misses the
     quad's interpolated ray by more than this many surface cells [-]."""
     shafts: bool = True
@@ -91,7 +91,7 @@ class CausticsConfig:
     so diffraction blurs the caustics over about √(λ·depth); at most a sixth of the patch [-]."""
     wave3d_periods: float = field(default=4.0, metadata=_range(0.5, 1000.0))
     """Periods of the drive over which u² is averaged into the ``wave3d`` intensity [-]."""
-    wave3d_gain: float = field(default=1.0, metadata=_range(0.0, None, lo_open=True))
+    wave3d_gain: float = field(default=1.0, metadata=_range(0.0, 1.0e6, lo_open=True))
     """a of Mercier's post-process a·I^b of the ``wave3d`` intensity (1, 1: the intensity) [-]."""
     wave3d_exponent: float = field(default=1.0, metadata=_range(0.0, 10.0, lo_open=True))
     """b of Mercier's post-process a·I^b [-]."""

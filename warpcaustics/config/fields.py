@@ -15,6 +15,29 @@ def _range(lo: float | None = None, hi: float | None = None, *, lo_open: bool = 
     return {"range": (lo, hi, lo_open)}
 
 
+MAX_LENGTH_M = 1.0e5
+"""Largest length or coordinate a scene may give [m] (100 km): beyond any patch a float32 surface
+resolves (a 1e30 m patch rendered NaN, issue 31)."""
+
+MAX_TIME_S = 1.0e7
+"""Largest time or period a scene may give [s] (about 116 days)."""
+
+
+def _length(*, lo_open: bool = False) -> dict:
+    """A length [m]: 0 (or above, ``lo_open``) to MAX_LENGTH_M."""
+    return _range(0.0, MAX_LENGTH_M, lo_open=lo_open)
+
+
+def _coordinate() -> dict:
+    """A coordinate [m]: ±MAX_LENGTH_M."""
+    return _range(-MAX_LENGTH_M, MAX_LENGTH_M)
+
+
+def _duration(*, lo_open: bool = False) -> dict:
+    """A time or period [s]: 0 (or above, ``lo_open``) to MAX_TIME_S."""
+    return _range(0.0, MAX_TIME_S, lo_open=lo_open)
+
+
 # Values other issues will add, each with why it is not built yet ("" where that is not known): named
 # so an error can say where they stand instead of "unknown".
 PLANNED_VALUES = {
@@ -25,9 +48,22 @@ PLANNED_VALUES = {
 }
 
 
+DESCRIBE_CHARS = 80
+"""An error quotes at most this many characters of a value (a 10 MB string is not echoed)."""
+
+
 def _describe(value: Any) -> str:
-    return repr(value) if isinstance(value, str) else str(value).lower() if isinstance(value, bool) \
-        else str(value)
+    """A value as an error quotes it (TOML-like), cut to DESCRIBE_CHARS characters."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    try:
+        text = repr(value) if isinstance(value, str) else str(value)
+    except (RecursionError, ValueError):  # nested too deeply; an integer of more than 4300 digits
+        text = ""
+    if text and len(text) <= DESCRIBE_CHARS:
+        return text
+    kind = "a table" if isinstance(value, dict) else "a list" if isinstance(value, list) else "a value"
+    return f"{text[:DESCRIBE_CHARS // 2]}… ({len(text)} characters)" if text else kind
 
 
 def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
@@ -42,6 +78,9 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
         allowed = [m.value for m in tp]
         if isinstance(value, str) and value in allowed:
             return tp(value)
+        if not isinstance(value, str):
+            raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected one of: "
+                              f"{', '.join(allowed)}")
         planned = PLANNED_VALUES.get(key, {})
         if value in planned:
             why = planned[value]

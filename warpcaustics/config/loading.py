@@ -115,11 +115,41 @@ def parse_override(text: str) -> tuple[str, Any]:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except RecursionError:
+        raise ConfigError(f"--set {key}=…: the value nests lists or tables too deeply (at most "
+                          f"{MAX_DEPTH} levels)") from None
+    except ValueError:  # Python reads integers of at most 4300 digits
+        raise ConfigError(f"--set {key}=…: the value is a number of {len(raw)} digits, too long to "
+                          "read; give an ordinary number") from None
+    check_depth(value, f"--set {key}")
     return key, value
+
+
+MAX_DEPTH = 32
+"""Deepest nesting of tables and lists a configuration may hold (the schema needs four)."""
+
+
+def check_depth(value: Any, where: str = "the configuration") -> None:
+    """Refuse tables and lists nested more than MAX_DEPTH deep (walked without recursion, so a
+    pathological input gets a one-line error naming ``where``, not a RecursionError)."""
+    stack = [(value, "", 0)]
+    while stack:
+        node, path, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            under = f" (under {path.split('.')[0]!r})" if path else ""
+            raise ConfigError(f"{where} nests tables or lists more than {MAX_DEPTH} levels deep{under}; "
+                              "the configuration needs at most four (see docs/config.md)")
+        if isinstance(node, dict):
+            stack += [(v, f"{path}.{k}" if path else str(k), depth + 1) for k, v in node.items()]
+        elif isinstance(node, list):
+            stack += [(v, path, depth + 1) for v in node]
 
 
 def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Config:
     """Validate a plain nested dict (as read from TOML) plus dotted overrides into a Config."""
+    check_depth(table)
+    for key, value in (overrides or {}).items():
+        check_depth(value, key)
     table = _deepcopy(table)
     for key, value in (overrides or {}).items():
         _set_dotted(table, key, value)
@@ -172,7 +202,7 @@ def _resolve_sun_position(table: dict, overridden: set[str]) -> None:
     for key, limit in (("latitude_deg", 90.0), ("longitude_deg", 180.0)):
         if isinstance(sun[key], bool) or not isinstance(sun[key], (int, float)):
             raise ConfigError(f"sun.{key} = {_describe(sun[key])} has the wrong type; expected a number")
-        if abs(sun[key]) > limit:
+        if not abs(sun[key]) <= limit:  # NaN too
             raise ConfigError(f"sun.{key} = {sun[key]} is out of range; allowed: -{limit:g} <= value <= "
                               f"{limit:g}")
     if isinstance(sun["datetime"], (datetime.datetime, datetime.date)):
@@ -203,13 +233,22 @@ def read_toml(path: str | Path) -> dict:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ConfigError(f"config file {str(path)!r} does not exist; check the path") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"config file {str(path)!r} cannot be read: {exc}") from None
+        raise ConfigError(f"config file {_describe(str(path))} does not exist; check the path") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ConfigError(f"config file {_describe(str(path))} cannot be read: {reason}") from None
     try:
-        return tomllib.loads(text)
+        table = tomllib.loads(text)
+        check_depth(table, f"config file {_describe(str(path))}")
+        return table
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"config file {str(path)!r} nests tables or lists too deeply (at most "
+                          f"{MAX_DEPTH} levels)") from None
+    except ValueError as exc:  # an integer of more than 4300 digits
+        raise ConfigError(f"config file {str(path)!r} holds a value that cannot be read: "
+                          f"{str(exc).split(';')[0]}") from None
 
 
 def config_to_dict(cfg: Any) -> dict:

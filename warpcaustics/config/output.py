@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _range
+from warpcaustics.config.fields import _coordinate, _range
 
 
 class Colourspace(str, enum.Enum):
@@ -43,9 +43,9 @@ class OutputConfig:
 
 @dataclass(frozen=True)
 class ProbeConfig:
-    x_m: float = 0.0
+    x_m: float = field(default=0.0, metadata=_coordinate())
     """Where the probe sits on the floor, x [m]."""
-    y_m: float = 0.0
+    y_m: float = field(default=0.0, metadata=_coordinate())
     """Where it sits, y [m]."""
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _range
+from warpcaustics.config.fields import _coordinate, _length, _range
 
 
 class FloorShape(str, enum.Enum):
@@ -18,7 +18,7 @@ class FloorShape(str, enum.Enum):
 
 @dataclass(frozen=True)
 class FloorConfig:
-    depth_m: float = field(default=4.0, metadata=_range(0.0, None, lo_open=True))
+    depth_m: float = field(default=4.0, metadata=_length(lo_open=True))
     """Depth of the floor below the water at rest at the origin (floor at z = -depth_m + relief) [m]."""
     shape: FloorShape = FloorShape.FLAT
     """Relief of the floor: ``flat``, ``slope`` (a plane), ``ripples`` (sand ripples, a sine) or
@@ -27,9 +27,9 @@ class FloorConfig:
     """Inclination of the ``slope`` [deg]."""
     slope_azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction in which the ``slope`` descends (gets deeper), from +x towards +y [deg]."""
-    ripple_amplitude_m: float = field(default=0.03, metadata=_range(0.0, None))
+    ripple_amplitude_m: float = field(default=0.03, metadata=_length())
     """Half the crest-to-trough height of the ``ripples`` [m]."""
-    ripple_wavelength_m: float = field(default=0.5, metadata=_range(0.0, None, lo_open=True))
+    ripple_wavelength_m: float = field(default=0.5, metadata=_length(lo_open=True))
     """Crest-to-crest distance of the ``ripples`` [m]."""
     ripple_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction across the ripple crests, from +x towards +y [deg]."""
@@ -49,11 +49,11 @@ class ReceiverConfig:
     mesh: str = "sphere"
     """A triangle mesh: ``sphere``, ``cube``, ``cylinder`` or ``cone`` (pyvista's unit-size
     primitives) or a file (OBJ, PLY, STL, VTK, VTP; relative to the config file's folder)."""
-    scale: tuple[float, ...] = field(default=(1.0,), metadata=_range(0.0, None, lo_open=True))
+    scale: tuple[float, ...] = field(default=(1.0,), metadata=_length(lo_open=True))
     """Scale factor: one value or (sx, sy, sz) [-]; applied first."""
     rotate_deg: tuple[float, ...] = field(default=(0.0, 0.0, 0.0), metadata=_range(-360.0, 360.0))
     """Rotations about x, then y, then z [deg]; applied after scaling."""
-    translate_m: tuple[float, ...] = (0.0, 0.0, -2.0)
+    translate_m: tuple[float, ...] = field(default=(0.0, 0.0, -2.0), metadata=_coordinate())
     """Translation (x, y, z) [m]; applied last."""
     albedo: tuple[float, ...] = field(default=(0.7, 0.7, 0.7), metadata=_range(0.0, 1.0))
     """Diffuse albedo: one value (grey) or three (linear sRGB, as for the floor) [-]."""
@@ -66,11 +66,11 @@ class CameraConfig:
     enabled: bool = False
     """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``); the camera is
     under water."""
-    position_m: tuple[float, ...] = (0.0, -6.0, -1.0)
+    position_m: tuple[float, ...] = field(default=(0.0, -6.0, -1.0), metadata=_coordinate())
     """Pinhole position (x, y, z) [m]; must be below the water surface."""
-    look_at_m: tuple[float, ...] = (0.0, 0.0, -3.0)
+    look_at_m: tuple[float, ...] = field(default=(0.0, 0.0, -3.0), metadata=_coordinate())
     """Point the camera looks at (x, y, z) [m]."""
-    up: tuple[float, ...] = (0.0, 0.0, 1.0)
+    up: tuple[float, ...] = field(default=(0.0, 0.0, 1.0), metadata=_coordinate())
     """Up direction of the image (x, y, z) [-]."""
     fov_deg: float = field(default=60.0, metadata=_range(1.0, 170.0))
     """Vertical field of view [deg]."""

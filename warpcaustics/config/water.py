@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _range
+from warpcaustics.config.fields import _coordinate, _duration, _length, _range
 
 
 class WaterModel(str, enum.Enum):
@@ -24,13 +24,13 @@ class WaterSpectrum(str, enum.Enum):
 
 @dataclass(frozen=True)
 class DropConfig:
-    time_s: float = field(default=0.0, metadata=_range(0.0, None))
+    time_s: float = field(default=0.0, metadata=_duration())
     """When the drop lands [s]."""
-    x_m: float = 0.0
+    x_m: float = field(default=0.0, metadata=_coordinate())
     """Where it lands, x [m] (the pool spans ±extent_m/2)."""
-    y_m: float = 0.0
+    y_m: float = field(default=0.0, metadata=_coordinate())
     """Where it lands, y [m]."""
-    radius_m: float = field(default=0.1, metadata=_range(0.0, None, lo_open=True))
+    radius_m: float = field(default=0.1, metadata=_length(lo_open=True))
     """Gaussian radius (standard deviation) of the added water [m]."""
     height_m: float = field(default=0.05, metadata=_range(-10.0, 10.0))
     """Peak height of the added (or, if negative, removed) water [m]."""
@@ -38,17 +38,17 @@ class DropConfig:
 
 @dataclass(frozen=True)
 class BodyConfig:
-    radius_m: float = field(default=0.0, metadata=_range(0.0, None))
+    radius_m: float = field(default=0.0, metadata=_length())
     """Radius of a disc-shaped body moving through the ``pool`` [m]; 0 = no body."""
-    center_x_m: float = 0.0
+    center_x_m: float = field(default=0.0, metadata=_coordinate())
     """Centre of its circular path, x [m]."""
-    center_y_m: float = 0.0
+    center_y_m: float = field(default=0.0, metadata=_coordinate())
     """Centre of its circular path, y [m]."""
-    path_radius_m: float = field(default=1.0, metadata=_range(0.0, None))
+    path_radius_m: float = field(default=1.0, metadata=_length())
     """Radius of the circular path [m]."""
-    period_s: float = field(default=4.0, metadata=_range(0.0, None, lo_open=True))
+    period_s: float = field(default=4.0, metadata=_duration(lo_open=True))
     """Time for one turn (counter-clockwise seen from above) [s]."""
-    response_s: float = field(default=0.02, metadata=_range(0.0, None, lo_open=True))
+    response_s: float = field(default=0.02, metadata=_duration(lo_open=True))
     """Time over which the water under the body takes on its velocity [s]."""
 
 
@@ -58,7 +58,7 @@ class WaterConfig:
     """Surface model: ``flat``, ``heightfield`` (from ``water.file``), ``fft`` (Tessendorf), the walled
     ``pool`` (shallow water) and ``wavepool`` (wave equation), or ``procedural`` (GPU Gems octave
     waves, an open patch that does not tile)."""
-    extent_m: float = field(default=16.0, metadata=_range(0.0, None, lo_open=True))
+    extent_m: float = field(default=16.0, metadata=_length(lo_open=True))
     """Side L of the square water patch centred at the origin [m]."""
     resolution: int | None = field(default=None, metadata=_range(4, 4096))
     """Vertices per side N (default 256; a heightfield takes N from its file) [-]."""
@@ -73,7 +73,7 @@ class WaterConfig:
     """Direction the wind blows to, from +x towards +y [deg]."""
     phillips_amplitude: float = field(default=1.75e-3, metadata=_range(0.0, 1.0, lo_open=True))
     """Phillips constant A (dimensionless): height variance = A·π·(V²/g)²/2 over all k."""
-    small_wave_m: float = field(default=0.0, metadata=_range(0.0, None))
+    small_wave_m: float = field(default=0.0, metadata=_length())
     """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
     fetch_m: float = field(default=100_000.0, metadata=_range(0.0, 1.0e7, lo_open=True))
     """Distance over which the wind has blown (JONSWAP) [m]."""
@@ -110,7 +110,7 @@ class WaterConfig:
     """S of the ``procedural`` waves (the chapter's SPEED): phase rate [rad/s]."""
     procedural_octaves: int = field(default=4, metadata=_range(1, 16))
     """Number of octaves of the ``procedural`` waves [-]."""
-    procedural_scale_m: float = field(default=0.0, metadata=_range(0.0, None))
+    procedural_scale_m: float = field(default=0.0, metadata=_length())
     """ℓ, one model unit of the chapter's shader in metres [m]; 0 = half of ``extent_m``."""
 
     @property

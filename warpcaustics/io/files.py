@@ -15,6 +15,28 @@ import numpy as np
 from warpcaustics import __version__
 
 
+def input_file(key: str, name: str, base_dir: Path | None, what: str) -> Path:
+    """The file a config key names (a relative path starts at ``base_dir``, the config file's
+    folder), checked to exist; otherwise a one-line ConfigError naming ``key``: a missing file, a
+    folder, a name the file system cannot hold. ``what``: the file it should be ("a .npy array")."""
+    from warpcaustics.config.fields import _describe
+    from warpcaustics.errors import ConfigError
+
+    path = Path(name)
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    try:
+        found = path.is_file()
+    except (OSError, ValueError) as exc:  # a name too long for the file system; a NUL byte
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ConfigError(f"{key} = {_describe(name)} cannot be a file name ({reason}); give the path "
+                          f"of {what}") from None
+    if not found:
+        raise ConfigError(f"{key} = {_describe(name)} does not exist; give the path of {what} (relative "
+                          "paths start at the config file's folder)")
+    return path
+
+
 @contextmanager
 def atomic_path(path: Path):
     """Yield a temporary name beside ``path``; rename it onto ``path`` only if the block succeeds."""

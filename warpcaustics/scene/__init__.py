@@ -98,20 +98,18 @@ def scene_from_config(cfg: Config, base_dir: Path, source: str | None = None) ->
     heights = None
     n = cfg.water.resolution or DEFAULT_RESOLUTION
     if cfg.water.model is WaterModel.HEIGHTFIELD:
-        path = Path(cfg.water.file)
-        heights = load_heights(path if path.is_absolute() else base_dir / path, cfg.water.resolution)
+        heights = load_heights(cfg.water.file, base_dir, cfg.water.resolution)
         n = heights.shape[0]
     cfg = dataclasses.replace(cfg, water=dataclasses.replace(cfg.water, resolution=n))
     _check_spectral_data(cfg, base_dir)
     relief = None
     if cfg.floor.shape is FloorShape.FILE:
-        path = Path(cfg.floor.file)
-        relief = load_floor_relief(path if path.is_absolute() else base_dir / path)
+        relief = load_floor_relief(cfg.floor.file, base_dir)
     meshes = tuple(load_receiver_mesh(r, base_dir, f"receivers[{i}]") for i, r in enumerate(cfg.receivers))
-    if cfg.caustics.method.uses_receivers:
-        from warpcaustics.optics import spectra
+    from warpcaustics.optics import spectra
 
-        receiver_albedos(cfg, spectra.bins_for(cfg.optics), base_dir)  # bad albedo files fail at load
+    # bad albedo files fail at load, whichever method (only the receiver methods shade with them)
+    receiver_albedos(cfg, spectra.bins_for(cfg.optics), base_dir)
     return Scene(cfg, base_dir, heights, source, relief, meshes)
 
 

@@ -7,16 +7,15 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics.errors import ConfigError
+from warpcaustics.io.files import input_file
 
 DEFAULT_RESOLUTION = 256
 """Vertices per side when ``water.resolution`` is not given."""
 
 
-def load_heights(path: Path, resolution: int | None) -> np.ndarray:
+def load_heights(name: str, base_dir: Path, resolution: int | None) -> np.ndarray:
     """Read ``water.file``: a square 2-D array of finite heights [m], ``h[iy, ix]``."""
-    if not path.is_file():
-        raise ConfigError(f"water.file = {str(path)!r} does not exist; give the path of a .npy file "
-                          f"(relative paths start at the config file's folder)")
+    path = input_file("water.file", name, base_dir, "a .npy file of heights")
     try:
         heights = np.load(path, allow_pickle=False)
     except Exception as exc:  # noqa: BLE001 - any unreadable file is the same user error

@@ -8,8 +8,10 @@ the real vertex positions (``wp.Mesh``), so ray queries are exact.
 from __future__ import annotations
 
 import functools
+import logging
 import math
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +20,7 @@ import warp as wp
 
 from warpcaustics.config import Config, FloorConfig, FloorShape, ReceiverConfig
 from warpcaustics.errors import ConfigError
+from warpcaustics.io.files import input_file
 from warpcaustics.optics.spectra import SpectralBins
 
 FLOOR_ID = 0
@@ -69,12 +72,11 @@ def _periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndar
     return (1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1]) + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1])
 
 
-def load_floor_relief(path: Path) -> np.ndarray:
+def load_floor_relief(name: str, base_dir: Path) -> np.ndarray:
     """Read ``floor.file``: a square 2-D float array of relief [m]; one-line errors otherwise."""
+    path = input_file("floor.file", name, base_dir, "a .npy file of floor relief")
     try:
         relief = np.load(path, allow_pickle=False)
-    except FileNotFoundError:
-        raise ConfigError(f"floor.file = {str(path)!r} does not exist; check the path") from None
     except (OSError, ValueError) as exc:
         raise ConfigError(f"floor.file = {str(path)!r} is not a readable .npy array: {exc}") from None
     if relief.ndim != 2 or relief.shape[0] != relief.shape[1] or relief.shape[0] < 2:
@@ -95,6 +97,18 @@ class TriangleMesh:
     triangles: np.ndarray
 
 
+@contextmanager
+def quiet_vtk():
+    """Keep a reader's own log off the terminal (pyvista routes VTK's errors to Python's logging):
+    the one-line error that follows says what went wrong."""
+    previous = logging.root.manager.disable
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(previous)
+
+
 def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> TriangleMesh:
     """Read (or build) a receiver's mesh with pyvista and apply its scale, rotation, translation."""
     with warnings.catch_warnings():
@@ -104,15 +118,11 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
         if receiver.mesh in PRIMITIVES:
             poly = _primitive(receiver.mesh)
         else:
-            path = Path(receiver.mesh)
-            path = path if path.is_absolute() else base_dir / path
-            if not path.is_file():
-                raise ConfigError(
-                    f"{key}.mesh = {receiver.mesh!r} is neither a built-in mesh "
-                    f"({', '.join(PRIMITIVES)}) nor an existing file"
-                )
+            path = input_file(f"{key}.mesh", receiver.mesh, base_dir,
+                              f"a mesh file or a built-in mesh ({', '.join(PRIMITIVES)})")
             try:
-                poly = pv.read(str(path))
+                with quiet_vtk():
+                    poly = pv.read(str(path))
             except Exception as exc:  # pyvista raises many kinds for unreadable files
                 raise ConfigError(
                     f"{key}.mesh = {receiver.mesh!r} cannot be read by pyvista: "
