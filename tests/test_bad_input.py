@@ -237,3 +237,48 @@ def test_a_failed_rerun_does_not_leave_the_earlier_run_json(tmp_path, monkeypatc
     assert cli.main(render_args(tmp_path, "sun.elevation_deg=30")) == 2
     capsys.readouterr()
     assert not (tmp_path / "out" / "run.json").exists()
+
+
+# docs/config.md states every numeric key's range, from the metadata the checks read ---------------
+
+def _numeric_keys() -> dict[str, str]:
+    import dataclasses
+
+    from warpcaustics.config import Config
+    from warpcaustics.config.fields import range_doc
+    from warpcaustics.config.loading import _hints, _is_section, _tuple_item
+
+    out = {}
+
+    def walk(cls, prefix):
+        for f in dataclasses.fields(cls):
+            tp = _hints(cls)[f.name]
+            item = _tuple_item(tp)
+            if item is not None or _is_section(tp):
+                walk(item or tp, f"{prefix}{f.name}.")
+            elif text := range_doc(tp, dict(f.metadata)):
+                out[f"{prefix}{f.name}"] = text
+
+    walk(Config, "")
+    return out
+
+
+def test_docs_give_every_numeric_key_the_range_the_code_checks():
+    import re
+
+    from helpers import ROOT
+
+    rows = {}
+    for line in (ROOT / "docs" / "config.md").read_text(encoding="utf-8").splitlines():
+        m = re.match(r"^\| ((?:`[^`]+`(?:, )?)+) \|([^|]*)\|", line)
+        if m:
+            for key in re.findall(r"`([^`]+)`", m.group(1)):
+                rows[key] = m.group(2).strip()
+    keys = _numeric_keys()
+    assert len(keys) > 80
+    for key, text in keys.items():
+        assert key in rows, f"docs/config.md has no row for {key}"
+        doc = rows[key]
+        if text.startswith("floats"):  # "3 floats −1e5…1e5": the count is the docs' own
+            doc = re.sub(r"^(\d(?: or \d)? floats|list of floats)", "floats", doc)
+        assert doc.startswith(text), f"{key}: docs say {rows[key]!r}, the code checks {text!r}"

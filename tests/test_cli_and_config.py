@@ -125,13 +125,17 @@ def test_python_overrides_and_errors():
 
 
 def test_render_writes_complete_outputs(tmp_path, capsys):
-    """render writes an EXR whose bands are the floor map (image row 0 = largest y), a PNG and run.json."""
+    """render writes an EXR whose bands are the floor map (image row 0 = largest y), a PNG, run.json
+    and the manifest of what it wrote."""
     import OpenEXR
 
     out = tmp_path / "out"
     assert main(["render", str(CONFIGS / "ocean.toml"), *SMALL, "--out", str(out),
                  "--device", "cpu"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["frame_0000.exr", "frame_0000.png", "run.json"]
+    assert sorted(p.name for p in out.iterdir()) == ["frame_0000.exr", "frame_0000.png", "outputs.json",
+                                                     "run.json"]
+    assert json.loads((out / "outputs.json").read_text())["files"] == ["frame_0000.exr", "frame_0000.png",
+                                                                       "run.json"]
     run = json.loads((out / "run.json").read_text())
     assert run["config"]["water"]["resolution"] == 32 and run["device"] == "cpu"
     assert {"warp-lang", "numpy", "warpcaustics"} <= set(run["versions"])

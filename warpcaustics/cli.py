@@ -1,5 +1,5 @@
-"""Command line: ``warpcaustics render | study | sweep | preview | compare | report | info``. User
-errors print one line and exit with 2."""
+"""Command line: ``warpcaustics render | study | sweep | preview | compare | report | field | config |
+info``. User errors print one line and exit with 2."""
 
 from __future__ import annotations
 
@@ -47,6 +47,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--fps", type=float, default=30.0, metavar="F",
                    help="frames per second of an animation (default 30)")
     r.add_argument("--quiet", action="store_true", help="no progress output")
+    r.add_argument("--force", action="store_true",
+                   help="write into a folder holding outputs no earlier run recorded (they are kept)")
 
     st = sub.add_parser("study", help="water-type study: irradiance, contrast and colour vs depth",
                         description="Render a base scene for each water type × depth × sun elevation "
@@ -54,6 +56,7 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("study", metavar="STUDY", help="study TOML, e.g. configs/study.toml")
     st.add_argument("--out", required=True, metavar="DIR", help="output folder")
     _device_arg(st)
+    _set_arg(st, " of the study's scene")
 
     sw = sub.add_parser("sweep", help="run a parameter sweep (resumable) with a local process pool",
                         description="Render every scene variant × frame of a sweep TOML into "
@@ -68,7 +71,9 @@ def _parser() -> argparse.ArgumentParser:
                     help="with --executor ray: an existing cluster (e.g. auto or ray://host:10001); "
                          "default: a local Ray instance of --workers CPUs")
     _device_arg(sw)
+    _set_arg(sw, " for every variant (as the sweep's [set]; its [grid] and [zip] come after)")
     sw.add_argument("--quiet", action="store_true", help="no progress lines")
+    sw.add_argument("--force", action="store_true", help="add this sweep to a folder holding another one")
 
     pv = sub.add_parser("preview", help="an off-screen 3-D view (PNG) of a scene's frame",
                         description="Render one frame of CONFIG and draw it in 3-D with pyvista: the "
@@ -112,17 +117,41 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--quick", action="store_true",
                     help="a coarse run of three points, to check the command (not a comparison)")
     fd.add_argument("--quiet", action="store_true", help="no progress lines")
+    fd.add_argument("--force", action="store_true", help="add this run to a folder holding another one")
+
+    cf = sub.add_parser("config", help="print a scene's resolved configuration (a dry run)",
+                        description="Validate CONFIG with its --set overrides and print every key with "
+                                    "its value as TOML; nothing is rendered or written.")
+    cf.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
+    _set_arg(cf)
 
     sub.add_parser("info", help="versions and the devices Warp sees",
                    description="Print package versions and the compute devices Warp can use.")
     return p
 
 
-def _render(args: argparse.Namespace) -> int:
+def _overrides(args: argparse.Namespace) -> dict:
     from warpcaustics.config import parse_override
+
+    return dict(parse_override(text) for text in args.overrides)
+
+
+def _config(args: argparse.Namespace) -> int:
+    """The resolved configuration as TOML (every key with its value): load_scene's whole validation,
+    the files it names included, and nothing rendered."""
+    from warpcaustics.config import config_to_dict
+    from warpcaustics.io.toml_out import dumps_toml
     from warpcaustics.scene import load_scene
 
-    overrides = dict(parse_override(text) for text in args.overrides)
+    scene = load_scene(args.config, _overrides(args))
+    print(dumps_toml(config_to_dict(scene.config)), end="")
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from warpcaustics.scene import load_scene
+
+    overrides = _overrides(args)
     scene = load_scene(args.config, overrides)  # validate everything before touching the output
     if args.frames < 1:
         raise WarpcausticsError(f"--frames = {args.frames} must be at least 1")
@@ -145,7 +174,9 @@ def _render(args: argparse.Namespace) -> int:
         raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
     results = []
     from warpcaustics.batch.sweep import Progress
+    from warpcaustics.io.manifest import claim
 
+    manifest = claim(out, args.force)  # the earlier run's files go; unrecorded outputs are refused
     # run.json marks a complete run: an earlier run's must not stand beside this run's frames
     (out / "run.json").unlink(missing_ok=True)
     progress = Progress(args.frames, args.quiet, unit="frame")
@@ -155,7 +186,7 @@ def _render(args: argparse.Namespace) -> int:
             result = renderer.render(args.time + frame / args.fps)
             try:
                 with renderer.memory_errors():
-                    save_frame(result, out, frame=frame)
+                    manifest.add(save_frame(result, out, frame=frame).values())
             except OSError as exc:
                 raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
                                         f"{exc.strerror or exc}") from None
@@ -165,6 +196,7 @@ def _render(args: argparse.Namespace) -> int:
     finally:
         progress.close()
     write_run_json(out, results)
+    manifest.add([out / "run.json"])
     if not args.quiet:
         print(f"wrote {args.frames} frame(s) and run.json to {out}")
     return 0
@@ -173,7 +205,7 @@ def _render(args: argparse.Namespace) -> int:
 def _study(args: argparse.Namespace) -> int:
     from warpcaustics.batch.study import load_study, run_study
 
-    study = load_study(args.study)
+    study = load_study(args.study, _overrides(args))
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
@@ -186,7 +218,6 @@ def _study(args: argparse.Namespace) -> int:
 
 
 def _preview(args: argparse.Namespace) -> int:
-    from warpcaustics.config import parse_override
     from warpcaustics.io.preview import preview_png
     from warpcaustics.pipeline import render
     from warpcaustics.scene import load_scene
@@ -194,7 +225,7 @@ def _preview(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.suffix.lower() != ".png":
         raise WarpcausticsError(f"--out {str(out)!r} must name a .png file")
-    scene = load_scene(args.config, dict(parse_override(text) for text in args.overrides))
+    scene = load_scene(args.config, _overrides(args))
     if not out.parent.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
     preview_png(render(scene, args.time, args.device), out)
@@ -204,7 +235,6 @@ def _preview(args: argparse.Namespace) -> int:
 
 def _compare(args: argparse.Namespace) -> int:
     from warpcaustics.batch.compare import compare_methods, write_comparison
-    from warpcaustics.config import parse_override
 
     if args.time != args.time or abs(args.time) == float("inf"):
         raise WarpcausticsError(f"--time = {args.time} must be a finite number of seconds")
@@ -212,7 +242,7 @@ def _compare(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
-    overrides = dict(parse_override(text) for text in args.overrides)
+    overrides = _overrides(args)
     comparison = compare_methods(args.config, overrides, args.time, args.device, methods)
     paths = write_comparison(out, comparison, args.time)
     print(f"{'method':10s} {'correlation':>11s} {'rel. L1':>8s} {'contrast':>8s} {'seconds':>8s}"
@@ -256,7 +286,9 @@ def main(argv: list[str] | None = None) -> int:
             from warpcaustics.batch.sweep import sweep_main
 
             return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet, args.executor,
-                              args.address)
+                              args.address, _overrides(args), args.force)
+        if args.command == "config":
+            return _config(args)
         if args.command == "preview":
             return _preview(args)
         if args.command == "compare":
@@ -266,7 +298,7 @@ def main(argv: list[str] | None = None) -> int:
 
             paths = run_gernez2009(args.scene, args.out, series=tuple(args.series.split(",")),
                                    frames=args.frames, workers=args.workers, device=args.device,
-                                   quick=args.quick, quiet=args.quiet)
+                                   quick=args.quick, quiet=args.quiet, force=args.force)
             print("wrote " + ", ".join(str(p) for p in paths.values()))
             return 0
         if args.command == "report":

@@ -133,6 +133,7 @@ def run_gernez2009(
     device: str | None = None,
     quick: bool = False,
     quiet: bool = False,
+    force: bool = False,
 ) -> dict[str, Path]:
     """Render every point of the comparison (a resumable sweep into ``out``), pool each point's
     frames and write ``gernez2009.csv`` and ``gernez2009.png``."""
@@ -160,7 +161,7 @@ def run_gernez2009(
     bad = next((t.error for t in sweep.tasks if t.error is not None), None)
     if bad is not None:
         raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
-    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet)
+    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet, force=force)
     if not quiet:
         print(format_report(report))
     if report.failed:

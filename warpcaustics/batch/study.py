@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics.config import WaterType, read_toml
+from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
@@ -50,8 +51,9 @@ def _flatten(table: dict, prefix: str = "") -> dict:
     return out
 
 
-def load_study(path: str | Path) -> StudyConfig:
-    """Read a study TOML; errors are one line naming the key."""
+def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
+    """Read a study TOML; errors are one line naming the key. ``overrides`` (the command line's
+    ``--set``) join the study's [overrides]."""
     path = Path(path)
     table = read_toml(path)
     for key in table:
@@ -75,11 +77,14 @@ def load_study(path: str | Path) -> StudyConfig:
         raise ConfigError("study key depths_m needs at least two depths (the attenuation is fitted "
                           "over them)")
     elevations = _numbers("sun_elevations_deg", table["sun_elevations_deg"], positive=True)
+    extra = overrides
     overrides = table.get("overrides", {})
     if not isinstance(overrides, dict):
         raise ConfigError(f"study key overrides = {overrides!r} must be a table of scene keys")
-    return StudyConfig(path.parent / table["scene"], tuple(water_types), depths, elevations,
-                       _flatten(overrides))
+    scene_overrides = {**_flatten(overrides), **(extra or {})}
+    for key in scene_overrides:
+        check_key(key, "study [overrides]")
+    return StudyConfig(path.parent / table["scene"], tuple(water_types), depths, elevations, scene_overrides)
 
 
 def floor_colour_hex(spectrum: np.ndarray, bins) -> str:

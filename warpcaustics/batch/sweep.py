@@ -34,6 +34,7 @@ This module reads and expands sweeps and drives them; ``batch/worker.py`` render
 from __future__ import annotations
 
 import csv
+import difflib
 import hashlib
 import itertools
 import json
@@ -49,8 +50,9 @@ from warpcaustics import __version__
 from warpcaustics.batch.executors import run_locally, run_on_ray
 from warpcaustics.batch.worker import task_tmp_dir
 from warpcaustics.config import config_to_dict, read_toml
+from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError, WarpcausticsError
-from warpcaustics.io.files import atomic_path, write_csv
+from warpcaustics.io.files import atomic_path, write_csv, write_json
 
 MANIFEST = "manifest.jsonl"
 SUMMARY = "summary.csv"
@@ -100,8 +102,13 @@ def _values(table: Any, key: str) -> dict[str, list]:
     return out
 
 
-def load_sweep(path: str | Path) -> Sweep:
-    """Read a sweep TOML and expand it into tasks; every variant is validated before anything runs."""
+FRAME_KEYS = ("count", "fps", "start_s")
+"""The keys of a sweep's [frames] table."""
+
+
+def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
+    """Read a sweep TOML and expand it into tasks; every key and variant is validated before
+    anything runs. ``overrides`` (the command line's ``--set``) join the sweep's [set]."""
     path = Path(path)
     table = read_toml(path)
     unknown = set(table) - {"base", "set", "grid", "zip", "frames"}
@@ -113,12 +120,23 @@ def load_sweep(path: str | Path) -> Sweep:
     fixed = table.get("set", {})
     if not isinstance(fixed, dict):
         raise ConfigError("sweep [set] must be a table of dotted keys and values")
+    fixed = {**fixed, **(overrides or {})}
     grid = _values(table.get("grid"), "grid")
     zipped = _values(table.get("zip"), "zip")
     lengths = {len(v) for v in zipped.values()}
     if len(lengths) > 1:
         raise ConfigError(f"sweep [zip] lists must have equal lengths; got {sorted(lengths)}")
+    for where, keys in (("sweep [set]", fixed), ("sweep [grid]", grid), ("sweep [zip]", zipped)):
+        for key in keys:  # a misspelt key fails the sweep at once, not each of its tasks
+            check_key(key, where)
     frames = table.get("frames", {})
+    if not isinstance(frames, dict):
+        raise ConfigError("sweep [frames] must be a table of count, fps and start_s")
+    for key in frames:
+        if key not in FRAME_KEYS:
+            near = difflib.get_close_matches(key, FRAME_KEYS, n=1, cutoff=0.0)
+            raise ConfigError(f"sweep [frames] key {key!r} is unknown; nearest valid key: {near[0]!r} "
+                              f"(allowed: {', '.join(FRAME_KEYS)})")
     count = frames.get("count", 1)
     fps = frames.get("fps", 30.0)
     start = frames.get("start_s", 0.0)
@@ -181,6 +199,33 @@ def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
 
 # ---------------------------------------------------------------------------------------------
 # Driver
+
+
+SWEEP_RECORD = "sweep.json"
+"""Which sweep a folder holds: the hash of its task ids (the resolved configs, times and version)."""
+
+
+def sweep_hash(sweep: Sweep) -> str:
+    return hashlib.sha256(" ".join(sorted(t.id for t in sweep.tasks)).encode()).hexdigest()[:16]
+
+
+def _claim(out: Path, sweep: Sweep, force: bool) -> None:
+    """A folder resumes the sweep it holds and refuses another one (a one-line error naming
+    ``--force``, which lets the two share the folder); the first run records its hash."""
+    record = out / SWEEP_RECORD
+    mine = sweep_hash(sweep)
+    if record.exists():
+        try:
+            theirs = json.loads(record.read_text(encoding="utf-8")).get("hash")
+        except (OSError, ValueError, AttributeError):
+            theirs = None
+    else:
+        theirs = "unrecorded" if (out / MANIFEST).exists() else None
+    if theirs not in (None, mine) and not force:
+        raise WarpcausticsError(f"--out {str(out)!r} holds the results of another sweep (other keys, values, "
+                                "frames or version); give another --out, or --force to add this one to it")
+    if theirs is None or force:
+        write_json(record, {"hash": mine, "version": __version__, "source": str(sweep.source)})
 
 
 def read_manifest(out_dir: Path) -> dict[str, dict]:
@@ -252,6 +297,7 @@ def run_sweep(
     quiet: bool = False,
     executor: str = "local",
     address: str | None = None,
+    force: bool = False,
 ) -> SweepReport:
     """Run every unfinished task of ``sweep`` into ``out_dir``: with a local process pool
     (``executor = "local"``, ``workers`` processes) or on Ray (``"ray"``: the cluster at ``address``,
@@ -265,6 +311,7 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     out.mkdir(parents=True, exist_ok=True)
+    _claim(out, sweep, force)
     for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
         shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
     records = read_manifest(out)
@@ -383,10 +430,13 @@ def sweep_main(
     quiet: bool,
     executor: str = "local",
     address: str | None = None,
+    overrides: dict | None = None,
+    force: bool = False,
 ) -> int:
-    sweep = load_sweep(path)
+    sweep = load_sweep(path, overrides)
     report = run_sweep(
-        sweep, out, workers=workers, device=device, quiet=quiet, executor=executor, address=address
+        sweep, out, workers=workers, device=device, quiet=quiet, executor=executor, address=address,
+        force=force,
     )
     print(format_report(report), file=sys.stdout)
     print(f"summary: {Path(out) / SUMMARY}")

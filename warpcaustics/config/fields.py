@@ -23,9 +23,13 @@ MAX_TIME_S = 1.0e7
 """Largest time or period a scene may give [s] (about 116 days)."""
 
 
-def _length(*, lo_open: bool = False) -> dict:
-    """A length [m]: 0 (or above, ``lo_open``) to MAX_LENGTH_M."""
-    return _range(0.0, MAX_LENGTH_M, lo_open=lo_open)
+MIN_SIZE = 1.0e-6
+"""Smallest positive length [m] or time [s] a scene may give: a 5e-324 m patch divided by zero."""
+
+
+def _length(*, positive: bool = False) -> dict:
+    """A length [m]: 0 (or MIN_SIZE, ``positive``) to MAX_LENGTH_M."""
+    return _range(MIN_SIZE if positive else 0.0, MAX_LENGTH_M)
 
 
 def _coordinate() -> dict:
@@ -33,9 +37,9 @@ def _coordinate() -> dict:
     return _range(-MAX_LENGTH_M, MAX_LENGTH_M)
 
 
-def _duration(*, lo_open: bool = False) -> dict:
-    """A time or period [s]: 0 (or above, ``lo_open``) to MAX_TIME_S."""
-    return _range(0.0, MAX_TIME_S, lo_open=lo_open)
+def _duration(*, positive: bool = False) -> dict:
+    """A time or period [s]: 0 (or MIN_SIZE, ``positive``) to MAX_TIME_S."""
+    return _range(MIN_SIZE if positive else 0.0, MAX_TIME_S)
 
 
 # Values other issues will add, each with why it is not built yet ("" where that is not known): named
@@ -123,3 +127,38 @@ def _range_text(lo, hi, lo_open) -> str:
     left = "" if lo is None else f"{lo} {'<' if lo_open else '<='} "
     right = "" if hi is None else f" <= {hi}"
     return f"{left}value{right}"
+
+
+def _number(x: float, integer: bool) -> str:
+    """A bound as the docs write it: 60, 0.7, 1e5, 2147483647, −360 (a minus sign, not a hyphen)."""
+    if integer:
+        text = str(int(x))
+    elif (abs(x) >= 1e5 or 0 < abs(x) < 1e-3) and f"{abs(x):.0e}".startswith("1e"):
+        text = f"{x:.0e}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+    else:
+        text = f"{x:g}"
+    return "−" + text[1:] if text.startswith("-") else text
+
+
+def range_doc(tp: Any, meta: dict) -> str:
+    """A numeric key's type and valid range as docs/config.md's table states it, from the same
+    metadata the checks read: ``float 0…60``, ``float > 0, ≤ 60``, ``int 1…16384``, ``float ≥ 0``
+    (a list of floats: the range of each); "" for a key that is not a number."""
+    args = typing.get_args(tp)
+    if type(None) in args:
+        tp = next(a for a in args if a is not type(None))
+    if typing.get_origin(tp) is tuple and typing.get_args(tp) == (float, Ellipsis):
+        kind = "floats"
+    elif tp in (int, float):
+        kind = tp.__name__
+    else:
+        return ""
+    lo, hi, lo_open = meta.get("range", (None, None, False))
+    if lo is None and hi is None:
+        return kind
+    whole = kind == "int"
+    if lo is not None and hi is not None and not lo_open:
+        return f"{kind} {_number(lo, whole)}…{_number(hi, whole)}"
+    parts = ([f"{'>' if lo_open else '≥'} {_number(lo, whole)}"] if lo is not None else []) + \
+        ([f"≤ {_number(hi, whole)}"] if hi is not None else [])
+    return f"{kind} {', '.join(parts)}"

@@ -59,6 +59,25 @@ def _nearest(key: str) -> str:
     return match[0] if match else ""
 
 
+def settable_keys() -> set[str]:
+    """Every dotted key an override may set: the leaves, the arrays of tables (``water.drops``) and
+    the sections (``[]`` dropped: an array is set whole)."""
+    leaves = {k.replace("[]", "") for k in all_keys()}
+    parents = {k.rsplit(".", i)[0] for k in leaves for i in range(1, k.count(".") + 1)}
+    return leaves | parents
+
+
+def check_key(key: str, where: str) -> None:
+    """Refuse a dotted key no config has, naming the nearest valid one (``where``: what gave it,
+    e.g. "sweep [grid]"); a retired key names its successor."""
+    if key in RETIRED_KEYS:
+        fate, successor = RETIRED_KEYS[key]
+        raise ConfigError(f"{where}: {key} was {fate} {successor}; set that instead")
+    if key not in settable_keys():
+        raise ConfigError(f"{where}: unknown key '{key}'; nearest valid key: '{_nearest(key)}' "
+                          "(see docs/config.md)")
+
+
 RETIRED_KEYS: dict[str, tuple[str, str]] = {
     "caustics.sunmap_disk_deg": ("merged into", "sun.angular_diameter_deg"),
 }

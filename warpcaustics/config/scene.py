@@ -18,7 +18,7 @@ class FloorShape(str, enum.Enum):
 
 @dataclass(frozen=True)
 class FloorConfig:
-    depth_m: float = field(default=4.0, metadata=_length(lo_open=True))
+    depth_m: float = field(default=4.0, metadata=_length(positive=True))
     """Depth of the floor below the water at rest at the origin (floor at z = -depth_m + relief) [m]."""
     shape: FloorShape = FloorShape.FLAT
     """Relief of the floor: ``flat``, ``slope`` (a plane), ``ripples`` (sand ripples, a sine) or
@@ -29,7 +29,7 @@ class FloorConfig:
     """Direction in which the ``slope`` descends (gets deeper), from +x towards +y [deg]."""
     ripple_amplitude_m: float = field(default=0.03, metadata=_length())
     """Half the crest-to-trough height of the ``ripples`` [m]."""
-    ripple_wavelength_m: float = field(default=0.5, metadata=_length(lo_open=True))
+    ripple_wavelength_m: float = field(default=0.5, metadata=_length(positive=True))
     """Crest-to-crest distance of the ``ripples`` [m]."""
     ripple_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction across the ripple crests, from +x towards +y [deg]."""
@@ -49,7 +49,7 @@ class ReceiverConfig:
     mesh: str = "sphere"
     """A triangle mesh: ``sphere``, ``cube``, ``cylinder`` or ``cone`` (pyvista's unit-size
     primitives) or a file (OBJ, PLY, STL, VTK, VTP; relative to the config file's folder)."""
-    scale: tuple[float, ...] = field(default=(1.0,), metadata=_length(lo_open=True))
+    scale: tuple[float, ...] = field(default=(1.0,), metadata=_length(positive=True))
     """Scale factor: one value or (sx, sy, sz) [-]; applied first."""
     rotate_deg: tuple[float, ...] = field(default=(0.0, 0.0, 0.0), metadata=_range(-360.0, 360.0))
     """Rotations about x, then y, then z [deg]; applied after scaling."""

@@ -30,7 +30,7 @@ class DropConfig:
     """Where it lands, x [m] (the pool spans ±extent_m/2)."""
     y_m: float = field(default=0.0, metadata=_coordinate())
     """Where it lands, y [m]."""
-    radius_m: float = field(default=0.1, metadata=_length(lo_open=True))
+    radius_m: float = field(default=0.1, metadata=_length(positive=True))
     """Gaussian radius (standard deviation) of the added water [m]."""
     height_m: float = field(default=0.05, metadata=_range(-10.0, 10.0))
     """Peak height of the added (or, if negative, removed) water [m]."""
@@ -46,9 +46,9 @@ class BodyConfig:
     """Centre of its circular path, y [m]."""
     path_radius_m: float = field(default=1.0, metadata=_length())
     """Radius of the circular path [m]."""
-    period_s: float = field(default=4.0, metadata=_duration(lo_open=True))
+    period_s: float = field(default=4.0, metadata=_duration(positive=True))
     """Time for one turn (counter-clockwise seen from above) [s]."""
-    response_s: float = field(default=0.02, metadata=_duration(lo_open=True))
+    response_s: float = field(default=0.02, metadata=_duration(positive=True))
     """Time over which the water under the body takes on its velocity [s]."""
 
 
@@ -58,7 +58,7 @@ class WaterConfig:
     """Surface model: ``flat``, ``heightfield`` (from ``water.file``), ``fft`` (Tessendorf), the walled
     ``pool`` (shallow water) and ``wavepool`` (wave equation), or ``procedural`` (GPU Gems octave
     waves, an open patch that does not tile)."""
-    extent_m: float = field(default=16.0, metadata=_length(lo_open=True))
+    extent_m: float = field(default=16.0, metadata=_length(positive=True))
     """Side L of the square water patch centred at the origin [m]."""
     resolution: int | None = field(default=None, metadata=_range(4, 4096))
     """Vertices per side N (default 256; a heightfield takes N from its file) [-]."""

@@ -1,0 +1,120 @@
+"""Issue 28: what a new user trips over. The CLI runs in a subprocess: exit codes and messages."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import warpcaustics as wc
+from warpcaustics.config.loading import tomllib  # tomli on Python 3.10
+
+from helpers import CONFIGS
+
+TINY = ["--set", "water.resolution=16", "--set", "caustics.map_resolution=16", "--set",
+        "optics.wavelengths.bins=2"]
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "warpcaustics", *args], capture_output=True, text=True,
+                          timeout=600)
+
+
+def one_line_error(proc: subprocess.CompletedProcess, *names: str) -> str:
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr[-2000:]
+    for name in names:
+        assert name in lines[0], lines[0]
+    return lines[0]
+
+
+def write_sweep(path: Path, extra: str = "", grid: str = '"sun.elevation_deg" = [40.0]') -> Path:
+    path.write_text(f'base = "{CONFIGS / "ocean.toml"}"\n{extra}\n[set]\n"water.resolution" = 16\n'
+                    '"caustics.map_resolution" = 16\n"optics.wavelengths.bins" = 2\n'
+                    f"[grid]\n{grid}\n")
+    return path
+
+
+# Sweeps check everything before the first task ---------------------------------------------------
+
+def test_a_misspelt_frames_key_fails_the_sweep_at_once(tmp_path):
+    sweep = write_sweep(tmp_path / "s.toml", "[frames]\ncont = 2")
+    one_line_error(run_cli("sweep", str(sweep), "--out", str(tmp_path / "out"), "--device", "cpu"),
+                   "'cont'", "'count'")
+    assert not (tmp_path / "out" / "manifest.jsonl").exists()
+
+
+def test_a_misspelt_grid_key_fails_the_sweep_at_once(tmp_path):
+    sweep = write_sweep(tmp_path / "s.toml", grid='"floor.depht_m" = [2.0, 3.0]')
+    one_line_error(run_cli("sweep", str(sweep), "--out", str(tmp_path / "out"), "--device", "cpu"),
+                   "floor.depht_m", "floor.depth_m")
+    assert not (tmp_path / "out" / "manifest.jsonl").exists()
+
+
+def test_sweep_and_study_take_set(tmp_path):
+    sweep = write_sweep(tmp_path / "s.toml")
+    out = tmp_path / "out"
+    proc = run_cli("sweep", str(sweep), "--out", str(out), "--device", "cpu", "--quiet",
+                   "--set", "floor.depth_m=2.5")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    (task,) = [p for p in out.iterdir() if p.is_dir() and not p.name.startswith(".")]
+    import json
+
+    assert json.loads((task / "run.json").read_text())["config"]["floor"]["depth_m"] == 2.5
+    one_line_error(run_cli("sweep", str(sweep), "--out", str(tmp_path / "o2"), "--device", "cpu",
+                           "--set", "floor.depht_m=2.5"), "floor.depht_m", "floor.depth_m")
+    one_line_error(run_cli("study", str(CONFIGS / "study.toml"), "--out", str(tmp_path / "o3"), "--device",
+                           "cpu", "--set", "sun.elevatoin_deg=30"), "sun.elevatoin_deg", "sun.elevation_deg")
+
+
+# warpcaustics config ------------------------------------------------------------------------------
+
+def test_config_prints_the_resolved_configuration_as_toml(tmp_path):
+    proc = run_cli("config", str(CONFIGS / "pool_pots.toml"), "--set", "sun.elevation_deg=33")
+    assert proc.returncode == 0, proc.stderr
+    printed = tmp_path / "printed.toml"
+    printed.write_text(proc.stdout)
+    table = tomllib.loads(proc.stdout)
+    assert table["sun"]["elevation_deg"] == 33.0 and len(table["receivers"]) >= 1
+    # every key with its value: read back, it is the same scene
+    again = wc.load_scene(printed).config
+    assert again == wc.load_scene(CONFIGS / "pool_pots.toml", {"sun.elevation_deg": 33.0}).config
+    one_line_error(run_cli("config", str(CONFIGS / "ocean.toml"), "--set", "water.extnt_m=3"),
+                   "water.extnt_m", "water.extent_m")
+
+
+# No stale outputs --------------------------------------------------------------------------------
+
+def test_a_rerun_removes_the_earlier_runs_files_and_only_those(tmp_path):
+    out = tmp_path / "out"
+    render = ["render", str(CONFIGS / "ocean.toml"), "--out", str(out), "--device", "cpu", "--quiet", *TINY]
+    assert run_cli(*render, "--set", "output.npz=true", "--set", "output.vtk=true").returncode == 0
+    assert (out / "frame_0000.npz").exists() and (out / "floor_0000.vti").exists()
+    (out / "notes.txt").write_text("mine")
+    assert run_cli(*render).returncode == 0
+    assert not (out / "frame_0000.npz").exists() and not (out / "floor_0000.vti").exists()
+    assert (out / "frame_0000.exr").exists() and (out / "run.json").exists()
+    assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_outputs_no_run_recorded_are_refused_without_force(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "frame_0000.exr").write_bytes(b"someone else's")
+    render = ["render", str(CONFIGS / "ocean.toml"), "--out", str(out), "--device", "cpu", "--quiet", *TINY]
+    one_line_error(run_cli(*render), "--force")
+    assert (out / "frame_0000.exr").read_bytes() == b"someone else's"
+    assert run_cli(*render, "--force").returncode == 0
+    assert (out / "run.json").exists()
+
+
+def test_a_folder_holding_another_sweep_is_refused_and_the_same_sweep_resumes(tmp_path):
+    out = tmp_path / "out"
+    first = write_sweep(tmp_path / "a.toml")
+    base = ["--out", str(out), "--device", "cpu", "--quiet"]
+    assert run_cli("sweep", str(first), *base).returncode == 0
+    again = run_cli("sweep", str(first), *base)
+    assert again.returncode == 0 and "skipped 1" in again.stdout, again.stdout
+    other = write_sweep(tmp_path / "b.toml", grid='"sun.elevation_deg" = [50.0]')
+    one_line_error(run_cli("sweep", str(other), *base), "another sweep", "--force")
+    assert run_cli("sweep", str(other), *base, "--force").returncode == 0
