@@ -118,3 +118,96 @@ def test_a_folder_holding_another_sweep_is_refused_and_the_same_sweep_resumes(tm
     other = write_sweep(tmp_path / "b.toml", grid='"sun.elevation_deg" = [50.0]')
     one_line_error(run_cli("sweep", str(other), *base), "another sweep", "--force")
     assert run_cli("sweep", str(other), *base, "--force").returncode == 0
+
+
+# Public API, licence, citation -------------------------------------------------------------------
+
+def test_the_public_names_are_discoverable():
+    import warpcaustics
+
+    names = dir(warpcaustics)
+    for name in ("load_scene", "render", "Renderer", "RenderResult", "Scene", "ConfigError", "DeviceError",
+                 "WarpcausticsError"):
+        assert name in names and getattr(warpcaustics, name) is not None
+    assert issubclass(warpcaustics.ConfigError, warpcaustics.WarpcausticsError)
+
+
+def test_licence_and_citation_are_there():
+    from helpers import ROOT
+
+    licence = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert "Apache License" in licence and "Version 2.0, January 2004" in licence
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert pyproject["project"]["license"]["text"] == "Apache-2.0"
+    citation = (ROOT / "CITATION.cff").read_text(encoding="utf-8")
+    assert "cff-version: 1.2.0" in citation and f'version: "{wc.__version__}"' in citation
+    assert (ROOT / "CHANGELOG.md").exists()
+
+
+# EXR colour metadata ------------------------------------------------------------------------------
+
+def test_rgb_exrs_carry_the_chromaticities_of_their_colour_space(tmp_path):
+    """Rec. 709 primaries and D65 for sRGB; AP1 and the ACES white for ACEScg. The code takes them from
+    colour-science; the test's values are the published ones (ITU-R BT.709-6 items 1.3–1.4; the
+    Academy's ACEScg specification S-2014-004, AP1 and the ACES white point)."""
+    import OpenEXR
+    import pytest
+
+    expected = {"sRGB": (0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290),
+                "ACEScg": (0.713, 0.293, 0.165, 0.830, 0.128, 0.044, 0.32168, 0.33767)}
+    for space, xy in expected.items():
+        scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 16, "caustics.map_resolution": 16,
+                                                       "optics.wavelengths.bins": 2,
+                                                       "output.colourspace": space})
+        paths = wc.render(scene, 0.0, "cpu").save(tmp_path / space)
+        with OpenEXR.File(str(paths["exr"])) as exr:
+            assert exr.header()["chromaticities"] == pytest.approx(xy, abs=1e-6)
+
+
+# Reports and progress -----------------------------------------------------------------------------
+
+def test_sweep_progress_names_the_variant_and_summary_cells_are_toml(tmp_path):
+    sweep = write_sweep(tmp_path / "s.toml",
+                        grid='"water.model" = ["pool"]\n"water.drops" = [[{ x_m = 0.25, y_m = 0.0 }]]')
+    out = tmp_path / "out"
+    proc = run_cli("sweep", str(sweep), "--out", str(out), "--device", "cpu")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert 'water.model="pool"' in proc.stdout + proc.stderr
+    import csv
+
+    with open(out / "summary.csv", encoding="utf-8") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["water.drops"] == "[{ x_m = 0.25, y_m = 0.0 }]" and row["water.model"] == "pool"
+    report = run_cli("report", str(out))
+    assert report.returncode == 0 and (out / "summary.png").exists(), report.stderr
+    assert proc.stderr.count("no CUDA device found") <= 1
+
+
+# NetCDF follows CF-1.10 ------------------------------------------------------------------------
+
+def test_netcdf_follows_cf(tmp_path):
+    """Read back with xarray: Conventions, axes that cf_xarray finds, standard names of the
+    coordinates, time in "seconds since" the scene's date, the bin edges as bounds."""
+    import numpy as np
+    import pytest
+
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("cf_xarray")
+    place = {"sun.datetime": "2009-07-14T11:30:00+02:00", "sun.latitude_deg": 43.7, "sun.longitude_deg": 7.3}
+    small = {"water.resolution": 16, "caustics.map_resolution": 16, "optics.wavelengths.bins": 3}
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {**small, "output.netcdf": True, **place})
+    result = wc.render(scene, 0.25, "cpu")
+    path = result.save(tmp_path)["netcdf"]
+    with xr.open_dataset(path) as ds:
+        assert ds.attrs["Conventions"] == "CF-1.10"
+        assert ds.cf.axes == {"X": ["x"], "Y": ["y"], "T": ["time"]}
+        assert {"projection_x_coordinate", "projection_y_coordinate", "time", "radiation_wavelength"} <= \
+            set(ds.cf.standard_names)
+        assert ds["time"].values[0] == np.datetime64("2009-07-14T09:30:00.250")  # 11:30 at +02:00, + 0.25 s
+        bounds = ds[ds["wavelength"].attrs["bounds"]].values
+        np.testing.assert_allclose(bounds[:, 0], result.bins.edges_nm[:-1])
+        np.testing.assert_allclose(bounds[:, 1], result.bins.edges_nm[1:])
+        floor = ds["floor_irradiance"].attrs
+        assert "long_name" in floor and floor["units"] == "W m-2 nm-1"
+    with xr.open_dataset(path, decode_times=False) as raw:
+        assert raw["time"].attrs["units"] == "seconds since 2009-07-14 09:30:00"

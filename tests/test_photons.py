@@ -195,8 +195,9 @@ def test_newton_puts_the_pools_light_on_the_same_receivers_as_exact_hits(config,
     may go to the other receiver or be lost are those within about a light-view texel (4–6 mm) of
     an edge (the floor–wall corner, a wall's edge in the view), about 0.3 % of the floor's flux.
     (Viewed along the sun in air, two thirds of the floor's flux went to the walls at 40° in
-    pool.toml — issue 28's report, kept here as its regression case — and all of it at 20°.) wavepool.toml has the larger waves: crests send some light
-    (0.06 % at 30°) onto the walls above the water at rest."""
+    pool.toml — issue 28's report, kept here as its regression case — and all of it at 20°.)
+    wavepool.toml has the larger waves: crests send some light (0.06 % at 30°) onto the walls
+    above the water at rest."""
     f = pool_flux_by_intersection(elevation_deg, CONFIGS / config)
     for part in ("floor", "walls"):
         assert abs(f["newton"][part] - f["exact"][part]) < 5e-3 * f["transmitted"], part

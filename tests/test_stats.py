@@ -119,7 +119,7 @@ def test_animation_writes_statistics_npz_and_netcdf(tmp_path):
     npz = np.load(out / "frame_0002.npz")
     assert npz["floor_irradiance"].shape == (16, 32, 32)
     np.testing.assert_allclose(npz["x_m"][[0, -1]], [-7.75, 7.75])
-    ds = xr.open_dataset(out / "frame_0002.nc")
+    ds = xr.open_dataset(out / "frame_0002.nc", decode_times=False)  # seconds, as written
     assert ds["floor_irradiance"].dims == ("time", "wavelength", "y", "x")
     assert ds["floor_irradiance"].attrs["units"] == "W m-2 nm-1"
     assert ds["par"].attrs["units"] == "umol m-2 s-1"

@@ -7,7 +7,14 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-__all__ = ["load_scene", "render", "Renderer", "RenderResult", "Scene", "WarpcausticsError", "__version__"]
+__all__ = ["load_scene", "render", "Renderer", "RenderResult", "Scene", "WarpcausticsError", "ConfigError",
+           "DeviceError", "__version__"]
+
+
+def __dir__() -> list[str]:
+    """The public names (those loaded on first use included), so ``dir(warpcaustics)`` and editors
+    show them."""
+    return sorted(set(__all__) | set(globals()))
 
 
 def __getattr__(name: str):
@@ -20,8 +27,8 @@ def __getattr__(name: str):
         from warpcaustics import pipeline
 
         return getattr(pipeline, name)
-    if name == "WarpcausticsError":
-        from warpcaustics.errors import WarpcausticsError
+    if name in ("WarpcausticsError", "ConfigError", "DeviceError"):
+        from warpcaustics import errors
 
-        return WarpcausticsError
+        return getattr(errors, name)
     raise AttributeError(f"module 'warpcaustics' has no attribute {name!r}")

@@ -46,7 +46,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--frames", type=int, default=1, metavar="N", help="number of frames (default 1)")
     r.add_argument("--fps", type=float, default=30.0, metavar="F",
                    help="frames per second of an animation (default 30)")
-    r.add_argument("--quiet", action="store_true", help="no progress output")
+    r.add_argument("--quiet", action="store_true", help="no progress output and no closing \"wrote …\" line")
     r.add_argument("--force", action="store_true",
                    help="write into a folder holding outputs no earlier run recorded (they are kept)")
 

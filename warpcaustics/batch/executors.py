@@ -46,6 +46,12 @@ def die_with_parent(parent_pid: int) -> None:
 def run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
     import multiprocessing
 
+    devices = {t.config.get("device", "auto") for t in todo if t.config}
+    if device is None and todo and len(devices) == 1:
+        # chosen once here, so "no CUDA device found" is said once, not by every worker
+        from warpcaustics.device import resolve_device
+
+        device = resolve_device(None, config_value=devices.pop())
     context = multiprocessing.get_context("spawn")  # no forked Warp/CUDA state in the workers
     with ProcessPoolExecutor(
         max_workers=workers, mp_context=context, initializer=die_with_parent, initargs=(os.getpid(),)

@@ -205,6 +205,16 @@ SWEEP_RECORD = "sweep.json"
 """Which sweep a folder holds: the hash of its task ids (the resolved configs, times and version)."""
 
 
+def _varied(sweep: Sweep, task: Task) -> str:
+    """The task's values of the sweep's varied keys (its grid and zip), and its frame times."""
+    from warpcaustics.io.toml_out import literal
+
+    keys = sweep.varied or sorted(task.overrides)
+    text = ", ".join(f"{k}={literal(task.overrides[k])}" for k in keys if k in task.overrides)
+    times = "t=" + ",".join(f"{t:g}" for t in task.times_s)
+    return f"{text}, {times}" if text else times
+
+
 def sweep_hash(sweep: Sweep) -> str:
     return hashlib.sha256(" ".join(sorted(t.id for t in sweep.tasks)).encode()).hexdigest()[:16]
 
@@ -351,7 +361,7 @@ def run_sweep(
             message = _error_line(error)
             _append(out, {**record, "state": "failed", "error": message})
             report.failed.append((task.id, message))
-            progress.step(f"FAILED {task.id}: {message}")
+            progress.step(f"FAILED {task.id} ({_varied(sweep, task)}): {message}")
             return
         _append(
             out,
@@ -364,7 +374,7 @@ def run_sweep(
             },
         )
         report.done += 1
-        progress.step(f"done {task.id} in {outcome['seconds']:.1f} s")
+        progress.step(f"done {task.id} ({_varied(sweep, task)}) in {outcome['seconds']:.1f} s")
 
     try:
         if executor == "ray":
@@ -452,6 +462,11 @@ def _short(text: str) -> str:
     return text if value.is_integer() and "." not in text else f"{value:.4g}"
 
 
+STAT_AXES = (("floor_w_m2", "floor irradiance\n[W m$^{-2}$]"), ("contrast", "contrast\n(std / mean)"),
+             ("cv", "CV after the\ncollector"))
+"""The statistics ``warpcaustics report`` plots, one panel each, over the sweep's variants."""
+
+
 def report_main(out: str) -> int:
     """Print ``DIR/summary.csv`` as a table and plot the floor irradiance per task."""
     path = Path(out) / SUMMARY
@@ -481,14 +496,20 @@ def report_main(out: str) -> int:
     except ImportError:
         print("(pip install warpcaustics[study] for the plot)")
         return 0
-    fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(rows)), 4))
-    varied = [c for c in shown if c not in headline]
-    labels = ["/".join(_short(r[c]) for c in varied) or r["id"][:6] for r in rows]
-    ax.bar(range(len(rows)), [float(r["floor_w_m2"]) for r in rows])
-    ax.set_xticks(range(len(rows)), labels, rotation=90, fontsize=7)
-    ax.set_yscale("log")
-    ax.set_ylabel("mean floor irradiance [W m$^{-2}$]")
-    ax.set_title(f"{len(rows)} frames of {Path(out).name}" + (f" ({' / '.join(varied)})" if varied else ""))
+    # The varied config keys (dotted names) label the x axis; the statistics are the panels' y axes.
+    varied = [c for c in rows[0] if "." in c and c not in fixed]
+    labels = [", ".join(_short(r[c]) for c in varied) or f"{r['id'][:6]} #{r['frame']}" for r in rows]
+    panels = [(c, label) for c, label in STAT_AXES if c in rows[0]]
+    fig, axes = plt.subplots(len(panels), 1, sharex=True, squeeze=False,
+                             figsize=(max(6.0, 0.3 * len(rows) + 2.0), 1.0 + 2.0 * len(panels)))
+    for ax, (column, label) in zip(axes[:, 0], panels):
+        ax.bar(range(len(rows)), [float(r[column] or "nan") for r in rows])
+        ax.set_ylabel(label, fontsize=8)
+    axes[0, 0].set_yscale("log")
+    bottom = axes[-1, 0]
+    bottom.set_xticks(range(len(rows)), labels, rotation=90, fontsize=7)
+    bottom.set_xlabel(" / ".join(varied) if varied else "task", fontsize=8)
+    axes[0, 0].set_title(f"{Path(out).name}: {len(rows)} frames", fontsize=9)
     fig.tight_layout()
     plot = Path(out) / "summary.png"
     with atomic_path(plot) as tmp:

@@ -109,6 +109,14 @@ def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> di
     return {"rows": rows, "seconds": time.perf_counter() - t0, "device": result.device}
 
 
+def cell(value):
+    """A varied key's value in summary.csv: numbers, strings and booleans as they are, a list or a
+    table as its TOML literal (what the sweep file says), not a Python repr."""
+    from warpcaustics.io.toml_out import literal
+
+    return literal(value) if isinstance(value, (list, tuple, dict)) else value
+
+
 def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> dict:
     """Summary statistics of one frame: per band mean and max floor irradiance, caustic contrast
     (standard deviation / mean of the band-summed floor irradiance), photon counts, timings.
@@ -116,7 +124,7 @@ def summary_row(task: Task, result, k: int, statistics: dict | None = None) -> d
     floor = result.floor_irradiance.astype(np.float64)
     total = (floor * result.bin_widths_nm[:, None, None]).sum(axis=0)
     row = {"id": task.id, "frame": task.frame_start + k, "time_s": result.time_s}
-    row.update({key: task.overrides[key] for key in sorted(task.overrides)})
+    row.update({key: cell(task.overrides[key]) for key in sorted(task.overrides)})
     for wl, band in zip(result.wavelengths_nm, floor):
         row[f"mean_{wl:g}nm"] = float(band.mean())
         row[f"max_{wl:g}nm"] = float(band.max())

@@ -32,10 +32,34 @@ def write_npz(result, out_dir: Path, *, frame: int) -> dict[str, Path]:
     return {"npz": path}
 
 
+CF_CONVENTIONS = "CF-1.10"
+
+
+def time_units(result) -> tuple[str, str]:
+    """CF's time units and a comment: seconds since ``sun.datetime`` (in UTC) when the scene gives
+    one, else since 1970-01-01 00:00:00 UTC standing for the simulation's t = 0."""
+    text = result.scene.config.sun.datetime
+    if text:
+        from warpcaustics.optics.solar import parse_datetime
+
+        start = parse_datetime(text)
+        if start.tzinfo is not None:
+            import datetime
+
+            start = start.astimezone(datetime.timezone.utc).replace(tzinfo=None)
+        return (f"seconds since {start:%Y-%m-%d %H:%M:%S}",
+                f"simulation time from sun.datetime = {text!r} (UTC)")
+    return ("seconds since 1970-01-01 00:00:00",
+            "simulation time; the scene gives no date (sun.datetime), so t = 0 is written as 1970-01-01 UTC")
+
+
 def write_netcdf(result, out_dir: Path, *, frame: int) -> dict[str, Path]:
-    """``frame_NNNN.nc`` through xarray: ``floor_irradiance`` (time, wavelength, y, x) and ``par``
-    (time, y, x), units and descriptions as attributes (NetCDF3 via scipy when netCDF4 is not
-    installed)."""
+    """``frame_NNNN.nc`` through xarray, following CF-1.10: ``floor_irradiance`` (time, wavelength, y,
+    x) and ``par`` (time, y, x) with units and long names; coordinates with ``axis`` and their CF
+    standard names (projection x/y, time in "seconds since …", radiation_wavelength with the bin
+    edges as ``bounds``). NetCDF4 through netCDF4 or h5netcdf when installed, else NetCDF3 (scipy)."""
+    import importlib.util
+
     try:
         import xarray as xr
     except ImportError:
@@ -45,17 +69,37 @@ def write_netcdf(result, out_dir: Path, *, frame: int) -> dict[str, Path]:
                                 "(or set output.netcdf = false)") from None
     path = out_dir / f"frame_{frame:04d}.nc"
     a = science_arrays(result)
+    edges = a["bin_edges_nm"]
+    units, comment = time_units(result)
     ds = xr.Dataset(
         {"floor_irradiance": (("time", "wavelength", "y", "x"), a["floor_irradiance"][None],
-                              {"units": "W m-2 nm-1", "long_name": "floor spectral irradiance"}),
+                              {"units": "W m-2 nm-1", "long_name": "spectral irradiance on the sea floor, "
+                               "bin average"}),
          "par": (("time", "y", "x"), a["par_umol_m2_s"][None],
                  {"units": "umol m-2 s-1",
-                  "long_name": "photosynthetically available radiation (400-700 nm)"})},
-        coords={"time": ("time", a["time_s"], {"units": "s"}),
-                "wavelength": ("wavelength", a["wavelength_nm"], {"units": "nm"}),
-                "y": ("y", a["y_m"], {"units": "m"}), "x": ("x", a["x_m"], {"units": "m"})},
-        attrs={"source": "warpcaustics", "config": str(result.scene.source or ""),
-               "bin_edges_nm": a["bin_edges_nm"]})
+                  "long_name": "photosynthetically available radiation (400-700 nm) on the sea floor"}),
+         "wavelength_bnds": (("wavelength", "nv"), np.stack([edges[:-1], edges[1:]], axis=1),
+                             {"units": "nm", "long_name": "wavelength bin edges"})},
+        coords={"time": ("time", a["time_s"], {"units": units, "calendar": "standard", "axis": "T",
+                                               "standard_name": "time", "comment": comment}),
+                "wavelength": ("wavelength", a["wavelength_nm"],
+                               {"units": "nm", "standard_name": "radiation_wavelength",
+                                "long_name": "wavelength bin centre", "bounds": "wavelength_bnds"}),
+                "y": ("y", a["y_m"], {"units": "m", "axis": "Y", "standard_name": "projection_y_coordinate",
+                                      "long_name": "y of the texel centre (the patch centred at 0)"}),
+                "x": ("x", a["x_m"], {"units": "m", "axis": "X", "standard_name": "projection_x_coordinate",
+                                      "long_name": "x of the texel centre (the patch centred at 0)"})},
+        attrs={"Conventions": CF_CONVENTIONS, "title": "sea-floor caustics rendered by warpcaustics",
+               "source": f"warpcaustics {result_version()}", "config": str(result.scene.source or ""),
+               "references": "https://cfconventions.org (CF-1.10); docs/architecture.md (outputs)"})
+    engine = next((e for e, module in (("netcdf4", "netCDF4"), ("h5netcdf", "h5netcdf"))
+                   if importlib.util.find_spec(module)), "scipy")
     with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp)
+        ds.to_netcdf(tmp, engine=engine, format="NETCDF4" if engine != "scipy" else "NETCDF3_64BIT")
     return {"netcdf": path}
+
+
+def result_version() -> str:
+    from warpcaustics import __version__
+
+    return __version__

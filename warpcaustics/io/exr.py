@@ -18,12 +18,25 @@ def spectral_channel_name(wavelength_nm: float) -> str:
     return "S0." + f"{wavelength_nm:.6f}".replace(".", ",") + "nm"
 
 
+def chromaticities(colourspace: str) -> tuple[float, ...]:
+    """OpenEXR's ``chromaticities`` attribute of an RGB colour space: the x, y of its red, green and
+    blue primaries and of its white, from colour-science's definition (sRGB: Rec. 709 primaries
+    and D65; ACEScg: AP1 and the ACES white)."""
+    from warpcaustics.optics.colour import colour_science
+
+    space = colour_science().RGB_COLOURSPACES[colourspace]
+    return tuple(float(v) for v in np.concatenate([np.ravel(space.primaries), np.ravel(space.whitepoint)]))
+
+
 def write_exr(path: Path, rgb: np.ndarray, spectral: np.ndarray | None, wavelengths_nm: np.ndarray,
-              extra_header: dict[str, str], units: str = EMISSIVE_UNITS) -> None:
+              extra_header: dict[str, str], units: str = EMISSIVE_UNITS, colourspace: str = "sRGB") -> None:
+    """An EXR of linear ``rgb`` in ``colourspace`` (its ``chromaticities`` attribute set, so viewers
+    read the primaries right) and, optionally, the ``spectral`` bands."""
     import OpenEXR
 
     channels = {name: np.ascontiguousarray(rgb[..., i], dtype=np.float32) for i, name in enumerate("RGB")}
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
+              "chromaticities": chromaticities(colourspace)}
     if spectral is not None:
         for k, wl in enumerate(wavelengths_nm):
             channels[spectral_channel_name(wl)] = np.ascontiguousarray(spectral[k], dtype=np.float32)

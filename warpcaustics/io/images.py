@@ -56,5 +56,5 @@ def write_spectral_image(result, image: np.ndarray, exr: Path, png: Path, header
         **header, "warpcaustics.time_s": f"{result.time_s:g}",
         "warpcaustics.rgb": f"linear {out_cfg.colourspace.value}, white balance "
                             f"{out_cfg.white_balance.value}"},
-        units=units)
+        units=units, colourspace=out_cfg.colourspace.value)
     write_png(png, colour_out.tone_map_srgb8(srgb, xyz[..., 1], out_cfg.exposure_ev))

@@ -13,8 +13,9 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.config import Config, DropConfig
+from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels.water import pool as pool_kernels
-from warpcaustics.water.pool import WalledPool
+from warpcaustics.water.pool import MAX_SUBSTEPS_PER_CALL, WalledPool
 from warpcaustics.water.surface import FLOAT32_BYTES, GRAVITY_M_S2, SURFACE_BYTES_PER_VERTEX, Surface
 
 
@@ -68,7 +69,15 @@ class WaveEquationPool(WalledPool):
     def advance(self, time_s: float) -> None:
         """Step to the last multiple of the fixed Δt not after ``time_s`` (frames snap to it)."""
         self._check_forward(time_s)
-        while self.time_s + self.dt <= time_s + 1e-9:
+        # counted once, to within a millionth of a step (a tolerance in seconds looped forever once
+        # Δt fell below it: a 1e-6 m pool has Δt ~ 1e-9 s)
+        steps = math.floor((time_s - self.time_s) / self.dt + 1e-6)
+        if steps > MAX_SUBSTEPS_PER_CALL:
+            raise WarpcausticsError(
+                f"the wave pool needs {steps:.3g} steps of Δt = {self.dt:.3g} s to reach t = {time_s:g} s "
+                f"(more than {MAX_SUBSTEPS_PER_CALL:.0e}); lower water.resolution, enlarge water.extent_m "
+                "or render an earlier time")
+        for _ in range(steps):
             self.step()
             self._drop_bumps(self.time_s)
 
