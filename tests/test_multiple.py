@@ -68,9 +68,8 @@ def test_unscattered_part_follows_beer_lambert():
     photons = st["photons"] / 3
     sigma = np.sqrt(expected * (1 - expected) / photons)
     assert np.all(np.abs(fraction - expected) < 4 * sigma)
-    closing = (
-        np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"]) + np.array(st["truncated"])
-    ) / t
+    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
+               + np.array(st["truncated"]) + np.array(st["roulette"])) / t
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
 
 
@@ -185,7 +184,7 @@ def test_walk_of_a_uniform_sky_over_still_water_is_the_analytic_integral():
             sigma = math.sqrt(max(reached[k] * (1.0 - reached[k]), 0.0) / photons)
             assert floor[k].mean() == pytest.approx(expected, rel=1e-3 + 4 * sigma / reached[k])
         closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
-                   + np.array(st["truncated"])) / t
+                   + np.array(st["truncated"]) + np.array(st["roulette"])) / t
         np.testing.assert_allclose(closing, 1.0, atol=1e-6)
         assert np.all(np.array(st["unscattered"]) == np.array(st["floor"]))
 
@@ -216,7 +215,7 @@ def test_render_walks_the_sky_apart_from_the_sun():
     sky_st = st["sky"]
     t = np.array(sky_st["transmitted"])
     closing = (np.array(sky_st["floor"]) + np.array(sky_st["escaped"]) + np.array(sky_st["absorbed"])
-               + np.array(sky_st["truncated"])) / t
+               + np.array(sky_st["truncated"]) + np.array(sky_st["roulette"])) / t
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
     # skylight entering still water: the patch's area × E_sky × the mean Fresnel transmittance over
     # the 16 cosine-weighted directions
@@ -315,3 +314,26 @@ def test_the_walk_keeps_photons_at_the_seam_on_the_whole_map(extent_m, m):
     walk.map_scale = m / walk.map_extent_m
     wp.launch(_map_texels, dim=xs.shape[0], inputs=[walk, xs, m], outputs=[out], device="cpu")
     assert np.all(out.numpy() == -1)
+
+
+def test_russian_roulette_ends_long_paths_without_bias():
+    """Turbid, absorbing water and a walk allowed 10,000 events: every photon ends (nothing is
+    truncated), the floor map holds no float32 subnormal, the books close (1e-6), and the roulette
+    tally — the weight of the photons it ended less what its survivors gained, zero in expectation —
+    stays within 4σ of zero: each photon's term is at most its roulette weight, 1/64 of its start,
+    so σ ≤ max start / 64 × √photons, with a start at most twice the mean (Fresnel and cos θ vary
+    little over this sea)."""
+    from helpers import subnormal_count
+
+    scene = wc.load_scene(None, {**BASE, "optics.water_type": "turbid_harbor", "optics.mc_max_events": 10000})
+    r = wc.render(scene, device="cpu")
+    st = r.multiple_scattering_stats
+    t = np.array(st["transmitted"])
+    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
+               + np.array(st["truncated"]) + np.array(st["roulette"])) / t
+    np.testing.assert_allclose(closing, 1.0, atol=1e-6)
+    assert np.all(np.array(st["truncated"]) == 0.0)
+    assert subnormal_count(r.floor_irradiance) == 0
+    photons = st["photons"] / 3
+    bound = 4.0 * 2.0 / (64.0 * math.sqrt(photons))
+    assert np.all(np.abs(np.array(st["roulette"])) / t < bound), (np.array(st["roulette"]) / t, bound)

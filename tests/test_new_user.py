@@ -211,3 +211,63 @@ def test_netcdf_follows_cf(tmp_path):
         assert "long_name" in floor and floor["units"] == "W m-2 nm-1"
     with xr.open_dataset(path, decode_times=False) as raw:
         assert raw["time"].attrs["units"] == "seconds since 2009-07-14 09:30:00"
+
+
+# PNG through Pillow ------------------------------------------------------------------------------
+
+def test_png_previews_read_back_exactly(tmp_path):
+    """The preview's 8-bit pixels come back from Pillow's reader as written, rows top first."""
+    import numpy as np
+    from PIL import Image
+
+    from warpcaustics.io.png import write_png
+
+    rgb8 = np.random.default_rng(28).integers(0, 256, (7, 11, 3), dtype=np.uint8)
+    write_png(tmp_path / "p.png", rgb8)
+    with Image.open(tmp_path / "p.png") as image:
+        assert image.format == "PNG" and image.mode == "RGB"
+        np.testing.assert_array_equal(np.asarray(image), rgb8)
+
+
+# Ray client addresses --------------------------------------------------------------------------
+
+def test_a_ray_client_address_without_the_client_is_one_line(tmp_path, monkeypatch, capsys):
+    """Without Ray's client (grpc), ``--address ray://…`` names the extra instead of a traceback."""
+    import importlib.util
+
+    import pytest
+
+    pytest.importorskip("ray")
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "grpc" else real(name, *a))
+    from warpcaustics import cli
+
+    sweep = write_sweep(tmp_path / "s.toml")
+    code = cli.main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--executor", "ray",
+                     "--address", "ray://127.0.0.1:1", "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "warpcaustics[ray]" in err[0] and "ray[client]" in err[0], err
+
+
+def test_info_lists_the_extras():
+    from warpcaustics.config.loading import tomllib as toml
+
+    from helpers import ROOT
+
+    proc = run_cli("info")
+    assert proc.returncode == 0, proc.stderr
+    project = toml.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    declared = project["optional-dependencies"]
+    listed = proc.stdout.split("extras:")[1].split("devices:")[0]
+    for extra in declared:
+        assert extra in listed
+
+
+def test_config_docs_tables_are_whole_and_say_what_the_defaults_do():
+    from helpers import ROOT
+
+    text = (ROOT / "docs" / "config.md").read_text(encoding="utf-8")
+    assert "|\n\n| `" not in text  # a blank line inside a table splits it in two on render
+    assert "The sun is a point" not in text  # the default disk is 0.53°
+    assert "no stage uses it yet" not in text  # optics.phase_function drives the shafts and the walk

@@ -254,12 +254,35 @@ def _compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def extras() -> dict[str, list[str]]:
+    """Each optional extra of the installed package with the distributions it lacks ([] when installed)."""
+    import re
+    from importlib import metadata
+
+    out: dict[str, list[str]] = {}
+    for requirement in metadata.requires("warpcaustics") or []:
+        marker = re.search(r"""extra\s*==\s*["']([^"']+)["']""", requirement)
+        if not marker:
+            continue
+        name = re.match(r"[A-Za-z0-9_.-]+", requirement).group(0)
+        missing = out.setdefault(marker.group(1), [])
+        try:
+            metadata.version(name)
+        except metadata.PackageNotFoundError:
+            missing.append(name)
+    return out
+
+
 def _info() -> int:
     from warpcaustics.device import DEVICE_ENV
     from warpcaustics.io.files import versions
 
     for name, version in versions().items():
         print(f"{name:16s}{version}")
+    print("extras:")
+    for extra, missing in extras().items():
+        fix = f"missing {', '.join(missing)}: pip install 'warpcaustics[{extra}]'"
+        print(f"  {extra:14s}{fix if missing else 'installed'}")
     import os
 
     from warpcaustics.device import _warp

@@ -8,6 +8,12 @@ rest is absorbed there) and turn by the phase function, sampled by inverting its
 distribution (a table). A photon ends on the flat floor (its weight is deposited into the map),
 above the mean surface going up (it escapes), or after ``mc_max_events`` interactions (its weight
 is counted as truncated). Every watt is accounted for in ``tallies``.
+
+A photon whose weight falls below ROULETTE_FRACTION of its starting weight plays Russian roulette
+(Veach 1997 §2.5 gives the method; it is unbiased): it survives with probability weight / w_r at
+the weight w_r = ROULETTE_FRACTION × its start, or ends. Long paths so end instead of carrying
+subnormal weights to ``mc_max_events``; the ``ROULETTE`` tally keeps the books exact, adding the
+weight of the photons that end and subtracting what the survivors gain (zero on average).
 """
 
 import warp as wp
@@ -22,8 +28,12 @@ ESCAPED = wp.constant(2)
 ABSORBED = wp.constant(3)
 UNSCATTERED = wp.constant(4)
 TRUNCATED = wp.constant(5)
-TALLIES = 6
+ROULETTE = wp.constant(6)
+TALLIES = 7
 """Columns of the (K, TALLIES) float64 tally array [W nm⁻¹]."""
+
+ROULETTE_FRACTION = wp.constant(1.0 / 64.0)
+"""A photon plays Russian roulette once its weight is below this fraction of its start."""
 
 
 @wp.struct
@@ -138,6 +148,7 @@ def random_walk(
     if weight <= 0.0:
         return
     wp.atomic_add(tallies, b, TRANSMITTED, wp.float64(weight))
+    roulette_weight = ROULETTE_FRACTION * weight
     c = absorption_per_m[b] + scattering_per_m[b]
     albedo = float(0.0)
     if c > 0.0:
@@ -167,4 +178,11 @@ def random_walk(
             return
         wp.atomic_add(tallies, b, ABSORBED, wp.float64(weight * (1.0 - albedo)))
         weight = weight * albedo
+        if weight < roulette_weight:  # Russian roulette: on at roulette_weight, or end
+            if wp.randf(state) * roulette_weight < weight:
+                wp.atomic_add(tallies, b, ROULETTE, wp.float64(weight - roulette_weight))
+                weight = roulette_weight
+            else:
+                wp.atomic_add(tallies, b, ROULETTE, wp.float64(weight))
+                return
         d = turn(d, sample_cosine(inverse_cdf, wp.randf(state)), 2.0 * wp.pi * wp.randf(state))

@@ -74,19 +74,29 @@ def run_on_ray(
 ) -> None:
     """One Ray task per sweep task (``num_gpus=1`` when rendering on CUDA); the workers write to
     ``out``, which must be storage they share with the driver."""
+    import importlib.util
+
     try:
         import ray
     except ImportError:
         raise WarpcausticsError("--executor ray needs Ray: pip install 'warpcaustics[ray]'") from None
+    if address and address.startswith("ray://") and importlib.util.find_spec("grpc") is None:
+        raise WarpcausticsError(f"--address {address!r} is a Ray client address, which needs Ray's client "
+                                "(ray[client]): pip install 'warpcaustics[ray]'")
     started = not ray.is_initialized()
     if started:
-        ray.init(
-            address=address,
-            num_cpus=None if address else workers,
-            include_dashboard=False,
-            log_to_driver=False,
-            configure_logging=False,
-        )
+        try:
+            ray.init(
+                address=address,
+                num_cpus=None if address else workers,
+                include_dashboard=False,
+                log_to_driver=False,
+                configure_logging=False,
+            )
+        except (ConnectionError, RuntimeError, ValueError, TimeoutError) as exc:
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise WarpcausticsError(f"--address {address!r}: Ray could not start or connect ({first}); "
+                                    "check the address, or leave it out for a local Ray") from None
     try:
         gpus = 1 if device is not None and device.startswith("cuda") else 0
         remote = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(run_task)

@@ -17,8 +17,10 @@ from warpcaustics.kernels.caustics import multiple as mc_kernels
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.water import Surface
 
-TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated")
-"""The columns of the walk's tallies [W nm⁻¹ per band]."""
+TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated", "roulette")
+"""The columns of the walk's tallies [W nm⁻¹ per band]; ``roulette``: the weight of the photons that
+Russian roulette ended less what its survivors gained (zero on average), so transmitted = floor +
+escaped + absorbed + truncated + roulette exactly."""
 
 TURN_STREAM = 0x2545F491
 """Added to a walk's seed for the random turn of the directions over each cell's photons."""
