@@ -239,9 +239,12 @@ def check_outputs(out: Path) -> None:
 @example(base="ocean.toml", sets=[("sun.datetime", '"2009-07-14T11:30:00+02:00"'),
                                   ("sun.latitude_deg", "nan"), ("sun.longitude_deg", "7.3")])
 # found by this fuzz: a patch of 5e-324 m divided by zero; a table key given a string; a 1e-6 m wave
-# pool stepped Δt ~ 1e-9 s towards t = 0 + 1e-9 s for minutes
+# pool stepped Δt ~ 1e-9 s towards t = 0 + 1e-9 s for minutes; a file name holding a record separator;
+# a CFL number of 5e-324 (a zero Δt)
 @example(base="pool.toml", sets=[("water.extent_m", "5e-324")])
 @example(base="wavepool.toml", sets=[("water.extent_m", "1e-06")])
+@example(base="wavepool.toml", sets=[("water.cfl", "5e-324")])
+@example(base="ocean.toml", sets=[("floor.albedo_file", '"0\x1e0"')])  # a line break to splitlines()
 @example(base="ocean.toml", sets=[("stats.probes", '""')])
 def test_the_cli_renders_or_names_the_key(base, sets):
     run(base, sets)

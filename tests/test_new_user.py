@@ -180,7 +180,19 @@ def test_sweep_progress_names_the_variant_and_summary_cells_are_toml(tmp_path):
     assert row["water.drops"] == "[{ x_m = 0.25, y_m = 0.0 }]" and row["water.model"] == "pool"
     report = run_cli("report", str(out))
     assert report.returncode == 0 and (out / "summary.png").exists(), report.stderr
-    assert proc.stderr.count("no CUDA device found") <= 1
+
+
+def test_the_no_cuda_notice_is_said_once_per_sweep(tmp_path):
+    """Two workers, the device left to "auto" on a machine without CUDA: one notice, not one each."""
+    import pytest
+    import warp as wp
+
+    if wp.get_cuda_device_count() > 0:
+        pytest.skip("a CUDA device is present: no notice to count")
+    sweep = write_sweep(tmp_path / "s.toml", grid='"sun.elevation_deg" = [30.0, 50.0, 70.0]')
+    proc = run_cli("sweep", str(sweep), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stderr.count("no CUDA device found") == 1, proc.stderr
 
 
 # NetCDF follows CF-1.10 ------------------------------------------------------------------------

@@ -360,7 +360,7 @@ def test_photon_scene_errors_are_one_line():
         wc.load_scene(None, {**PHOTONS, "floor.shape": "file"})
     with pytest.raises(ConfigError, match="floor.file = '.*nope.npy' does not exist"):
         wc.load_scene(None, {**PHOTONS, "floor.shape": "file", "floor.file": "nope.npy"})
-    with pytest.raises(ConfigError, match=r"receivers\[0\].mesh = 'teapot.obj' is neither"):
+    with pytest.raises(ConfigError, match=r"receivers\[0\].mesh = 'teapot.obj' does not exist"):
         wc.load_scene(None, {**PHOTONS, "receivers": [{"mesh": "teapot.obj"}]})
     with pytest.raises(ConfigError, match=r"receivers\[0\].translate_m .* must have 3 values"):
         wc.load_scene(None, {**PHOTONS, "receivers": [{"translate_m": [1.0, 2.0]}]})

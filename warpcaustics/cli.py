@@ -298,6 +298,12 @@ def _info() -> int:
     return 0
 
 
+def one_line(text: str) -> str:
+    """A message as one printable line: control characters (a newline, or a record separator that
+    a file name given in a config carried) written as escapes."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
@@ -330,7 +336,7 @@ def main(argv: list[str] | None = None) -> int:
             return report_main(args.out)
         return _info()
     except WarpcausticsError as exc:
-        print(f"warpcaustics: error: {exc}", file=sys.stderr)
+        print(f"warpcaustics: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("warpcaustics: interrupted", file=sys.stderr)

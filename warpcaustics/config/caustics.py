@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _coordinate, _length, _range
+from warpcaustics.config.fields import _coordinate, _length, _positive, _range
 
 
 class CausticsMethod(str, enum.Enum):
@@ -75,7 +75,7 @@ class CausticsConfig:
     beam_levels: int = field(default=0, metadata=_range(0, 4))
     """Adaptive beams (Liktor & Dachsbacher 2011 §4.2): start from quads of 2^beam_levels surface
     cells and split where needed down to single cells; 0 = one beam pair per cell (uniform) [-]."""
-    beam_tolerance: float = field(default=0.25, metadata=_range(0.0, 1.0e3))
+    beam_tolerance: float = field(default=0.25, metadata=_range(0.0, 1.0e6))
     """Split an adaptive quad where a vertex's refracted ray, followed to its receiver, misses the
     quad's interpolated ray by more than this many surface cells [-]."""
     shafts: bool = True
@@ -91,10 +91,10 @@ class CausticsConfig:
     so diffraction blurs the caustics over about √(λ·depth); at most a sixth of the patch [-]."""
     wave3d_periods: float = field(default=4.0, metadata=_range(0.5, 1000.0))
     """Periods of the drive over which u² is averaged into the ``wave3d`` intensity [-]."""
-    wave3d_gain: float = field(default=1.0, metadata=_range(0.0, 1.0e6, lo_open=True))
+    wave3d_gain: float = field(default=1.0, metadata=_positive(1.0e6))
     """a of Mercier's post-process a·I^b of the ``wave3d`` intensity (1, 1: the intensity) [-]."""
-    wave3d_exponent: float = field(default=1.0, metadata=_range(0.0, 10.0, lo_open=True))
+    wave3d_exponent: float = field(default=1.0, metadata=_positive(10.0))
     """b of Mercier's post-process a·I^b [-]."""
-    sunmap_halo_deg: float = field(default=5.3, metadata=_range(0.0, 180.0, lo_open=True))
+    sunmap_halo_deg: float = field(default=5.3, metadata=_positive(180.0))
     """Angular diameter of the halo where the ``sunmap`` brightness falls to 0 (GPU Gems ch. 2: an
     arc about 10 times the disk's); it must exceed ``sun.angular_diameter_deg`` [deg]."""

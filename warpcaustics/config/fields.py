@@ -24,12 +24,18 @@ MAX_TIME_S = 1.0e7
 
 
 MIN_SIZE = 1.0e-6
-"""Smallest positive length [m] or time [s] a scene may give: a 5e-324 m patch divided by zero."""
+"""Smallest value of a length [m], time [s] or other quantity that must be positive: a 5e-324 m
+patch and a 5e-324 CFL number divided by zero (found by tests/test_fuzz.py)."""
 
 
 def _length(*, positive: bool = False) -> dict:
     """A length [m]: 0 (or MIN_SIZE, ``positive``) to MAX_LENGTH_M."""
     return _range(MIN_SIZE if positive else 0.0, MAX_LENGTH_M)
+
+
+def _positive(hi: float) -> dict:
+    """A quantity that must be positive: MIN_SIZE to ``hi`` (a subnormal CFL or wind divided by zero)."""
+    return _range(MIN_SIZE, hi)
 
 
 def _coordinate() -> dict:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _range
+from warpcaustics.config.fields import _positive, _range
 
 
 class SunSpectrum(str, enum.Enum):
@@ -22,7 +22,7 @@ class SkyModel(str, enum.Enum):
 
 @dataclass(frozen=True)
 class SunConfig:
-    elevation_deg: float = field(default=60.0, metadata=_range(0.0, 90.0, lo_open=True))
+    elevation_deg: float = field(default=60.0, metadata=_positive(90.0))
     """Angle of the sun above the horizon [deg]."""
     azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction towards the sun, from +x towards +y [deg]."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
-from warpcaustics.config.fields import _coordinate, _duration, _length, _range
+from warpcaustics.config.fields import _coordinate, _duration, _length, _positive, _range
 
 
 class WaterModel(str, enum.Enum):
@@ -67,15 +67,15 @@ class WaterConfig:
     are resolved against the config file's folder."""
     spectrum: WaterSpectrum = WaterSpectrum.PHILLIPS
     """Wave spectrum of the ``fft`` ocean: ``phillips`` (Tessendorf) or ``jonswap`` (fetch-limited)."""
-    wind_speed_m_s: float = field(default=4.0, metadata=_range(0.0, 60.0, lo_open=True))
+    wind_speed_m_s: float = field(default=4.0, metadata=_positive(60.0))
     """Wind speed at 10 m [m/s]."""
     wind_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
     """Direction the wind blows to, from +x towards +y [deg]."""
-    phillips_amplitude: float = field(default=1.75e-3, metadata=_range(0.0, 1.0, lo_open=True))
+    phillips_amplitude: float = field(default=1.75e-3, metadata=_positive(1.0))
     """Phillips constant A (dimensionless): height variance = A·π·(V²/g)²/2 over all k."""
     small_wave_m: float = field(default=0.0, metadata=_length())
     """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
-    fetch_m: float = field(default=100_000.0, metadata=_range(0.0, 1.0e7, lo_open=True))
+    fetch_m: float = field(default=100_000.0, metadata=_positive(1.0e7))
     """Distance over which the wind has blown (JONSWAP) [m]."""
     jonswap_gamma: float = field(default=3.3, metadata=_range(1.0, 10.0))
     """JONSWAP peak enhancement γ (1 = Pierson–Moskowitz shape) [-]."""
@@ -85,7 +85,7 @@ class WaterConfig:
     """Strength λ of the choppy horizontal displacement (Tessendorf eq. 29) [-]; 0 = none."""
     viscosity_m2_s: float = field(default=1.0e-4, metadata=_range(0.0, 1.0))
     """Kinematic (eddy) viscosity of the shallow-water ``pool`` [m²/s]."""
-    cfl: float = field(default=0.4, metadata=_range(0.0, 0.7, lo_open=True))
+    cfl: float = field(default=0.4, metadata=_positive(0.7))
     """Courant number of the pools' steps: dt = cfl·Δx / (|u| + √(g h)) [-]; the explicit gravity
     step is stable up to 1/√2 in 2-D, hence at most 0.7."""
     drops: tuple[DropConfig, ...] = ()
@@ -101,9 +101,9 @@ class WaterConfig:
     """Seed of the ocean's random phases and amplitudes."""
     procedural_amplitude: float = field(default=0.01, metadata=_range(0.0, 1.0))
     """A of the ``procedural`` waves (GPU Gems ch. 2's VTXSIZE): η = 2Aℓ·r·Σ −f cos(…) [-]."""
-    procedural_frequency: float = field(default=10.0, metadata=_range(0.0, 1.0e4, lo_open=True))
+    procedural_frequency: float = field(default=10.0, metadata=_positive(1.0e4))
     """W of the ``procedural`` waves (the chapter's WAVESIZE): phase W·x̂·ŷ/f in units of ℓ [-]."""
-    procedural_factor: float = field(default=1.0, metadata=_range(0.0, 100.0, lo_open=True))
+    procedural_factor: float = field(default=1.0, metadata=_positive(100.0))
     """f_0 of the ``procedural`` waves (the chapter's FACTOR): the first octave's weight; each
     further octave halves it [-]."""
     procedural_speed_rad_s: float = field(default=2.0, metadata=_range(-1.0e3, 1.0e3))
