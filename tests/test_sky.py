@@ -1,4 +1,5 @@
-"""Skylight (sky.model = "uniform"): the analytic integral over the sky, reported apart from the sun."""
+"""Skylight (sky.model = "uniform", the CIE standard general skies): the analytic integral over the
+sky, reported apart from the sun."""
 
 import math
 
@@ -68,22 +69,23 @@ def test_sky_is_reported_apart_from_the_sun():
          "sun map looks up the sun alone"),
         ({"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "caustics.method": "photons",
           "caustics.intersection": "newton"}, "intersection"),
-        ({"sky.model": "cie_clear", "sky.diffuse_fraction": 0.2}, "not implemented yet"),
+        ({"sky.model": "cie", "sky.diffuse_fraction": 0.2, "sky.cie_type": 16}, "sky.cie_type"),
     ],
 )
 def test_sky_errors_are_one_line(overrides, needle):
     """A fraction without a sky, a sky without light, a sky with the sun map or with Newton
-    photons, and the planned CIE clear sky are refused naming the key."""
+    photons, and a CIE sky type that does not exist are refused naming the key."""
     with pytest.raises(ConfigError, match=needle):
         wc.load_scene(None, {**BASE, **overrides})
 
 
 @pytest.mark.parametrize("method", ["photons", "beams"])
-def test_photons_and_beams_see_the_sky_as_the_flux_ratio_map_does(method):
+@pytest.mark.parametrize("model", ["uniform", "cie_clear"])
+def test_photons_and_beams_see_the_sky_as_the_flux_ratio_map_does(method, model):
     """The sky over still water by photons and by beams (a pass per sky direction, each shaded and
     refracted as the flux-ratio map's): the sky's part has the flux-ratio map's mean (1e-4, float32
     sums) and is reported apart from the sun's, whose map is the sun-only render's (1e-5)."""
-    sky = {"sky.model": "uniform", "sky.diffuse_fraction": 0.3, "sky.directions": 8,
+    sky = {"sky.model": model, "sky.diffuse_fraction": 0.3, "sky.directions": 8,
            "sun.elevation_deg": 50.0}
     reference = wc.render(wc.load_scene(None, {**BASE, **sky}), device="cpu")
     r = wc.render(wc.load_scene(None, {**BASE, **sky, "caustics.method": method}), device="cpu")
@@ -128,3 +130,96 @@ def test_grid_methods_solve_the_sky_a_direction_at_a_time(method, rtol):
     if method == "eikonal":
         np.testing.assert_array_equal(renderer.method.approximate.texture(),
                                       sun_renderer.method.approximate.texture())
+
+
+# The CIE standard general skies (ISO 15469 / CIE S 011; data/cie_standard_general_sky.csv) -------
+
+SUN = np.array([math.cos(math.radians(40.0)), 0.0, math.sin(math.radians(40.0))])
+
+
+def test_cie_skies_pass_the_data_readmes_checks():
+    """Every type is 1 at the zenith; types 1, 3 and 5 do not depend on azimuth; type 5 is uniform;
+    for the clear skies (12, 13) the brightest of 200,000 elements lies within 2° of the sun."""
+    from warpcaustics.optics.sky import cie_relative_radiance
+
+    rng = np.random.default_rng(26)
+    v = rng.normal(size=(200_000, 3))
+    v[:, 2] = np.abs(v[:, 2])
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    for t in range(1, 16):
+        assert cie_relative_radiance(t, np.array([0.0, 0.0, 1.0]), SUN) == pytest.approx(1.0, abs=1e-12)
+    ring = np.stack([np.cos(np.linspace(0, 2 * np.pi, 37)) * 0.6, np.sin(np.linspace(0, 2 * np.pi, 37)) * 0.6,
+                     np.full(37, 0.8)], axis=1)
+    for t in (1, 3, 5):
+        values = cie_relative_radiance(t, ring, SUN)
+        assert np.ptp(values) < 1e-12 * values.max()
+    np.testing.assert_allclose(cie_relative_radiance(5, v, SUN), 1.0, atol=1e-12)
+    for t in (12, 13):
+        brightest = v[np.argmax(cie_relative_radiance(t, v, SUN))]
+        assert math.degrees(math.acos(min(float(brightest @ SUN), 1.0))) < 2.0
+
+
+@pytest.mark.parametrize("sky_type", range(1, 16))
+def test_cie_sky_directions_carry_the_requested_diffuse_share(sky_type):
+    """The sky's directions bring exactly its horizontal irradiance (1e-12; the issue asks 1e-4),
+    whatever the type: Σ share·cosθ = 1; type 5's shares are the uniform sky's."""
+    extra = {"sky.diffuse_fraction": 0.25, "sun.elevation_deg": 40.0, "sky.directions": 64}
+    cie = wc.load_scene(None, {**BASE, **extra, "sky.model": "cie", "sky.cie_type": sky_type})
+    dirs, shares = cie.sky_directions()
+    assert float(np.sum(shares * dirs[:, 2])) == pytest.approx(1.0, abs=1e-12)
+    if sky_type == 5:
+        uniform = wc.load_scene(None, {**BASE, **extra, "sky.model": "uniform"})
+        np.testing.assert_allclose(shares, uniform.sky_directions()[1], rtol=1e-12)
+
+
+def test_cie_clear_is_type_12_and_type_5_renders_the_uniform_sky():
+    extra = {"sky.diffuse_fraction": 0.25, "sky.directions": 16}
+    clear = wc.load_scene(None, {**BASE, **extra, "sky.model": "cie_clear", "sky.cie_type": 3})
+    twelve = wc.load_scene(None, {**BASE, **extra, "sky.model": "cie", "sky.cie_type": 12})
+    np.testing.assert_array_equal(clear.sky_directions()[1], twelve.sky_directions()[1])
+    five_scene = wc.load_scene(None, {**BASE, **extra, "sky.model": "cie", "sky.cie_type": 5})
+    five = wc.render(five_scene, device="cpu")
+    uniform = wc.render(wc.load_scene(None, {**BASE, **extra, "sky.model": "uniform"}), device="cpu")
+    np.testing.assert_allclose(five.sky_floor_irradiance, uniform.sky_floor_irradiance, rtol=1e-6)
+
+
+def test_cie_clear_sky_over_flat_water_is_the_analytic_integral():
+    """The CIE clear sky (type 12, sun 40° high) over still water: the floor receives
+    ∫ L(Z, χ) cosθ T(θ) e^{−cD/cosθt} dΩ with L scaled so that ∫ L cosθ dΩ = E_sky (float64
+    quadrature over the hemisphere, the CIE formula written out here) — within 2e-3 with 1024
+    directions (measured 4.5e-4; 4.2e-3 with the default 64, whose stratified directions sample
+    the circumsolar peak coarsely: docs/validation.md)."""
+    from scipy import integrate as integ
+
+    from warpcaustics.optics.sky import cie_sky_types
+
+    t12 = cie_sky_types()[12]
+    zs = math.radians(50.0)
+
+    def radiance(theta, phi):
+        chi = math.acos(max(-1.0, min(1.0, math.cos(zs) * math.cos(theta)
+                                       + math.sin(zs) * math.sin(theta) * math.cos(phi))))
+
+        def f(x):
+            return (1 + t12.c * (math.exp(t12.d * x) - math.exp(t12.d * math.pi / 2))
+                    + t12.e * math.cos(x) ** 2)
+
+        grad = 1 + t12.a * math.exp(t12.b / math.cos(theta)) if theta < math.pi / 2 - 1e-12 else 1.0
+        return f(chi) * grad
+
+    def hemisphere(g):
+        return integ.dblquad(lambda th, ph: radiance(th, ph) * g(th) * math.cos(th) * math.sin(th),
+                             0.0, 2 * math.pi, 0.0, math.pi / 2, epsabs=0, epsrel=1e-7)[0]
+
+    scene = wc.load_scene(None, {**BASE, "sky.model": "cie_clear", "sky.diffuse_fraction": 0.3,
+                                 "sky.directions": 1024, "sun.elevation_deg": 40.0, "sun.azimuth_deg": 0.0})
+    r = wc.render(scene, device="cpu")
+    e_sky = scene.sky_irradiance(r.sun_irradiance)
+    horizontal = hemisphere(lambda th: 1.0)
+    for k, c in enumerate(r.attenuation_per_m):
+        def through(th, c=c):
+            t = fresnel_t_angles(np.array([th]), 1.0, 1.333)[0]
+            return t * math.exp(-c * 2.0 / math.cos(math.asin(math.sin(th) / 1.333)))
+
+        expected = e_sky[k] * hemisphere(through) / horizontal
+        assert r.sky_floor_irradiance[k].mean() == pytest.approx(expected, rel=2e-3)

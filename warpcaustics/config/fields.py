@@ -50,12 +50,7 @@ def _duration(*, positive: bool = False) -> dict:
 
 # Values other issues will add, each with why it is not built yet ("" where that is not known): named
 # so an error can say where they stand instead of "unknown".
-PLANNED_VALUES = {
-    "sky.model": {
-        "cie_clear": "it needs the CIE standard-sky coefficients from a maintained source, which no "
-        "colour-science release has yet",
-    },
-}
+PLANNED_VALUES: dict[str, dict[str, str]] = {}
 
 
 DESCRIBE_CHARS = 80

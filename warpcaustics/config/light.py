@@ -18,6 +18,8 @@ class SunSpectrum(str, enum.Enum):
 class SkyModel(str, enum.Enum):
     NONE = "none"
     UNIFORM = "uniform"
+    CIE = "cie"
+    CIE_CLEAR = "cie_clear"
 
 
 @dataclass(frozen=True)
@@ -56,10 +58,12 @@ class SunConfig:
 @dataclass(frozen=True)
 class SkyConfig:
     model: SkyModel = SkyModel.NONE
-    """Skylight: ``none`` or ``uniform`` (the same radiance from every direction of the sky; every
-    method but ``sunmap``). ``cie_clear`` is planned: it waits for a sourced table of the CIE
-    standard skies (colour-science's ``sky_luminance_distribution_CIE2003`` is in no release
-    yet)."""
+    """Skylight (every method but ``sunmap``): ``none``; ``uniform`` (the same radiance from every
+    direction of the sky); ``cie`` (the radiance shape of CIE standard general sky ``cie_type``,
+    ISO 15469 / CIE S 011, around the sun); ``cie_clear`` (type 12, the CIE clear sky)."""
+    cie_type: int = field(default=12, metadata=_range(1, 15))
+    """The CIE standard general sky type of ``sky.model = "cie"`` (1 overcast … 12 clear … 15
+    turbid; ``data/cie_standard_general_sky.csv``) [-]."""
     diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
     """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
     (``sun.*``) is the rest [-]."""

@@ -13,6 +13,7 @@ import numpy as np
 from warpcaustics.config import (
     Config,
     FloorShape,
+    SkyModel,
     WaterModel,
     config_from_dict,
     read_toml,
@@ -66,15 +67,24 @@ class Scene:
 
     def sky_directions(self) -> tuple[np.ndarray, np.ndarray]:
         """(K, 3) unit directions towards the sky and (K,) the share of the sky's horizontal
-        irradiance each carries on a plane perpendicular to it, 1/(K cosθ): cosine-weighted
-        stratified samples (sinθ = √((j + ½)/K), turns of the golden angle), so for a uniform sky
-        each direction brings 1/K of the horizontal irradiance."""
-        count = self.config.sky.directions
+        irradiance each carries on a plane perpendicular to it: cosine-weighted stratified samples
+        (sinθ = √((j + ½)/K), turns of the golden angle), each standing for an equal part of the
+        horizontal irradiance of a uniform sky, so it brings L_j / Σ L of it, L_j the sky's relative
+        radiance there (1 for ``uniform``: 1/(K cosθ) on its perpendicular plane; the CIE type's
+        L/L_zenith around the sun for ``cie``, ``cie_clear``). The shares' horizontal parts sum to 1."""
+        sky = self.config.sky
+        count = sky.directions
         j = np.arange(count) + 0.5
         sin_t = np.sqrt(j / count)
         cos_t = np.sqrt(1.0 - sin_t * sin_t)
         phi = j * math.pi * (3.0 - math.sqrt(5.0))
         d = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
+        if sky.model in (SkyModel.CIE, SkyModel.CIE_CLEAR):
+            from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance
+
+            sky_type = CIE_CLEAR_TYPE if sky.model is SkyModel.CIE_CLEAR else sky.cie_type
+            radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
+            return d, radiance / (radiance.sum() * cos_t)
         return d, 1.0 / (count * cos_t)
 
     def sky_irradiance(self, sun_irradiance: np.ndarray) -> np.ndarray:

@@ -1,0 +1,74 @@
+"""The CIE standard general sky (ISO 15469:2004 / CIE S 011/E:2003, Table 1): the relative
+radiance of the 15 sky types, whose shape the sky's directions carry (``sky.model = "cie"``).
+
+For a sky element at zenith angle Z and angular distance χ from the sun (zenith angle Z_s)::
+
+    L(Z, χ) / L_zenith = f(χ) φ(Z) / (f(Z_s) φ(0))
+    φ(Z) = 1 + a exp(b / cos Z)          (φ(π/2) = 1)
+    f(χ) = 1 + c [exp(d χ) − exp(d π/2)] + e cos² χ
+
+with the gradation (a, b) and indicatrix (c, d, e) of each type from ``data/cie_standard_general_
+sky.csv`` (provenance in ``data/README.md``). Luminance shape stands for the radiance's shape at
+every wavelength (the sky's spectrum is taken apart from it).
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from warpcaustics.optics.spectra import DATA_DIR
+
+CIE_CLEAR_TYPE = 12
+"""``sky.model = "cie_clear"``: the CIE standard clear sky of low turbidity (type 12)."""
+
+
+@dataclass(frozen=True)
+class CieSkyType:
+    number: int
+    a: float
+    b: float
+    c: float
+    d: float
+    e: float
+    description: str
+
+
+@functools.lru_cache(maxsize=1)
+def cie_sky_types() -> dict[int, CieSkyType]:
+    """The 15 types of the CIE standard general sky, by number."""
+    with open(DATA_DIR / "cie_standard_general_sky.csv", encoding="utf-8", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return {int(r["sky_type"]): CieSkyType(int(r["sky_type"]), float(r["a"]), float(r["b"]), float(r["c"]),
+                                           float(r["d"]), float(r["e"]), r["description"]) for r in rows}
+
+
+def _gradation(t: CieSkyType, cos_z: np.ndarray) -> np.ndarray:
+    """φ(Z) = 1 + a exp(b / cos Z), 1 at the horizon (cos Z → 0⁺)."""
+    cos_z = np.asarray(cos_z, np.float64)
+    with np.errstate(divide="ignore", over="ignore"):
+        out = 1.0 + t.a * np.exp(np.where(cos_z > 0.0, t.b / np.maximum(cos_z, 1e-300), -np.inf))
+    return out
+
+
+def _indicatrix(t: CieSkyType, chi: np.ndarray) -> np.ndarray:
+    """f(χ) = 1 + c [exp(d χ) − exp(d π/2)] + e cos² χ."""
+    chi = np.asarray(chi, np.float64)
+    return 1.0 + t.c * (np.exp(t.d * chi) - math.exp(t.d * math.pi / 2.0)) + t.e * np.cos(chi) ** 2
+
+
+def cie_relative_radiance(sky_type: int, directions: np.ndarray, sun_direction: np.ndarray) -> np.ndarray:
+    """L / L_zenith of each unit direction (…, 3) towards the sky (z up) for CIE type ``sky_type``
+    with the sun towards ``sun_direction`` (float64)."""
+    t = cie_sky_types()[sky_type]
+    d = np.asarray(directions, np.float64)
+    s = np.asarray(sun_direction, np.float64)
+    s = s / np.linalg.norm(s)
+    chi = np.arccos(np.clip(d @ s, -1.0, 1.0))
+    sun_zenith = math.acos(min(max(float(s[2]), -1.0), 1.0))
+    scale = _indicatrix(t, np.array(sun_zenith)) * _gradation(t, np.array(1.0))
+    return _indicatrix(t, chi) * _gradation(t, d[..., 2]) / scale
