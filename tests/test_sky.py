@@ -46,7 +46,8 @@ def test_uniform_sky_over_flat_water_is_the_analytic_integral():
 
 def test_sky_is_reported_apart_from_the_sun():
     """The floor map is the sun's map plus the sky's, and the sky's share follows
-    sky.diffuse_fraction: E_sky = f/(1 − f) E_sun sin(elevation) on a horizontal plane."""
+    sky.diffuse_fraction: over the bins, ∫E_sky = f/(1 − f) ∫E_sun sin(elevation) on a horizontal
+    plane (1e-12); with ``sky.spectrum = "sun"`` band by band."""
     sun_only = wc.render(wc.load_scene(None, BASE), device="cpu")
     both = wc.render(
         wc.load_scene(None, {**BASE, "sky.model": "uniform", "sky.diffuse_fraction": 0.2}), device="cpu"
@@ -55,9 +56,34 @@ def test_sky_is_reported_apart_from_the_sun():
         both.floor_irradiance - both.sky_floor_irradiance, sun_only.floor_irradiance, rtol=1e-5
     )
     scene = both.scene
-    np.testing.assert_allclose(
-        scene.sky_irradiance(both.sun_irradiance), 0.25 * both.sun_irradiance * math.sin(math.radians(60.0))
-    )
+    beam = both.sun_irradiance * math.sin(math.radians(60.0))
+    widths = both.bin_widths_nm
+    assert np.sum(scene.sky_irradiance(both.sun_irradiance) * widths) == pytest.approx(
+        0.25 * np.sum(beam * widths), rel=1e-12)
+    sun_shaped = wc.load_scene(None, {**BASE, "sky.model": "uniform", "sky.diffuse_fraction": 0.2,
+                                      "sky.spectrum": "sun"})
+    np.testing.assert_allclose(sun_shaped.sky_irradiance(both.sun_irradiance), 0.25 * beam)
+
+
+def test_the_sky_has_the_diffuse_spectrum_of_astm_g173():
+    """The sky's spectral shape is ASTM G173-03's diffuse part (global tilt − direct × cos 11.19°,
+    from the shipped table), which is bluer than the direct sun: its ratio to the sun's falls from
+    blue to red, band by band, and it is the table's, bin-averaged, written out here."""
+    from warpcaustics.optics import spectra
+
+    scene = wc.load_scene(None, {**BASE, "optics.wavelengths": {"min_nm": 400.0, "max_nm": 700.0, "bins": 6},
+                                 "sky.model": "uniform", "sky.diffuse_fraction": 0.2})
+    bins = spectra.bins_for(scene.config.optics)
+    sun = spectra.sun_irradiance(bins, scene.config.sun)
+    sky = scene.sky_irradiance(sun)
+    assert np.all(np.diff(sky / sun) < 0)
+    table = np.loadtxt(spectra.DATA_DIR / "solar_astm_g173_03.csv", delimiter=",", skiprows=1)
+    diffuse = table[:, 2] - table[:, 3] * math.cos(math.acos(1.0 / 1.5) - math.radians(37.0))
+    averages = []
+    for a, b in zip(bins.edges_nm[:-1], bins.edges_nm[1:]):
+        x = np.linspace(a, b, 2001)
+        averages.append(np.trapezoid(np.interp(x, table[:, 0], diffuse), x) / (b - a))
+    np.testing.assert_allclose(sky / sky[0], np.array(averages) / averages[0], rtol=1e-4)
 
 
 @pytest.mark.parametrize(

@@ -21,7 +21,7 @@ from warpcaustics.config.caustics import (
     Intersection,
 )
 from warpcaustics.config.fields import PLANNED_VALUES
-from warpcaustics.config.light import SkyConfig, SkyModel, SunConfig, SunSpectrum
+from warpcaustics.config.light import SkyConfig, SkyModel, SkySpectrum, SunConfig, SunSpectrum
 from warpcaustics.config.loading import all_keys, config_from_dict, config_to_dict, parse_override, read_toml
 from warpcaustics.config.optics import (
     JerlovSource,
@@ -62,6 +62,7 @@ __all__ = [
     "Scattering",
     "SkyConfig",
     "SkyModel",
+    "SkySpectrum",
     "StatsConfig",
     "SunConfig",
     "SunSpectrum",

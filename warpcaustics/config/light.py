@@ -22,6 +22,11 @@ class SkyModel(str, enum.Enum):
     CIE_CLEAR = "cie_clear"
 
 
+class SkySpectrum(str, enum.Enum):
+    ASTM_G173_DIFFUSE = "astm_g173_diffuse"
+    SUN = "sun"
+
+
 @dataclass(frozen=True)
 class SunConfig:
     elevation_deg: float = field(default=60.0, metadata=_positive(90.0))
@@ -67,5 +72,10 @@ class SkyConfig:
     diffuse_fraction: float = field(default=0.0, metadata=_range(0.0, 0.99))
     """Share of the global horizontal irradiance that comes from the sky; the sun's direct beam
     (``sun.*``) is the rest [-]."""
+    spectrum: SkySpectrum = SkySpectrum.ASTM_G173_DIFFUSE
+    """Spectral shape of the skylight: ``astm_g173_diffuse``, the diffuse part of ASTM G173-03's
+    global spectrum (global tilt − direct × cos of the sun's 11.19° incidence on its 37° plane at
+    AM1.5), bluer than the sun's; or ``sun``, the sun's own shape. Scaled so that the sky's share of
+    the global horizontal irradiance over the render's bins is ``diffuse_fraction``."""
     directions: int = field(default=64, metadata=_range(1, 4096))
     """Directions the sky is integrated over (cosine-weighted, stratified) [-]."""

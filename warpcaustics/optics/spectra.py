@@ -22,6 +22,7 @@ table. Sources (files under ``warpcaustics/data/``, provenance in its README):
 from __future__ import annotations
 
 import functools
+import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -214,6 +215,23 @@ def sun_irradiance(bins: SpectralBins, sun: SunConfig | None = None,
     if not integral > 0:
         raise ConfigError(f"sun.spectrum = {sun.spectrum.value!r} has no energy in optics.wavelengths")
     return shape * (total / integral)
+
+
+ASTM_G173_SUN_ZENITH_DEG = math.degrees(math.acos(1.0 / 1.5))
+"""The sun's zenith angle of ASTM G173-03's reference conditions: air mass 1.5 = 1 / cos Z (48.19°)."""
+ASTM_G173_TILT_DEG = 37.0
+"""The tilt of its global spectrum's receiving plane, facing the sun (data/README.md)."""
+
+
+def sky_diffuse_shape(bins: SpectralBins) -> np.ndarray:
+    """The skylight's spectral shape per bin: the diffuse part of ASTM G173-03's global tilt
+    spectrum, global − direct × cos(incidence), the incidence on its sun-facing 37° plane being the
+    sun's zenith (48.19° at AM1.5) less the tilt, 11.19° (relative units; the ground-reflected light
+    on that plane is part of it)."""
+    wavelength, global_tilt = _table("solar_astm_g173_03.csv", "E_global_tilt37_W_m2_nm")
+    _, direct = sun_table()
+    incidence = math.radians(ASTM_G173_SUN_ZENITH_DEG - ASTM_G173_TILT_DEG)
+    return bins.average(wavelength, global_tilt - direct * math.cos(incidence), what="ASTM G173 diffuse sky")
 
 
 def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",

@@ -88,12 +88,24 @@ class Scene:
         return d, 1.0 / (count * cos_t)
 
     def sky_irradiance(self, sun_irradiance: np.ndarray) -> np.ndarray:
-        """(K,) the sky's horizontal spectral irradiance [W m⁻² nm⁻¹]: ``sky.diffuse_fraction`` f of
-        the global, the sun's direct beam E_sun sin(elevation) the rest, so E_sky = f/(1 − f) ×
-        that beam (the sky takes the sun's spectral shape: a simplification)."""
-        f = self.config.sky.diffuse_fraction
+        """(K,) the sky's horizontal spectral irradiance [W m⁻² nm⁻¹]: over the render's bins it is
+        ``sky.diffuse_fraction`` f of the global horizontal irradiance, the sun's direct beam
+        E_sun sin(elevation) the rest, so ∫E_sky = f/(1 − f) × ∫ that beam; its shape is
+        ``sky.spectrum``'s (the diffuse part of ASTM G173-03, or the sun's own)."""
+        from warpcaustics.config import SkySpectrum
+
+        sky = self.config.sky
+        f = sky.diffuse_fraction
         elevation = math.radians(self.config.sun.elevation_deg)
-        return f / (1.0 - f) * np.asarray(sun_irradiance, np.float64) * math.sin(elevation)
+        beam = np.asarray(sun_irradiance, np.float64) * math.sin(elevation)
+        if sky.spectrum is SkySpectrum.SUN:
+            return f / (1.0 - f) * beam
+        from warpcaustics.optics import spectra
+
+        bins = spectra.bins_for(self.config.optics)
+        shape = spectra.sky_diffuse_shape(bins)
+        widths = bins.widths_nm
+        return f / (1.0 - f) * float(np.sum(beam * widths)) * shape / float(np.sum(shape * widths))
 
     @property
     def sun_direction(self) -> np.ndarray:
