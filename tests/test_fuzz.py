@@ -240,10 +240,11 @@ def check_outputs(out: Path) -> None:
                                   ("sun.latitude_deg", "nan"), ("sun.longitude_deg", "7.3")])
 # found by this fuzz: a patch of 5e-324 m divided by zero; a table key given a string; a 1e-6 m wave
 # pool stepped Δt ~ 1e-9 s towards t = 0 + 1e-9 s for minutes; a file name holding a record separator;
-# a CFL number of 5e-324 (a zero Δt)
+# a CFL number of 5e-324 (a zero Δt); a 5e-324 m map window
 @example(base="pool.toml", sets=[("water.extent_m", "5e-324")])
 @example(base="wavepool.toml", sets=[("water.extent_m", "1e-06")])
 @example(base="wavepool.toml", sets=[("water.cfl", "5e-324")])
+@example(base="ocean.toml", sets=[("caustics.map_extent_m", "5e-324")])
 @example(base="ocean.toml", sets=[("floor.albedo_file", '"0\x1e0"')])  # a line break to splitlines()
 @example(base="ocean.toml", sets=[("stats.probes", '""')])
 def test_the_cli_renders_or_names_the_key(base, sets):

@@ -29,8 +29,11 @@ patch and a 5e-324 CFL number divided by zero (found by tests/test_fuzz.py)."""
 
 
 def _length(*, positive: bool = False) -> dict:
-    """A length [m]: 0 (or MIN_SIZE, ``positive``) to MAX_LENGTH_M."""
-    return _range(MIN_SIZE if positive else 0.0, MAX_LENGTH_M)
+    """A length [m]: MIN_SIZE to MAX_LENGTH_M, or also exactly 0 (where 0 means "none" or "the
+    default"; ``positive``: it may not be 0). A 5e-324 m map window divided by zero."""
+    if positive:
+        return _range(MIN_SIZE, MAX_LENGTH_M)
+    return {**_range(0.0, MAX_LENGTH_M), "zero_or_at_least": MIN_SIZE}
 
 
 def _positive(hi: float) -> dict:
@@ -117,6 +120,9 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
             raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected a string")
         return value
     lo, hi, lo_open = meta.get("range", (None, None, False))
+    least = meta.get("zero_or_at_least")
+    if least is not None and 0 < value < least:
+        raise ConfigError(f"{key} = {value} is out of range; allowed: 0 or {least:g} <= value <= {hi}")
     if lo is not None and (value < lo or (lo_open and value == lo)):
         raise ConfigError(f"{key} = {value} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
     if hi is not None and value > hi:
@@ -158,6 +164,8 @@ def range_doc(tp: Any, meta: dict) -> str:
     if lo is None and hi is None:
         return kind
     whole = kind == "int"
+    if meta.get("zero_or_at_least") is not None:
+        return f"{kind} 0 or {_number(meta['zero_or_at_least'], whole)}…{_number(hi, whole)}"
     if lo is not None and hi is not None and not lo_open:
         return f"{kind} {_number(lo, whole)}…{_number(hi, whole)}"
     parts = ([f"{'>' if lo_open else '≥'} {_number(lo, whole)}"] if lo is not None else []) + \
