@@ -698,3 +698,26 @@ def test_adaptive_beams_follow_the_waves_from_frame_to_frame():
         counts.append(r.beam_stats["beams"])
         np.testing.assert_allclose(r.floor_flux_w_nm, r.transmitted_flux_w_nm, rtol=1e-6)
     assert len(set(counts)) > 1
+
+
+def test_soft_fade_scales_a_chord_by_its_near_faces_distance_to_the_receiver():
+    """Liktor & Dachsbacher 2011 §5.2 (caustics.beam_soft_fade_m): a camera 0.5 m above a black
+    floor looks straight down under a zenith sun, so each ray runs inside one vertical beam from the
+    camera (the chord's near face, s = 0) to the floor: with a fade of F its shaft is scaled by
+    min(depth / F, 1), the G-buffer's depth to the floor. Off (0, the default) is the unfaded image
+    to the bit; a fade shorter than the floor's distance changes nothing; a longer one only removes
+    light."""
+    view = {"floor.albedo": 0.0, "camera.enabled": True, "camera.position_m": [0.1, 0.1, -1.0],
+            "camera.look_at_m": [0.1, 0.1, -2.0], "camera.up": [0.0, 1.0, 0.0], "camera.fov_deg": 10.0,
+            "camera.width": 16, "camera.height": 16, "water.resolution": 16, "sun.angular_diameter_deg": 0.0}
+    images = {}
+    for fade in (0.0, 0.25, 1.0):
+        scene = _flat(90.0, 1.5, "clear_ocean", **view, **{"caustics.beam_soft_fade_m": fade})
+        result = wc.render(scene, device="cpu")
+        images[fade] = result.camera_radiance.astype(np.float64)
+        depth = result.camera_gbuffer["depth"]
+    default = wc.render(_flat(90.0, 1.5, "clear_ocean", **view), device="cpu")  # the key left out
+    np.testing.assert_array_equal(default.camera_radiance, images[0.0].astype(np.float32))
+    assert np.all(images[0.0] > 0.0) and np.all(np.isfinite(depth)) and depth.max() < 0.51
+    np.testing.assert_allclose(images[0.25], images[0.0], rtol=1e-6)  # every floor is 0.5 m away
+    np.testing.assert_allclose(images[1.0], images[0.0] * np.minimum(depth / 1.0, 1.0)[None], rtol=1e-4)

@@ -81,6 +81,11 @@ class CausticsConfig:
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""
+    beam_soft_fade_m: float = field(default=0.0, metadata=_length())
+    """Liktor & Dachsbacher (2011) §5.2's soft fade of a beam's shaft where it meets a receiver: a
+    chord whose near face lies less than this far in front of the receiver the pixel sees is
+    scaled by that distance over it (soft particles, Lorach 2007). It hides a rasteriser's clipping,
+    which the exact scan-plane chords do not have, and removes light by design; 0 = off [m]."""
     eikonal_resolution: int = field(default=128, metadata=_range(8, 1024))
     """Nodes N per side of the ``eikonal`` grid over the water extent; the spacing L/N is also the
     layer spacing in depth [-]."""

@@ -201,9 +201,20 @@ def _check_beam_levels(cfg: Config) -> None:
                           "caustics.beam_levels = 0 or caustics.beam_interpolation = 'flat'")
 
 
+def _check_soft_fade(cfg: Config) -> None:
+    """The soft fade acts on the beams' light shafts in the camera image alone."""
+    c = cfg.caustics
+    if c.beam_soft_fade_m and not (c.method in (CausticsMethod.BEAMS, CausticsMethod.BOTH)
+                                   and cfg.camera.enabled and c.shafts):
+        raise ConfigError(f"caustics.beam_soft_fade_m = {c.beam_soft_fade_m:g} fades the beams' light shafts "
+                          "in the camera image: it needs caustics.method = \"beams\" (or \"both\"), "
+                          "camera.enabled and caustics.shafts; or set it to 0")
+
+
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
+    _check_soft_fade(cfg)
     _check_sunmap(cfg)
     _check_map_window(cfg)
     _check_sky(cfg)

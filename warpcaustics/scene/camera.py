@@ -223,6 +223,7 @@ class UnderwaterCamera:
             self._pairs.zero_()
             sb = beam_kernels.ShaftBeams()
             sb.beams, sb.copies = beams.gather_beams(), copies
+            sb.soft_fade_m = float(beams.cfg.caustics.beam_soft_fade_m)
             sb.scattering_per_m = self.scattering_per_m
             ph = self.phase
             sb.phase_kind, sb.hg_g, sb.cone_phase = ph.kind, ph.g, ph.cone_phase

@@ -155,6 +155,8 @@ class ShaftBeams:
 
     beams: Beams
     copies: int
+    soft_fade_m: float
+    """Liktor & Dachsbacher 2011 §5.2's soft fade distance [m]; 0 = off."""
     scattering_per_m: wp.array[wp.float32]
     phase_kind: int
     hg_g: float
@@ -187,6 +189,9 @@ def chord_radiance(
     if s_b <= s_a:
         return 0
     ds = s_b - s_a
+    fade = float(1.0)
+    if sb.soft_fade_m > 0.0:  # §5.2: the near face's distance in front of the receiver, over the fade
+        fade = wp.min((s_max - s_a) / sb.soft_fade_m, 1.0)
     # About one piece per beam width √|A| at the chord's midpoint. Most chords are shorter than
     # that: ds² < |A| finds them without the square root and two divisions that would otherwise
     # sit on every chord's chain of dependent operations (docs/benchmarks.md). The test's margin
@@ -215,6 +220,8 @@ def chord_radiance(
         density = flux_density(bm, b, smp, x[2], lattice_wraps)
         e_perp = density / wp.abs(smp.d[2])
         f = piece * phase * e_perp
+        if sb.soft_fade_m > 0.0:
+            f = f * fade
         for jj in range(bm.wavelengths_per_group):
             k = g * bm.wavelengths_per_group + jj
             scattered = f * sb.scattering_per_m[k]
