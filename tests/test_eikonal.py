@@ -143,3 +143,56 @@ def test_transport_keeps_the_flux_of_the_flux_ratio_map(depth_m):
         "caustics.eikonal_resolution": 64, "optics.water_type": "none", "floor.depth_m": depth_m,
         "optics.wavelengths": "rgb"}), device="cpu")
     np.testing.assert_allclose(r.floor_flux_w_nm, r.comparison.floor_flux_w_nm, rtol=5e-3)
+
+
+# Mercier 2013 §3.3: the threshold post-process (caustics.eikonal_threshold_depth_m) -------------
+
+@pytest.mark.parametrize("spread_deg", [15.0, 30.0])
+def test_threshold_wave_spreads_light_in_cones_of_the_spread_angle(spread_deg):
+    """A spot of light (a Gaussian of σ = 1.5 cells) at the threshold layer, run down 40 layers by
+    the §3.3 wave: at 20, 30 and 40 layers its brightest ring lies Δz·tan(spread) from the spot, to
+    between −0.5 and +2 cells (the spot's own width adds), "the angle of the blue cones" of the
+    paper's Fig. 5; on a periodic grid the layer's sum is kept (1e-5, float32)."""
+    n, layers = 128, 41
+    grid = eikonal_kernels.EikonalGrid()
+    grid.n, grid.layers, grid.h, grid.periodic = n, layers, 1.0, 1
+    y, x = np.mgrid[0:n, 0:n] - n // 2
+    r = np.hypot(x, y)
+    volume = np.zeros((layers, n, n), np.float32)
+    volume[0] = np.exp(-0.5 * (r / 1.5) ** 2)
+    volume[0] /= volume[0].sum()
+    horizontal = wp.array(volume, dtype=wp.float32, device="cpu")
+    courant2 = math.tan(math.radians(spread_deg)) ** 2
+    for k in range(layers - 1):
+        wp.launch(eikonal_kernels.threshold_wave_step, dim=(n, n),
+                  inputs=[grid, horizontal, k, courant2, int(k == 0)], device="cpu")
+    out = horizontal.numpy()
+    for depth in (20, 30, 40):
+        ring = np.array([out[depth][(r >= q - 0.5) & (r < q + 0.5)].mean() for q in range(n // 2)])
+        expected = depth * math.tan(math.radians(spread_deg))
+        assert expected - 0.5 <= np.argmax(ring) <= expected + 2.0, (depth, np.argmax(ring), expected)
+        assert out[depth].sum(dtype=np.float64) == pytest.approx(1.0, abs=1e-5)
+
+
+def test_threshold_post_process_leaves_uniform_light_alone_and_spreads_caustics():
+    """Still water gives a uniform texture, which the wave leaves as it is (1e-6); under the ocean
+    the caustics below the threshold spread (the floor's contrast falls) while the floor's mean is
+    kept to the clamping of the wave's negative dips (5e-3; measured 1e-3); unset, the floor map is
+    the plain eikonal's to the bit; the key needs the eikonal method."""
+    still = {"caustics.eikonal_resolution": 32}
+    plain = wc.render(_flat(60.0, **still), device="cpu").floor_irradiance
+    spread = wc.render(_flat(60.0, **still, **{"caustics.eikonal_threshold_depth_m": 0.5}),
+                       device="cpu").floor_irradiance
+    np.testing.assert_allclose(spread, plain, rtol=1e-6)
+    base = {"caustics.method": "eikonal", "water.resolution": 64, "caustics.map_resolution": 64,
+            "optics.wavelengths": "rgb", "caustics.eikonal_resolution": 64, "sun.angular_diameter_deg": 0.0}
+    off = wc.render(wc.load_scene(CONFIGS / "ocean.toml", base), device="cpu").floor_irradiance.sum(0)
+    unset = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, "caustics.eikonal_spread_deg": 30.0}),
+                      device="cpu").floor_irradiance.sum(0)
+    np.testing.assert_array_equal(unset, off)
+    on = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, "caustics.eikonal_threshold_depth_m": 1.0}),
+                   device="cpu").floor_irradiance.sum(0)
+    assert on.mean() == pytest.approx(off.mean(), rel=5e-3)
+    assert on.std() / on.mean() < 0.5 * off.std() / off.mean()
+    with pytest.raises(wc.ConfigError, match="eikonal_threshold_depth_m"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"caustics.eikonal_threshold_depth_m": 1.0})

@@ -358,7 +358,7 @@ def floor_irradiance(
     as in the flux-ratio map: the faces continue the front, so the field itself does not know."""
     b, j, i = wp.tid()
     xy = cell_centre(i, j, out.shape[1], grid.extent_m)
-    e = floor_sample(grid, horizontal, floor_z, xy[0], xy[1])
+    e = wp.max(floor_sample(grid, horizontal, floor_z, xy[0], xy[1]), 0.0)  # §3.3's waves may dip below 0
     length = floor_sample(grid, path, floor_z, xy[0], xy[1])
     value = sun_irradiance[b] * e * wp.exp(-attenuation_per_m[b] * length)
     if grid.periodic == 0 and beyond_patch(grid, xy[0], xy[1], floor_z):
@@ -374,3 +374,39 @@ def beyond_patch(grid: EikonalGrid, x: float, y: float, floor_z: float) -> bool:
     s = (0.0 - floor_z) / wp.abs(t[2])
     half = 0.5 * grid.extent_m
     return wp.abs(x - t[0] * s) > half or wp.abs(y - t[1] * s) > half
+
+
+@wp.func
+def neighbour(i: int, n: int, periodic: int) -> int:
+    """Column index i of an n-column grid: wrapped (periodic) or mirrored at the faces."""
+    if periodic != 0:
+        return (i + n) % n
+    if i < 0:
+        return 0
+    if i >= n:
+        return n - 1
+    return i
+
+
+@wp.kernel
+def threshold_wave_step(grid: EikonalGrid, horizontal: wp.array3d[wp.float32], k: int, courant2: float,
+                        first: int):
+    """Mercier (2013) §3.3's post-process, one layer: below the threshold height the caustic texture
+    is not the eikonal's but a wave simulation in the xy plane, depth standing for time, started
+    from the threshold layer at rest, so light that the viscosity solution gathers into thin
+    structures spreads in cones of half-angle atan(√courant2): layer k+1 from layers k and k−1 by
+    leapfrog (the first step from layer k alone), columns wrapping on a periodic grid and mirrored
+    at the faces of a pool. Values may go negative; the floor sample clamps them."""
+    j, i = wp.tid()
+    n = grid.n
+    u = horizontal[k, j, i]
+    west = horizontal[k, j, neighbour(i - 1, n, grid.periodic)]
+    east = horizontal[k, j, neighbour(i + 1, n, grid.periodic)]
+    south = horizontal[k, neighbour(j - 1, n, grid.periodic), i]
+    north = horizontal[k, neighbour(j + 1, n, grid.periodic), i]
+    lap = west + east + south + north - 4.0 * u
+    if first != 0:
+        horizontal[k + 1, j, i] = u + 0.5 * courant2 * lap
+    else:
+        horizontal[k + 1, j, i] = 2.0 * u - horizontal[k - 1, j, i] + courant2 * lap
+

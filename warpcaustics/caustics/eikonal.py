@@ -101,6 +101,7 @@ class GridCaustics:
 
     def __init__(self, cfg: Config, n: int, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+        self.cfg = cfg
         self.device = device
         self.n = n
         self.extent_m = float(cfg.water.extent_m)
@@ -217,6 +218,7 @@ class EikonalCaustics(GridCaustics):
             wp.launch(eikonal_kernels.transport_layer, dim=(n, n),
                       inputs=[grid, k, self.top, self.psi, self.lap],
                       outputs=[self.intensity, self.path, self.horizontal], device=dev)
+        self._threshold_post_process(grid)
         k_bands, m = self.irradiance.shape[0], self.map_resolution
         wp.launch(eikonal_kernels.floor_irradiance, dim=(k_bands, m, m),
                   inputs=[grid, self.horizontal, self.path, self.floor_z, self.sun_irradiance,
@@ -224,6 +226,19 @@ class EikonalCaustics(GridCaustics):
                   outputs=[self.irradiance], device=dev)
         self.grid = grid
         return self.irradiance
+
+    def _threshold_post_process(self, grid: eikonal_kernels.EikonalGrid) -> None:
+        """Mercier 2013 §3.3 (``caustics.eikonal_threshold_depth_m``): from the first layer at or
+        below the threshold depth down, the horizontal irradiance is a wave in the xy plane with
+        depth as its time, of speed tan(``eikonal_spread_deg``) per unit depth."""
+        c = self.cfg.caustics
+        if c.eikonal_threshold_depth_m is None:
+            return
+        start = max(math.ceil((grid.z_top + c.eikonal_threshold_depth_m) / grid.h - 1e-9), 0)
+        courant2 = math.tan(math.radians(c.eikonal_spread_deg)) ** 2  # Δz = Δx = h
+        for k in range(start, grid.layers - 1):
+            wp.launch(eikonal_kernels.threshold_wave_step, dim=(self.n, self.n),
+                      inputs=[grid, self.horizontal, k, courant2, int(k == start)], device=self.device)
 
     def floor_map(self, surface: Surface, water, time_s: float, highest_m: float, visible: wp.array2d,
                   flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:

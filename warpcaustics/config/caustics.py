@@ -89,6 +89,13 @@ class CausticsConfig:
     eikonal_resolution: int = field(default=128, metadata=_range(8, 1024))
     """Nodes N per side of the ``eikonal`` grid over the water extent; the spacing L/N is also the
     layer spacing in depth [-]."""
+    eikonal_threshold_depth_m: float | None = field(default=None, metadata=_length(positive=True))
+    """Mercier (2013) §3.3's post-process, an aesthetic option: below this depth the ``eikonal``
+    caustic texture is replaced by a wave simulation in the xy plane started from the layer at this
+    depth, so the thin structures of the viscosity solution spread again; unset = off [m]."""
+    eikonal_spread_deg: float = field(default=20.0, metadata=_range(1.0, 35.0))
+    """Half-angle of the cones in which §3.3's wave spreads light below the threshold (the wave's
+    speed per unit depth is its tangent; the leapfrog is stable up to 35.26°) [deg]."""
     wave3d_resolution: int = field(default=64, metadata=_range(8, 1024))
     """Nodes N per side of the ``wave3d`` grid over the water extent (also its layer spacing) [-]."""
     wave3d_cells_per_wavelength: float = field(default=8.0, metadata=_range(4.0, 1000.0))

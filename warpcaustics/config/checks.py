@@ -211,10 +211,19 @@ def _check_soft_fade(cfg: Config) -> None:
                           "camera.enabled and caustics.shafts; or set it to 0")
 
 
+def _check_eikonal_threshold(cfg: Config) -> None:
+    c = cfg.caustics
+    depth = c.eikonal_threshold_depth_m
+    if depth is not None and c.method is not CausticsMethod.EIKONAL:
+        raise ConfigError(f"caustics.eikonal_threshold_depth_m = {depth:g} post-processes the eikonal "
+                          "caustic texture: it needs caustics.method = \"eikonal\"; or leave it unset")
+
+
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
     _check_soft_fade(cfg)
+    _check_eikonal_threshold(cfg)
     _check_sunmap(cfg)
     _check_map_window(cfg)
     _check_sky(cfg)
