@@ -50,6 +50,30 @@ def unwrap(a: wp.vec3, b: wp.vec3, periodic: int, extent_m: float) -> wp.vec3:
 
 
 @wp.func
+def step_sub(sub: int, quad: int, step: int, s: int):
+    """(sub, quad) one photon further (``step`` = ±1) along a row of s photons per quad, carried into
+    the next or previous quad."""
+    sub += step
+    if sub == s:
+        sub = 0
+        quad += 1
+    if sub < 0:
+        sub = s - 1
+        quad -= 1
+    return sub, quad
+
+
+@wp.func
+def on_receiver(n: int, r: int, face: wp.array[wp.int32], face_receiver: wp.array[wp.int32]) -> bool:
+    """Whether photon n exists (n ≥ 0), landed, and landed on receiver r."""
+    if n < 0:
+        return False
+    if face[n] < 0:
+        return False
+    return face_receiver[face[n]] == r
+
+
+@wp.func
 def grid_neighbour(p: int, along_v: int, step: int, quads: int, s: int, periodic: int) -> int:
     """Index of the photon one grid step (``step`` = ±1) along u (along_v = 0) or v from photon p;
     −1 past a wall."""
@@ -61,21 +85,9 @@ def grid_neighbour(p: int, along_v: int, step: int, quads: int, s: int, periodic
     a = sub % s
     b = sub / s
     if along_v == 0:
-        a += step
-        if a == s:
-            a = 0
-            qx += 1
-        if a < 0:
-            a = s - 1
-            qx -= 1
+        a, qx = step_sub(a, qx, step, s)
     else:
-        b += step
-        if b == s:
-            b = 0
-            qy += 1
-        if b < 0:
-            b = s - 1
-            qy -= 1
+        b, qy = step_sub(b, qy, step, s)
     if qx == quads or qy == quads or qx < 0 or qy < 0:
         if periodic == 0:
             return -1
@@ -101,15 +113,11 @@ def lattice_step(
     receiver; ok = 0 if neither qualifies."""
     r = face_receiver[face[p]]
     n = grid_neighbour(p, along_v, 1, quads, s, periodic)
-    if n >= 0:
-        if face[n] >= 0:
-            if face_receiver[face[n]] == r:
-                return unwrap(hit[p], hit[n], periodic, extent_m), int(1)
+    if on_receiver(n, r, face, face_receiver):
+        return unwrap(hit[p], hit[n], periodic, extent_m), int(1)
     n = grid_neighbour(p, along_v, -1, quads, s, periodic)
-    if n >= 0:
-        if face[n] >= 0:
-            if face_receiver[face[n]] == r:
-                return unwrap(hit[n], hit[p], periodic, extent_m), int(1)
+    if on_receiver(n, r, face, face_receiver):
+        return unwrap(hit[n], hit[p], periodic, extent_m), int(1)
     return wp.vec3(0.0), int(0)
 
 
