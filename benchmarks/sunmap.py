@@ -2,8 +2,10 @@
 
 For the default ocean (``configs/ocean.toml``, the surface grid path) and the procedural waves
 (``configs/procedural.toml``, the analytic path) at the same water N and map M: the median wall
-time of the sun-map stage (one backward ray per texel) and of the flux-ratio map (refraction of
-every vertex, then the footprint deposits), each after one warm-up frame, device synchronised.
+time of the sun-map stage (one backward ray per texel, §2.3–2.4), of its per-pixel variant
+(§2.5: the gradient above each texel, no search for the surface, no Snell's law) and of the
+flux-ratio map (refraction of every vertex, then the footprint deposits), each after a warm-up,
+device synchronised.
 ``python -m benchmarks.sunmap --help``.
 """
 
@@ -28,16 +30,22 @@ def measure(config: str, n: int, m: int, device: str, repeats: int) -> dict:
     surface = renderer.water.at(0.5)
     flux_ratio = flux_ratio_pass(renderer, surface, float(surface.positions.numpy()[..., 2].max()))
 
+    stage = renderer.method.approximate
+
     def sun_map():
-        renderer.method.approximate.run(surface, renderer.water, 0.5)
+        stage.run(surface, renderer.water, 0.5)
 
     fluxratio_s = median_time(flux_ratio, repeats, device)
     sunmap_s = median_time(sun_map, repeats, device)
+    stage.per_pixel = True  # §2.5's variant on the same surface and buffers
+    sun_map()  # warm-up: its kernels compile
+    per_pixel_s = median_time(sun_map, repeats, device)
     from warpcaustics.io.comparison import map_correlation, relative_l1
 
     return {"config": config, "water_n": n, "map_m": m, "bins": len(result.wavelengths_nm),
             "fluxratio_s": fluxratio_s, "sunmap_s": sunmap_s,
-            "speedup_sunmap_vs_fluxratio": fluxratio_s / sunmap_s,
+            "speedup_sunmap_vs_fluxratio": fluxratio_s / sunmap_s, "per_pixel_s": per_pixel_s,
+            "speedup_per_pixel_vs_per_vertex": sunmap_s / per_pixel_s,
             "relative_l1_sunmap_vs_fluxratio": relative_l1(result.floor_irradiance,
                                                            result.comparison.floor_irradiance),
             "correlation_sunmap_vs_fluxratio": map_correlation(result.floor_irradiance,
@@ -78,7 +86,8 @@ def run(quick: bool, device: str) -> dict:
             rows.append(row)
             print(f"sunmap       {config:24s} N={n:5d} M={m:5d} K={row['bins']:3d} | sun map "
                   f"{row['sunmap_s'] * 1e3:9.2f} ms | flux ratio {row['fluxratio_s'] * 1e3:9.2f} ms | "
-                  f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | L1 vs flux ratio "
+                  f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | per pixel {row['per_pixel_s'] * 1e3:8.2f} "
+                  f"ms ({row['speedup_per_pixel_vs_per_vertex']:4.2f}x per vertex's speed) | L1 vs flux ratio "
                   f"{row['relative_l1_sunmap_vs_fluxratio']:.2f}, correlation "
                   f"{row['correlation_sunmap_vs_fluxratio']:.2f}", flush=True)
     return {"benchmark": "sunmap_vs_fluxratio", **record, "repeats": repeats,

@@ -182,6 +182,7 @@ def main() -> int:
     _photons()
     _beams()
     _approximate_methods()
+    _sunmap_variants()
     _wave_depths()
     _multiple_scattering()
     return 0
@@ -241,6 +242,35 @@ def _approximate_methods() -> None:
         for r in rows[1:]:
             print(f"{label:37s} {r['method']:8s} correlation {r['correlation']:6.3f}  relative L1 "
                   f"{r['relative_l1']:.3f}  contrast {r['contrast']:.3f} (flux ratio {reference:.3f})")
+
+
+SUNMAP_SCENES = {"configs/ocean.toml": 0.0, "configs/pool.toml": 1.0, "configs/procedural.toml": 0.0}
+"""Scenes (and times) of the sun map's two variants against the flux-ratio map (issue 26)."""
+
+
+def sunmap_variant_rows(device: str = "cpu", overrides: dict | None = None) -> list[dict]:
+    """GPU Gems ch. 2's per-vertex (§2.3–2.4) and per-pixel (§2.5) sun maps against the
+    flux-ratio map of the same frame, under a point sun: one row per scene and variant."""
+    from warpcaustics.batch.compare import compare_methods
+
+    rows = []
+    for config, time_s in SUNMAP_SCENES.items():
+        for variant in ("per_vertex", "per_pixel"):
+            cmp = compare_methods(ROOT / config, {"sun.angular_diameter_deg": 0.0,
+                                                  "caustics.sunmap_variant": variant, **(overrides or {})},
+                                  time_s, device, ("sunmap",))["rows"]
+            rows.append({"config": config, "time_s": time_s, "variant": variant,
+                         "reference_contrast": cmp[0]["contrast"], **cmp[1]})
+    return rows
+
+
+def _sunmap_variants() -> None:
+    print("\n## Sun map per vertex (§2.3-2.4) and per pixel (§2.5) vs the flux-ratio map (point sun)")
+    for sun, overrides in (("the config's sun", {}), ("sun at 30°", {"sun.elevation_deg": 30.0})):
+        for r in sunmap_variant_rows(overrides=overrides):
+            print(f"{r['config']:24s} {sun:16s} t={r['time_s']:.1f} s {r['variant']:10s} correlation "
+                  f"{r['correlation']:6.3f}  relative L1 {r['relative_l1']:.3f}  contrast {r['contrast']:.3f} "
+                  f"(flux ratio {r['reference_contrast']:.3f})")
 
 
 def _photons() -> None:

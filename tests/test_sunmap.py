@@ -177,3 +177,84 @@ def test_compare_command_on_the_lens(tmp_path, capsys):
         assert (out / name).is_file(), name
     assert main(["compare", str(CONFIGS / "lens.toml"), "--out", str(out), "--methods", "raytrace"]) == 2
     assert "not a floor-caustics method" in capsys.readouterr().err
+
+
+# --- §2.5's per-pixel variant (caustics.sunmap_variant = "per_pixel") ---
+
+
+@pytest.mark.parametrize("elevation", [20.0, 90.0])
+def test_per_pixel_flat_water_is_uniform(elevation):
+    """Still water: every normal is vertical, so every texel reads the light map's centre."""
+    result = wc.render(_scene(**{"sun.elevation_deg": elevation, "caustics.sunmap_variant": "per_pixel"}),
+                       device="cpu")
+    np.testing.assert_array_equal(result.sunmap_brightness, 1.0)
+
+
+@pytest.mark.parametrize(("slope_deg", "elevation"), [(0.3, 90.0), (2.0, 90.0), (6.0, 90.0), (4.0, 40.0)])
+def test_per_pixel_tilted_plane_reads_the_light_map(device, slope_deg, elevation):
+    """A plane z = a·x: §2.5 evaluates it where the sun's still-water refracted ray through the
+    texel crosses z = 0, draws the line along its normal to the plane the local depth d above, and
+    reads the light map at the offset d·tan θ_n, i.e. the sun map at γ = (n − 1)/H · d·|a| (float64,
+    written here). The depth varies along x, so the brightness does too (the chapter: deeper
+    floors see a sharper sun)."""
+    n, extent, depth = 64, 4.0, 2.0
+    x = (np.arange(n) + 0.5) * extent / n - extent / 2
+    a = math.tan(math.radians(slope_deg))
+    water = HeightfieldWater(np.tile(a * x, (n, 1)), extent, device)
+    el, az = math.radians(elevation), math.radians(10.0)
+    sun = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    cfg = _scene(**{"sun.elevation_deg": elevation, "sun.azimuth_deg": 10.0, "floor.depth_m": depth,
+                    "caustics.sunmap_variant": "per_pixel"}).config
+    b = SunMapCaustics(cfg, sun, IOR, device, periodic=True).run(water.at(0.0), water, 0.0).numpy()
+
+    up = -snell(-sun, np.array([0.0, 0.0, 1.0]), 1.0 / IOR)
+    m = b.shape[0]
+    c = (np.arange(m) + 0.5) * extent / m - extent / 2
+    px = (c + up[0] * depth / up[2] + extent / 2) % extent - extent / 2
+    interior = np.abs(px) < extent / 2 - 2 * extent / n  # away from the tiled plane's seam
+    gamma = np.degrees((IOR - 1.0) / depth * (a * px + depth) * abs(a))
+    expected = np.array([brightness_of(g) for g in gamma])
+    assert interior.sum() > m / 2
+    np.testing.assert_allclose(b[:, interior], np.broadcast_to(expected[interior], b[:, interior].shape),
+                               atol=2e-4)
+
+
+def test_per_pixel_light_map_matches_snell_for_small_tilts():
+    """Our scale of the chapter's light map, (n − 1)/H, makes its angle Snell's to first order at
+    the still depth H (the chapter: "little visual difference" from refracting): the exact
+    deviation of an overhead sun's backward ray, asin(n sin θ) − θ, against (n − 1) tan θ, float64.
+    Within 0.1 % up to 3° of tilt (the halo's edge for 0.53°/5.3°: 7.9°), 0.6 % at 10°; beyond,
+    the light map reads too near its centre (2.5 % at 20°, 16 % at 40°) and never reaches total
+    internal reflection."""
+    for tilt_deg, low_by in [(0.5, 1.4e-5), (3.0, 5.1e-4), (10.0, 5.8e-3), (20.0, 0.0252), (40.0, 0.156)]:
+        t = math.radians(tilt_deg)
+        snell_gamma = math.asin(IOR * math.sin(t)) - t
+        light_map_gamma = (IOR - 1.0) * math.tan(t)
+        assert light_map_gamma < snell_gamma
+        assert (snell_gamma - light_map_gamma) / snell_gamma == pytest.approx(low_by, rel=0.02), tilt_deg
+
+
+def test_per_pixel_procedural_uses_the_gradient_above_the_texel(device):
+    """Overhead sun: the per-pixel variant reads the chapter's ``gradwave`` at the texel itself
+    (float64 central differences of ``wave``) and its ``wave`` for the local depth."""
+    from test_procedural import PARAMS, chapter_wave
+
+    n, extent, m, depth = 64, 2.0, 48, 1.0
+    params = dict(PARAMS, amplitude=0.002)
+    water = ProceduralWater(n, extent, device, scale_m=1.0, **params)
+    cfg = _scene(**{"sun.elevation_deg": 90.0, "water.model": "procedural", "water.extent_m": extent,
+                    "caustics.map_resolution": m, "floor.depth_m": depth,
+                    "caustics.sunmap_variant": "per_pixel"}).config
+    b = SunMapCaustics(cfg, np.array([0.0, 0.0, 1.0]), IOR, device, periodic=False).run(
+        water.at(0.4), water, 0.4).numpy()
+
+    c = (np.arange(m) + 0.5) * extent / m - extent / 2
+    xs, ys = np.meshgrid(c, c)
+    h = 1e-6
+    wave = lambda x, y: chapter_wave(x, y, 0.4, scale_m=1.0, **params)  # noqa: E731
+    gx = (wave(xs + h, ys) - wave(xs - h, ys)) / (2 * h)
+    gy = (wave(xs, ys + h) - wave(xs, ys - h)) / (2 * h)
+    gamma = np.degrees((IOR - 1.0) / depth * (wave(xs, ys) + depth) * np.hypot(gx, gy))
+    expected = np.vectorize(brightness_of)(gamma)
+    assert 0.05 < expected.mean() < 0.95
+    np.testing.assert_allclose(b, expected, atol=1e-3)

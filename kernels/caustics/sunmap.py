@@ -43,6 +43,21 @@ class SunMap:
     """Side of the water patch and of the map [m]."""
     periodic: int
     """1: the surface tiles; 0: rays meeting the surface outside the patch see no sun."""
+    light_scale: float
+    """``per_pixel``: angle from the sun [rad] per metre of the light-map offset, (n − 1)/H for
+    the still depth H: Snell's small-tilt deviation at the mean depth (our calibration of the
+    chapter's light map, whose own scale is its demo's constants)."""
+
+
+@wp.func
+def brightness_at(params: SunMap, gamma: float) -> float:
+    """The soft sun map at the angle ``gamma`` [rad] from the sun's centre."""
+    if gamma <= params.disk_rad:
+        return 1.0
+    if gamma >= params.halo_rad:
+        return 0.0
+    t = (gamma - params.disk_rad) / (params.halo_rad - params.disk_rad)
+    return 0.5 * (1.0 + wp.cos(wp.pi * t))
 
 
 @wp.func
@@ -51,11 +66,7 @@ def sun_brightness(params: SunMap, ray: wp.vec3) -> float:
     c = wp.dot(ray, params.sun_dir)
     if c >= params.cos_disk:
         return 1.0
-    gamma = wp.atan2(wp.length(wp.cross(ray, params.sun_dir)), c)  # accurate near 0, unlike acos
-    if gamma >= params.halo_rad:
-        return 0.0
-    t = (gamma - params.disk_rad) / (params.halo_rad - params.disk_rad)
-    return 0.5 * (1.0 + wp.cos(wp.pi * t))
+    return brightness_at(params, wp.atan2(wp.length(wp.cross(ray, params.sun_dir)), c))  # not acos: exact near 0
 
 
 @wp.func
@@ -118,4 +129,62 @@ def sunmap_procedural(
     value = float(0.0)
     if inside_patch(params, p):
         value = leave_water(params, wp.normalize(wp.vec3(-w[1], -w[2], 1.0)))
+    brightness[j, i] = value
+
+
+@wp.func
+def light_map(params: SunMap, normal: wp.vec3, depth: float) -> float:
+    """§2.5's per-pixel lookup (Listing 2-2): the line from the floor along the wave ``normal``
+    meets the plane ``depth`` above (``line_plane_intercept``) at the horizontal offset
+    depth·tan θ_n, and the light map (the sun overhead as an environment map, Fig. 2-7) is read
+    there: the sun map at the angle ``light_scale`` × offset. No Snell's law, no total internal
+    reflection; the same tilt reads farther out, so a sharper sun, the deeper the floor."""
+    tilt = wp.sqrt(normal[0] * normal[0] + normal[1] * normal[1]) / wp.max(normal[2], 1.0e-6)
+    return brightness_at(params, params.light_scale * wp.max(depth, 0.0) * tilt)
+
+
+@wp.func
+def pixel_point(params: SunMap, i: int, j: int, m: int) -> wp.vec3:
+    """Where §2.5 evaluates the wave for texel (i, j): directly above it for the chapter's overhead
+    sun; for any sun, where the sun's still-water refracted ray through the texel crosses the
+    mean water level (no search for the moving surface)."""
+    xy = cell_centre(i, j, m, params.extent_m)
+    start = wp.vec3(xy[0], xy[1], params.floor_z)
+    return start + params.up * ((0.0 - params.floor_z) / params.up[2])
+
+
+@wp.kernel
+def sunmap_pixel_grid(
+    params: SunMap,
+    positions: wp.array2d[wp.vec3],
+    normals: wp.array2d[wp.vec3],
+    brightness: wp.array2d[wp.float32],
+):
+    """GPU Gems §2.5's per-pixel variant from the surface grid: height and normal bilinearly
+    interpolated at :func:`pixel_point`, looked up by :func:`light_map`."""
+    j, i = wp.tid()
+    p = pixel_point(params, i, j, brightness.shape[0])
+    value = float(0.0)
+    if inside_patch(params, p):
+        z = grid_bilinear(positions, params.extent_m, params.periodic, p[0], p[1])[2]
+        n = wp.normalize(grid_bilinear(normals, params.extent_m, params.periodic, p[0], p[1]))
+        value = light_map(params, n, z - params.floor_z)
+    brightness[j, i] = value
+
+
+@wp.kernel
+def sunmap_pixel_procedural(
+    params: SunMap,
+    waves: OctaveWaves,
+    time_s: float,
+    brightness: wp.array2d[wp.float32],
+):
+    """GPU Gems §2.5's per-pixel variant from the analytic ``wave`` and ``gradwave`` (Listing 2-1)
+    at :func:`pixel_point`, looked up by :func:`light_map`."""
+    j, i = wp.tid()
+    p = pixel_point(params, i, j, brightness.shape[0])
+    value = float(0.0)
+    if inside_patch(params, p):
+        w = octave_wave(waves, p[0], p[1], time_s)
+        value = light_map(params, wp.vec3(-w[1], -w[2], 1.0), w[0] - params.floor_z)
     brightness[j, i] = value

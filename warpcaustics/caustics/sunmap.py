@@ -1,6 +1,7 @@
 """Sun-map caustics (GPU Gems ch. 2) on the host: ``caustics.method = "sunmap"``.
 
-The kernels (``kernels/caustics/sunmap.py``) give a grey brightness per floor-map texel from backward rays;
+The kernels (``kernels/caustics/sunmap.py``) give a grey brightness per floor-map texel by either of
+the chapter's variants (``caustics.sunmap_variant``: §2.3–2.4 per vertex, §2.5 per pixel);
 the pipeline scales it per band so that its mean equals the flux-ratio map's of the same frame
 (the chapter's map has no absolute scale: "zero means no lighting and one means a beam of very
 focused light"). The flux-ratio map rides along as the comparison.
@@ -14,7 +15,7 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.caustics.fluxratio import ApproximateStage
-from warpcaustics.config import Config
+from warpcaustics.config import Config, SunMapVariant
 from warpcaustics.kernels.caustics import sunmap as sunmap_kernels
 from warpcaustics.optics.refraction import still_water_refraction
 from warpcaustics.water import ProceduralWater, Surface
@@ -39,17 +40,20 @@ class SunMapCaustics:
         params.floor_z = -float(cfg.floor.depth_m)
         params.extent_m = float(cfg.water.extent_m)
         params.periodic = int(periodic)
+        params.light_scale = (float(ior) - 1.0) / float(cfg.floor.depth_m)
         self.params = params
+        self.per_pixel = cfg.caustics.sunmap_variant == SunMapVariant.PER_PIXEL
         self.brightness = wp.empty((m, m), dtype=wp.float32, device=device)
         """Sun-map brightness per floor texel (M, M), 0…1, row index along +y."""
 
     def run(self, surface: Surface, water, time_s: float) -> wp.array2d:
-        """Fill :attr:`brightness` for the surface at ``time_s``; the procedural waves use their
-        analytic height and gradient, every other model its surface grid."""
+        """Fill :attr:`brightness` for the surface at ``time_s`` by the configured variant; the
+        procedural waves use their analytic height and gradient, every other model its surface
+        grid."""
         m = self.brightness.shape[0]
         if isinstance(water, ProceduralWater):
             wp.launch(
-                sunmap_kernels.sunmap_procedural,
+                sunmap_kernels.sunmap_pixel_procedural if self.per_pixel else sunmap_kernels.sunmap_procedural,
                 dim=(m, m),
                 inputs=[self.params, water.waves, float(time_s)],
                 outputs=[self.brightness],
@@ -57,14 +61,13 @@ class SunMapCaustics:
             )
         else:
             wp.launch(
-                sunmap_kernels.sunmap_grid,
+                sunmap_kernels.sunmap_pixel_grid if self.per_pixel else sunmap_kernels.sunmap_grid,
                 dim=(m, m),
                 inputs=[self.params, surface.positions, surface.normals],
                 outputs=[self.brightness],
                 device=self.device,
             )
         return self.brightness
-
 
     def floor_map(self, surface: Surface, water, time_s: float, highest_m: float, visible: wp.array2d,
                   flux_ratio: np.ndarray) -> tuple[np.ndarray, dict]:

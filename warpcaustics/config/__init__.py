@@ -19,6 +19,7 @@ from warpcaustics.config.caustics import (
     CausticsConfig,
     CausticsMethod,
     Intersection,
+    SunMapVariant,
 )
 from warpcaustics.config.fields import PLANNED_VALUES
 from warpcaustics.config.light import SkyConfig, SkyModel, SkySpectrum, SunConfig, SunSpectrum
@@ -65,6 +66,7 @@ __all__ = [
     "SkySpectrum",
     "StatsConfig",
     "SunConfig",
+    "SunMapVariant",
     "SunSpectrum",
     "WaterConfig",
     "WaterModel",

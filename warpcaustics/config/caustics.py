@@ -32,6 +32,11 @@ class Intersection(str, enum.Enum):
     EXACT = "exact"
 
 
+class SunMapVariant(str, enum.Enum):
+    PER_VERTEX = "per_vertex"
+    PER_PIXEL = "per_pixel"
+
+
 class BeamInterpolation(str, enum.Enum):
     SMOOTH = "smooth"
     FLAT = "flat"
@@ -110,3 +115,8 @@ class CausticsConfig:
     sunmap_halo_deg: float = field(default=5.3, metadata=_positive(180.0))
     """Angular diameter of the halo where the ``sunmap`` brightness falls to 0 (GPU Gems ch. 2: an
     arc about 10 times the disk's); it must exceed ``sun.angular_diameter_deg`` [deg]."""
+    sunmap_variant: SunMapVariant = SunMapVariant.PER_VERTEX
+    """``sunmap``: ``per_vertex`` (GPU Gems §2.3–2.4: a backward ray from each texel to the moving
+    surface, Snell's law out, the sun map at the angle from the sun) or ``per_pixel`` (§2.5,
+    Listings 2-1 and 2-2: the wave's gradient directly above the texel, the line along its normal
+    to a plane at the water's depth, the light map read at that offset; no Snell's law)."""
