@@ -181,11 +181,14 @@ def _convex_area_on_screen(points: np.ndarray, width: int, height: int) -> float
     return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
-def prism_ends(v: np.ndarray, d: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """(B, 3, 3) end vertices of a bounding prism of each beam in the manner of Ernst et al. 2005:
-    each side is the plane through a base edge tilted just enough to hold all three end points;
-    neighbouring sides meet in a line through the shared base vertex, cut by the plane of
-    the three edge ends. NaN where a corner line runs parallel to the end plane."""
+def prism_ends(v: np.ndarray, d: np.ndarray, ends: np.ndarray, cap: str = "ends") -> np.ndarray:
+    """(B, 3, 3) end vertices of a bounding prism of each beam by Ernst's touching planes (Liktor &
+    Dachsbacher 2011 §4.3): each side is the plane through a base edge tilted just enough to hold
+    all three end points; neighbouring sides meet in a line through the shared base vertex, cut by
+    the cap: ``"ends"``, the plane of the three edge ends (``caustics.beam_bounds = "prism"``), or
+    ``"parallel"``, the plane parallel to the base through the farthest end (``"ernst"``). NaN
+    where a side plane does not exist or a corner line does not meet the cap ahead of its base
+    vertex (the kernel, kernels/caustics/beams/bounds.py, takes the hull there)."""
     e = v + ends[..., None] * d
     normals = []
     for i in range(3):
@@ -201,23 +204,37 @@ def prism_ends(v: np.ndarray, d: np.ndarray, ends: np.ndarray) -> np.ndarray:
             best = np.where(ok[:, None] & np.isnan(best), n, best)
         normals.append(best)
     dbar = d.sum(axis=1)
-    e0 = e.mean(axis=1)
-    ne = np.cross(e[:, 1] - e[:, 0], e[:, 2] - e[:, 0])
+    if cap == "ends":
+        e0 = e.mean(axis=1)
+        ne = np.cross(e[:, 1] - e[:, 0], e[:, 2] - e[:, 0])
+    else:
+        ne = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+        ne *= np.where((ne * dbar).sum(-1) < 0, -1.0, 1.0)[:, None]
+        far = ((e - v[:, :1]) * ne[:, None]).sum(-1).max(axis=1)
+        e0 = v[:, 0] + ne * (far / (ne * ne).sum(-1))[:, None]
     out = np.empty_like(v)
     for i in range(3):
         line = np.cross(normals[(i + 2) % 3], normals[i])  # sides (k, i) and (i, j) meet at v_i
         line *= np.where((line * dbar).sum(-1) < 0, -1.0, 1.0)[:, None]
-        t = ((e0 - v[:, i]) * ne).sum(-1) / (line * ne).sum(-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = ((e0 - v[:, i]) * ne).sum(-1) / (line * ne).sum(-1)
+        t = np.where(t > 0, t, np.nan)
         out[:, i] = v[:, i] + t[:, None] * line
     return out
 
 
+VOLUMES = ("hull", "prism", "ernst")
+"""``caustics.beam_bounds``'s volumes, compared by :func:`fill_measure` and :func:`_bounds_case`."""
+
+
 def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dict:
     """Pixels a rasteriser would touch for the beams' bounding volumes, on a sample of the beam copies
-    wholly in front of the camera: the tight hull (convex hull of base and end vertices) against a
-    bounding prism in Ernst's manner (:func:`prism_ends`), each projected and clipped to the frame;
-    and the pixels where the beam really is, whose centre ray has a scan-plane chord through it in
-    front of the camera (:func:`scan_chords`, float64; receivers not considered)."""
+    wholly in front of the camera: the tight hull (convex hull of base and end vertices) and the two
+    touching-plane prisms (:func:`prism_ends`; a beam whose prism does not exist takes the hull, as
+    in the kernel), each projected and clipped to the frame; and the pixels where the beam really
+    is, whose centre ray has a scan-plane chord through it in front of the camera
+    (:func:`scan_chords`, float64; receivers not considered). ``<volume>_fill``: beam pixels over
+    the volume's."""
     cam = camera.cam
     pos = np.array(cam.position, np.float64)
     right, up, fwd = (np.array(a, np.float64) for a in (cam.right, cam.up, cam.forward))
@@ -234,8 +251,14 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
     r = copies // 2
     shift = np.stack([(c % copies - r) * stage.extent_m, (c // copies - r) * stage.extent_m, 0 * c], 1)
     vb = v[b] + shift[:, None]
-    hull = np.concatenate([vb, vb + ends[b][..., None] * d[b]], axis=1)
-    prism = np.concatenate([vb, prism_ends(vb, d[b], ends[b])], axis=1)
+    tips = vb + ends[b][..., None] * d[b]
+    corners = {"hull": tips}
+    fallbacks = {}
+    for kind, cap in (("prism", "ends"), ("ernst", "parallel")):
+        top = prism_ends(vb, d[b], ends[b], cap)
+        missing = ~np.all(np.isfinite(top), axis=(1, 2))
+        corners[kind] = np.where(missing[:, None, None], tips, top)
+        fallbacks[kind] = missing
 
     def project(x):
         rel = x - pos
@@ -244,22 +267,24 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
         py = (1.0 - rel @ up / (z * cam.tan_half_fov)) * 0.5 * h
         return np.stack([px, py], -1), z
 
-    hp, hz = project(hull)
-    pp, pz = project(prism)
-    good = np.all(hz > 1e-3, axis=1) & np.all(pz > 1e-3, axis=1) & np.all(np.isfinite(pp), axis=(1, 2))
-    hull_px, prism_px, used = 0.0, 0.0, []
+    projected = {kind: project(np.concatenate([vb, top], axis=1)) for kind, top in corners.items()}
+    good = np.ones(len(vb), bool)
+    for pts, z in projected.values():
+        good &= np.all(z > 1e-3, axis=1) & np.all(np.isfinite(pts), axis=(1, 2))
+    touched = dict.fromkeys(VOLUMES, 0.0)
+    used = []
     for i in np.flatnonzero(good):
-        a_hull = _convex_area_on_screen(hp[i], w, h)
-        a_prism = _convex_area_on_screen(pp[i], w, h)
-        if a_prism <= 0.0 and a_hull <= 0.0:
+        areas = {kind: _convex_area_on_screen(projected[kind][0][i], w, h) for kind in VOLUMES}
+        if max(areas.values()) <= 0.0:
             continue
-        hull_px += a_hull
-        prism_px += a_prism
+        for kind in VOLUMES:
+            touched[kind] += areas[kind]
         used.append(i)
         if len(used) >= samples:
             break
     # Where the beams are: every pixel of each hull's screen box, tested by its centre ray.
     used = np.array(used, np.int64)
+    hp = projected["hull"][0]
     lo = np.clip(np.floor(hp[used].min(axis=1)), 0, [w, h]).astype(np.int64)
     hi = np.clip(np.ceil(hp[used].max(axis=1)), 0, [w, h]).astype(np.int64)
     size = hi - lo
@@ -274,9 +299,55 @@ def fill_measure(stage, camera, copies: int, samples: int, seed: int = 1) -> dic
         q = used[beam[part]]
         s_a, s_b = scan_chords(pos, pixel_rays(cam_np, px[part], py[part], w, h), vb[q], d[b[q]], ends[b[q]])
         inside += int(np.count_nonzero(s_b > np.maximum(s_a, 0.0)))
-    return {"beams_measured": len(used), "hull_pixels": hull_px, "prism_pixels": prism_px,
-            "hull_over_prism": hull_px / max(prism_px, 1e-300), "beam_pixels": inside,
-            "hull_fill": inside / max(hull_px, 1e-300), "prism_fill": inside / max(prism_px, 1e-300)}
+    out = {"beams_measured": len(used), "beam_pixels": inside}
+    for kind in VOLUMES:
+        out[f"{kind}_pixels"] = touched[kind]
+        out[f"{kind}_fill"] = inside / max(touched[kind], 1e-300)
+    for kind, missing in fallbacks.items():
+        out[f"{kind}_hull_fallback_fraction"] = float(missing[used].mean()) if len(used) else 0.0
+    out["hull_over_prism"] = touched["hull"] / max(touched["prism"], 1e-300)
+    out["hull_over_ernst"] = touched["hull"] / max(touched["ernst"], 1e-300)
+    return out
+
+
+def _bounds_case(n: int, size: tuple[int, int], device: str, repeats: int) -> list[dict]:
+    """The volume pass with each of ``caustics.beam_bounds``'s volumes on the benchmark camera
+    (``configs/ocean_floor.toml``): the shafts' time (a render with shafts minus one without,
+    the three volumes timed in turn), the pixels a rasteriser would touch and their fill
+    (:func:`fill_measure`), the (pixel, beam) pairs our boxes test, and the image against the
+    hull's."""
+    import warpcaustics as wc
+
+    cameras = {}
+    for kind in VOLUMES:
+        scene = point_sun_scene(ROOT / "configs" / "ocean_floor.toml", {
+            "caustics.method": "beams", "water.resolution": n, "optics.wavelengths": WAVELENGTHS,
+            "camera.width": size[0], "camera.height": size[1],
+            "optics.phase_function": "henyey_greenstein", "caustics.beam_bounds": kind})
+        renderer = wc.Renderer(scene, device)
+        renderer.render(0.0)  # warm-up
+        cameras[kind] = (renderer.method.camera, renderer.method.caustics[0])
+    sides = {}
+    for kind, (camera, stage) in cameras.items():
+        sides[f"{kind} with"] = (lambda c=camera, s=stage: c.render_beams(s, True), 1)
+        sides[f"{kind} without"] = (lambda c=camera, s=stage: c.render_beams(s, False), 1)
+    times = interleaved_times(sides, repeats, device)
+    camera, stage = cameras["hull"]
+    fill = fill_measure(stage, camera, 3 if stage.periodic else 1, samples=3000)
+    rows = []
+    reference = None
+    for kind, (camera, stage) in cameras.items():
+        camera.render_beams(stage, True)
+        shafts = camera.shafts.numpy().astype(np.float64)
+        reference = shafts if reference is None else reference
+        volume_s = max(float(np.median(np.subtract(times[f"{kind} with"], times[f"{kind} without"]))), 1e-9)
+        rows.append({"beam_bounds": kind, "water_n": n, "camera_px": list(size), "volume_s": volume_s,
+                     **camera.beam_fill(), "raster_pixels": fill[f"{kind}_pixels"],
+                     "raster_fill": fill[f"{kind}_fill"], "beams_measured": fill["beams_measured"],
+                     "relative_l1_vs_hull": relative_l1(reference, shafts)})
+    for r in rows:
+        r["time_vs_hull"] = r["volume_s"] / rows[0]["volume_s"]
+    return rows
 
 
 def _volume_case(n: int, size: tuple[int, int], device: str, warp_repeats: int, numpy_repeats: int) -> dict:
@@ -439,8 +510,9 @@ def _fill_vs_depth(depths, n: int, size: tuple[int, int], device: str,
         floor = result.floor_irradiance[1].astype(np.float64)
         rows.append({"floor_depth_m": depth, "contrast": float(floor.std() / floor.mean()), **fill})
         print(f"beams        fill at floor depth {depth:5.1f} m (contrast {rows[-1]['contrast']:.2f}): "
-              f"hull/prism {fill['hull_over_prism']:.3f} on {fill['beams_measured']} beams; fill (beam "
-              f"pixels / touched) hull {fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}", flush=True)
+              f"hull/prism {fill['hull_over_prism']:.3f}, hull/Ernst {fill['hull_over_ernst']:.3f} on "
+              f"{fill['beams_measured']} beams; fill (beam pixels / touched) hull {fill['hull_fill']:.2f}, "
+              f"prism {fill['prism_fill']:.2f}, Ernst {fill['ernst_fill']:.2f}", flush=True)
     return rows
 
 
@@ -477,9 +549,16 @@ def run(quick: bool, device: str) -> dict:
           f"lists {fill['tile_pairs']:.3g}, in oriented boxes {fill['oriented_box_pairs']:.3g}, with a "
           f"chord {fill['inside_pairs']:.3g}", flush=True)
     print(f"beams        bounding volumes on {fill['beams_measured']} beams in view: tight hull "
-          f"{fill['hull_pixels']:.4g} px, Ernst-style prism {fill['prism_pixels']:.4g} px, hull/prism "
-          f"{fill['hull_over_prism']:.2f}; where the beams are {fill['beam_pixels']} px: fill hull "
-          f"{fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}", flush=True)
+          f"{fill['hull_pixels']:.4g} px, prism {fill['prism_pixels']:.4g} px, Ernst's prism "
+          f"{fill['ernst_pixels']:.4g} px; where the beams are {fill['beam_pixels']} px: fill hull "
+          f"{fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}, Ernst {fill['ernst_fill']:.2f}", flush=True)
+    bounds = _bounds_case(sizes["camera_n"], sizes["camera"], device, max(warp_repeats, 3))
+    for r in bounds:
+        print(f"beams        beam_bounds = {r['beam_bounds']:5s} volume pass {r['volume_s'] * 1e3:8.1f} ms "
+              f"({r['time_vs_hull']:4.2f}x the hull's) | rasterised {r['raster_pixels']:.4g} px, fill "
+              f"{r['raster_fill']:.2f} | boxes test {r['oriented_box_pairs']:.3g} pairs for "
+              f"{r['inside_pairs']:.3g} chords, {r['hull_fallbacks']} copies fell back to the hull | L1 vs "
+              f"hull {r['relative_l1_vs_hull']:.1e}", flush=True)
     by_n = [_stage_time(n, sizes["scaling_m"][1], device, warp_repeats) for n in sizes["scaling_n"]]
     by_m = [_stage_time(sizes["scaling_n"][1], m, device, warp_repeats) for m in sizes["scaling_m"]]
     for rows, key in ((by_n, "beams"), (by_m, "map_m")):
@@ -516,6 +595,7 @@ def run(quick: bool, device: str) -> dict:
         "take the median of warp_repeats; beams and tile lists built by Warp once and shared with numpy",
         "surface_gather": gather,
         "volume_scan_planes": volume,
+        "beam_bounds": bounds,
         "stage_vs_beams": by_n,
         "stage_vs_map": by_m,
     }

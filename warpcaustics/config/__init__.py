@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from warpcaustics.config.caustics import (
     GREY_METHODS,
+    BeamBounds,
     BeamInterpolation,
     CausticsConfig,
     CausticsMethod,
@@ -41,6 +42,7 @@ from warpcaustics.config.water import BodyConfig, DropConfig, WaterConfig, Water
 __all__ = [
     "GREY_METHODS",
     "PLANNED_VALUES",
+    "BeamBounds",
     "BeamInterpolation",
     "BodyConfig",
     "CameraConfig",

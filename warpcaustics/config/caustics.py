@@ -37,6 +37,12 @@ class SunMapVariant(str, enum.Enum):
     PER_PIXEL = "per_pixel"
 
 
+class BeamBounds(str, enum.Enum):
+    HULL = "hull"
+    PRISM = "prism"
+    ERNST = "ernst"
+
+
 class BeamInterpolation(str, enum.Enum):
     SMOOTH = "smooth"
     FLAT = "flat"
@@ -83,6 +89,12 @@ class CausticsConfig:
     beam_tolerance: float = field(default=0.25, metadata=_range(0.0, 1.0e6))
     """Split an adaptive quad where a vertex's refracted ray, followed to its receiver, misses the
     quad's interpolated ray by more than this many surface cells [-]."""
+    beam_bounds: BeamBounds = BeamBounds.HULL
+    """The volume each beam's light shafts are bounded by on the screen (Liktor & Dachsbacher 2011
+    §4.3): ``hull`` (the convex hull of the beam's base and end vertices: the paper's 6-triangle
+    volume), ``prism`` (touching planes through the base edges, capped by the ends' plane) or
+    ``ernst`` (Ernst et al. 2005's prism as §4.3 gives it, capped parallel to the base). The image is
+    the same; only the pixels tested differ (docs/benchmarks.md)."""
     shafts: bool = True
     """Add light shafts (single scattering in the water: along each photon's path, or through each
     beam by scan planes) to the camera image."""

@@ -185,6 +185,7 @@ class UnderwaterCamera:
         G-buffer), add the scan-plane volume caustics, shade: (K, H, W) radiance."""
         from warpcaustics.caustics.beams import SCREEN_TILE_PIXELS, TileBins
         from warpcaustics.kernels.caustics import beams as beam_kernels
+        from warpcaustics.kernels.caustics.beams import bounds
 
         dev = self.device
         h, w = self.cfg.height, self.cfg.width
@@ -210,17 +211,17 @@ class UnderwaterCamera:
                 grid.wrap = 0
                 bins = self._screen_bins = TileBins(grid, items, dev).with_boxes()
                 self._box_pixels = wp.empty(items, dtype=wp.float32, device=dev)
-                self._pairs = wp.zeros(3, dtype=wp.int32, device=dev)
+                self._pairs = wp.zeros(4, dtype=wp.int32, device=dev)
+            self._pairs.zero_()
             wp.launch(
                 beam_kernels.screen_spans,
                 dim=items,
                 inputs=[bins.grid, self.cam, beams.base, beams.direction, beams.end_m, beams.weight, copies,
-                        beams.extent_m],
-                outputs=[bins.spans, bins.box_axis, bins.box_lo, bins.box_hi, self._box_pixels],
+                        beams.extent_m, getattr(bounds, beams.cfg.caustics.beam_bounds.name)],
+                outputs=[bins.spans, bins.box_axis, bins.box_lo, bins.box_hi, self._box_pixels, self._pairs],
                 device=dev,
             )
             bins.bin()
-            self._pairs.zero_()
             sb = beam_kernels.ShaftBeams()
             sb.beams, sb.copies = beams.gather_beams(), copies
             sb.soft_fade_m = float(beams.cfg.caustics.beam_soft_fade_m)
@@ -253,14 +254,16 @@ class UnderwaterCamera:
 
     def beam_fill(self) -> dict[str, float]:
         """Rasteriser fill of the last :meth:`render_beams` with shafts, as (pixel, beam copy) pairs:
-        in the axis-aligned screen boxes of the beams' hulls, in the tile lists, inside the oriented
-        boxes (where the scan plane is computed), and with a real chord through the beam."""
+        in the axis-aligned screen boxes of the beams' bounding volumes, in the tile lists, inside
+        the oriented boxes (where the scan plane is computed), and with a real chord through the
+        beam; and the beam copies whose prism (``caustics.beam_bounds``) fell back to the hull."""
         pairs = self._pairs.numpy()
         return {
             "box_pixels": float(self._box_pixels.numpy().astype(np.float64).sum()),
             "tile_pairs": int(pairs[0]),
             "oriented_box_pairs": int(pairs[1]),
             "inside_pairs": int(pairs[2]),
+            "hull_fallbacks": int(pairs[3]),
         }
 
     def gbuffer(self) -> dict[str, np.ndarray]:

@@ -11,6 +11,7 @@ run to run; on the CPU launches are serial and the result is deterministic.
 
 import warp as wp
 
+from warpcaustics.kernels.caustics.beams.bounds import bound_corners
 from warpcaustics.kernels.caustics.beams.section import copy_offset, safe_area, section_vertex, shadow_slack
 from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera
 
@@ -226,28 +227,17 @@ def hull_edge(cam: PinholeCamera, a: wp.vec3, b: wp.vec3, axis: wp.vec2, lo: wp.
 
 
 @wp.func
-def hull_box(
-    cam: PinholeCamera,
-    base: wp.array2d[wp.vec3],
-    direction: wp.array2d[wp.vec3],
-    end_m: wp.array2d[wp.float32],
-    b: int,
-    shift: wp.vec3,
-    axis: wp.vec2,
-):
-    """The box, in the screen frame (axis, perp(axis)), of the beam's hull: the convex hull of its
-    base and end vertices (which holds its bilinear side patches), clipped to the near plane."""
+def volume_box(cam: PinholeCamera, lower: wp.mat33, upper: wp.mat33, axis: wp.vec2):
+    """The box, in the screen frame (axis, perp(axis)), of a convex volume given by its lower and
+    upper triangles and the corner lines joining them (:func:`bound_corners`), clipped to the near
+    plane: every edge's projected part in front of it."""
     lo = wp.vec2(1.0e30)
     hi = wp.vec2(-1.0e30)
     for i in range(3):
         i1 = (i + 1) % 3
-        a = base[b, i] + shift
-        e = a + end_m[b, i] * direction[b, i]
-        a1 = base[b, i1] + shift
-        e1 = a1 + end_m[b, i1] * direction[b, i1]
-        lo, hi = hull_edge(cam, a, e, axis, lo, hi)
-        lo, hi = hull_edge(cam, a, a1, axis, lo, hi)
-        lo, hi = hull_edge(cam, e, e1, axis, lo, hi)
+        lo, hi = hull_edge(cam, lower[i], upper[i], axis, lo, hi)
+        lo, hi = hull_edge(cam, lower[i], lower[i1], axis, lo, hi)
+        lo, hi = hull_edge(cam, upper[i], upper[i1], axis, lo, hi)
     return lo, hi
 
 
@@ -261,15 +251,19 @@ def screen_spans(
     weight: wp.array[wp.float32],
     copies: int,
     extent_m: float,
+    bounds: int,
     spans: wp.array2d[wp.int32],
     box_axis: wp.array[wp.vec2],
     box_lo: wp.array[wp.vec2],
     box_hi: wp.array[wp.vec2],
     box_pixels: wp.array[wp.float32],
+    tally: wp.array[wp.int32],
 ):
-    """Screen bounds of each beam copy ``b · copies² + c``: the tile span of its hull's screen box
-    and an oriented box along the beam's projected axis (base centroid → end centroid) that the
-    tiles and pixels are then tested against. ``box_pixels``: pixels of the axis-aligned box."""
+    """Screen bounds of each beam copy ``b · copies² + c``: the tile span of the screen box of its
+    bounding volume (``bounds``: ``bounds.HULL``, ``PRISM`` or ``ERNST``) and an oriented box
+    along the beam's projected axis (base centroid → end centroid) that the tiles and pixels are
+    then tested against. ``box_pixels``: pixels of the axis-aligned box; ``tally[3]`` counts the
+    beam copies whose prism fell back to the hull."""
     item = wp.tid()
     per_beam = copies * copies
     b = item / per_beam
@@ -281,7 +275,10 @@ def screen_spans(
         empty_span(spans, item)
         return
     shift = copy_offset(item % per_beam, copies, extent_m)
-    lo, hi = hull_box(cam, base, direction, end_m, b, shift, wp.vec2(1.0, 0.0))
+    lower, upper, used = bound_corners(base, direction, end_m, b, shift, bounds)
+    if used == 0:
+        wp.atomic_add(tally, 3, 1)
+    lo, hi = volume_box(cam, lower, upper, wp.vec2(1.0, 0.0))
     w = float(cam.width)
     h = float(cam.height)
     if lo[0] > hi[0] or hi[0] < 0.0 or hi[1] < 0.0 or lo[0] >= w or lo[1] >= h:
@@ -303,7 +300,7 @@ def screen_spans(
         delta = screen_xy(cam, ce, ze) - screen_xy(cam, cb, zb)
         if wp.length(delta) > 1.0:
             axis = wp.normalize(delta)
-    olo, ohi = hull_box(cam, base, direction, end_m, b, shift, axis)
+    olo, ohi = volume_box(cam, lower, upper, axis)
     box_axis[item] = axis
     box_lo[item] = olo
     box_hi[item] = ohi
