@@ -551,7 +551,8 @@ def run(quick: bool, device: str) -> dict:
     print(f"beams        bounding volumes on {fill['beams_measured']} beams in view: tight hull "
           f"{fill['hull_pixels']:.4g} px, prism {fill['prism_pixels']:.4g} px, Ernst's prism "
           f"{fill['ernst_pixels']:.4g} px; where the beams are {fill['beam_pixels']} px: fill hull "
-          f"{fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}, Ernst {fill['ernst_fill']:.2f}", flush=True)
+          f"{fill['hull_fill']:.2f}, prism {fill['prism_fill']:.2f}, Ernst {fill['ernst_fill']:.2f}",
+          flush=True)
     bounds = _bounds_case(sizes["camera_n"], sizes["camera"], device, max(warp_repeats, 3))
     for r in bounds:
         print(f"beams        beam_bounds = {r['beam_bounds']:5s} volume pass {r['volume_s'] * 1e3:8.1f} ms "

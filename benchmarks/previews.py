@@ -4,8 +4,9 @@ the default 0.53° disk costs the flux-ratio map, photons and beams a pass per d
 - ``docs/images/ocean.png``: frame 0 of configs/ocean.toml;
 - ``docs/images/pool_frames.png``: six frames of configs/pool.toml side by side (0.25 s apart),
   the pool stepping forward from frame to frame;
-- ``docs/images/{ocean_floor,pool_pots,buried_in_sand}.png``: the camera images of the photon
-  configs (the pools stepped to 1 s, so that their drops have spread into waves);
+- ``docs/images/{ocean_floor,pool_pots,buried_in_sand,above_water}.png``: the camera images of the
+  photon configs and of the view from above (the pools stepped to 1 s, so that their drops have
+  spread into waves);
 - ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots and ocean_floor by
   photons (left) and by beams (right, ``caustics.method = "both"``);
 - ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
@@ -39,8 +40,9 @@ def _camera_preview(result) -> np.ndarray:
     return colour_out.tone_map_srgb8(colour_out.xyz_to_linear_srgb(xyz), xyz[..., 1])
 
 
-CAMERA_SCENES = {"ocean_floor": 0.0, "pool_pots": 1.0, "buried_in_sand": 1.0}
-"""Photon configs with a camera, and the time [s] their picture shows."""
+CAMERA_SCENES = {"ocean_floor": 0.0, "pool_pots": 1.0, "buried_in_sand": 1.0, "above_water": 1.0}
+"""Configs with a camera (photons; above_water: beams, seen from above), and the time [s] their
+picture shows."""
 
 
 def main() -> int:

@@ -265,6 +265,9 @@ def main(argv: list[str] | None = None) -> int:
     # Sun-map caustics vs the flux-ratio map of the same frame (benchmarks/sunmap.py).
     sunmap = _in_child("run", args.quick, args.device, module="sunmap")
 
+    # The camera above the water against the camera under it (benchmarks/above_water.py).
+    above_water = _in_child("run", args.quick, args.device, module="above_water")
+
     # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
     eikonal = _in_child("run", args.quick, args.device, module="eikonal")
 
@@ -301,6 +304,7 @@ def main(argv: list[str] | None = None) -> int:
         "photons": photons,
         "beams": beams,
         "sunmap": sunmap,
+        "above_water": above_water,
         "eikonal": eikonal,
         "sun_disk": sun_disk,
         "multiple": multiple,

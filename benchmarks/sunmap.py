@@ -86,8 +86,9 @@ def run(quick: bool, device: str) -> dict:
             rows.append(row)
             print(f"sunmap       {config:24s} N={n:5d} M={m:5d} K={row['bins']:3d} | sun map "
                   f"{row['sunmap_s'] * 1e3:9.2f} ms | flux ratio {row['fluxratio_s'] * 1e3:9.2f} ms | "
-                  f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | per pixel {row['per_pixel_s'] * 1e3:8.2f} "
-                  f"ms ({row['speedup_per_pixel_vs_per_vertex']:4.2f}x per vertex's speed) | L1 vs flux ratio "
+                  f"ratio {row['speedup_sunmap_vs_fluxratio']:6.1f}x | per pixel "
+                  f"{row['per_pixel_s'] * 1e3:8.2f} ms ({row['speedup_per_pixel_vs_per_vertex']:4.2f}x per "
+                  "vertex's speed) | L1 vs flux ratio "
                   f"{row['relative_l1_sunmap_vs_fluxratio']:.2f}, correlation "
                   f"{row['correlation_sunmap_vs_fluxratio']:.2f}", flush=True)
     return {"benchmark": "sunmap_vs_fluxratio", **record, "repeats": repeats,

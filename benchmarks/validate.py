@@ -269,7 +269,8 @@ def _sunmap_variants() -> None:
     for sun, overrides in (("the config's sun", {}), ("sun at 30°", {"sun.elevation_deg": 30.0})):
         for r in sunmap_variant_rows(overrides=overrides):
             print(f"{r['config']:24s} {sun:16s} t={r['time_s']:.1f} s {r['variant']:10s} correlation "
-                  f"{r['correlation']:6.3f}  relative L1 {r['relative_l1']:.3f}  contrast {r['contrast']:.3f} "
+                  f"{r['correlation']:6.3f}  relative L1 {r['relative_l1']:.3f}  contrast "
+                  f"{r['contrast']:.3f} "
                   f"(flux ratio {r['reference_contrast']:.3f})")
 
 

@@ -137,7 +137,8 @@ def test_hull_is_the_beams_own_corners():
     [
         (CONFIGS / "ocean_floor.toml", {"water.resolution": 32}),
         (CONFIGS / "pool.toml", {"water.resolution": 32, "camera.enabled": True,
-                                 "camera.position_m": [-1.5, -1.5, -0.6], "camera.look_at_m": [1.0, 0.5, -1.4],
+                                 "camera.position_m": [-1.5, -1.5, -0.6],
+                                 "camera.look_at_m": [1.0, 0.5, -1.4],
                                  "optics.water_type": "coastal_ocean"}),
     ],
     ids=["periodic-sea", "walled-pool"],

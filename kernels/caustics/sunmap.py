@@ -66,7 +66,8 @@ def sun_brightness(params: SunMap, ray: wp.vec3) -> float:
     c = wp.dot(ray, params.sun_dir)
     if c >= params.cos_disk:
         return 1.0
-    return brightness_at(params, wp.atan2(wp.length(wp.cross(ray, params.sun_dir)), c))  # not acos: exact near 0
+    # atan2, not acos: exact near 0
+    return brightness_at(params, wp.atan2(wp.length(wp.cross(ray, params.sun_dir)), c))
 
 
 @wp.func

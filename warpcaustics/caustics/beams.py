@@ -344,6 +344,7 @@ class BeamCaustics(PassCaustics):
             device=dev,
         )
         self._points_binned = False
+        self._volume_binned = False
         k, m = self.k, self.m
         self._bin_horizontal(self.floor_bins, *self.floor_z_range)
         wp.launch(
@@ -473,6 +474,23 @@ class BeamCaustics(PassCaustics):
             outputs=[out],
             device=self.device,
         )
+        return out
+
+    def inscatter(self, sb: beam_kernels.ShaftBeams, points: wp.array, views: wp.array, along_m: wp.array,
+                  piece_m: wp.array, out: wp.array2d, top_z: float) -> wp.array2d:
+        """Add to ``out`` (K, P) one midpoint piece of the single scattering into view rays at
+        ``points`` from the beams of the pass being traced (``kernels/caustics/beams/volume.py
+        point_inscatter``; ``sb``: the medium's scattering and phase function). The beams are
+        binned over the whole water column, from the receivers' lowest point to ``top_z``."""
+        if not self._volume_binned:
+            if getattr(self, "volume_bins", None) is None:
+                self.volume_bins = TileBins(self.point_bins.grid, self.weight.shape[0], self.device)
+            self._bin_horizontal(self.volume_bins, self.query_z[0], top_z)
+            self._volume_binned = True
+        sb.beams = self.gather_beams()
+        wp.launch(beam_kernels.point_inscatter, dim=points.shape[0],
+                  inputs=[*self.volume_bins.inputs(), sb, points, views, along_m, piece_m], outputs=[out],
+                  device=self.device)
         return out
 
     def _face_flux_w_nm(self) -> np.ndarray:

@@ -1,5 +1,6 @@
 """What the receiver methods (photons, beams, both) share: every receiver lit (relief, walls,
-meshes), the under-water camera fed, one light pass per direction of the sun's disk and of the sky."""
+meshes), the camera fed (under the water, or above it: ``scene/above.py``), one light pass per
+direction of the sun's disk and of the sky."""
 
 from __future__ import annotations
 
@@ -9,9 +10,11 @@ from typing import ClassVar
 import numpy as np
 
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
+from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.optics.refraction import still_water_refraction, sun_visibility
+from warpcaustics.scene.above import AboveWaterCamera, above_camera_bytes
 from warpcaustics.scene.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.scene.receivers import WALL_FACES, Receivers, floor_mesh_cells, floor_relief_height
 
@@ -168,7 +171,12 @@ class ReceiverStage(CausticStage):
             for direction in lights:
                 check_meshes_inside_patch(cfg, scene.receiver_meshes, direction, light.group_ior)
         self.camera = None
-        if cfg.camera.enabled:
+        if cfg.camera.enabled and cfg.camera.position_m[2] > 0.0:  # the view from above the water
+            sky = scene.sky_irradiance(light.sun_irradiance) if cfg.sky.model is not SkyModel.NONE else None
+            self.camera = AboveWaterCamera(cfg, self.receivers, light, light.optics.scattering_per_m,
+                                           PhaseFunction.from_optics(cfg.optics, device), scene.sun_direction,
+                                           sky, device)
+        elif cfg.camera.enabled:
             check_camera_position(cfg, scene.floor_relief, periodic)
             self.camera = UnderwaterCamera(cfg.camera, self.receivers, light.optics.scattering_per_m,
                                            PhaseFunction.from_optics(cfg.optics, device), device)
@@ -188,7 +196,11 @@ class ReceiverStage(CausticStage):
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
         cfg = scene.config
         faces = receiver_face_estimate(scene, cfg.water.periodic)
-        cam = camera_bytes(cfg.camera, k) if cfg.camera.enabled else 0
+        cam = 0
+        if cfg.camera.enabled:
+            above = cfg.camera.position_m[2] > 0.0
+            cam = (above_camera_bytes(cfg, k, scene.water_resolution) if above
+                   else camera_bytes(cfg.camera, k))
         return cls.caustics_bytes(scene, scene.water_resolution, k, groups, faces) + cam
 
     def check_frame(self, frame: Frame) -> None:
@@ -197,11 +209,17 @@ class ReceiverStage(CausticStage):
                 f"a receiver reaches z = {self.receivers.mesh_top_z:.3f} m, above the water surface's "
                 f"lowest point z = {frame.lowest:.3f} m at t = {frame.time_s:g} s; receivers must stay under "
                 "the water: lower them (receivers[].translate_m) or make the floor deeper")
-        if self.camera is not None and self.camera.position_z >= frame.lowest:
+        if getattr(self.camera, "above_water", False):
+            if self.camera.position_z <= frame.highest:
+                raise WarpcausticsError(
+                    f"camera.position_m z = {self.camera.position_z:g} is not above the water (a crest "
+                    f"reaches z = {frame.highest:.3f} m at t = {frame.time_s:g} s); raise the camera "
+                    "above the waves")
+        elif self.camera is not None and self.camera.position_z >= frame.lowest:
             raise WarpcausticsError(
                 f"camera.position_m z = {self.camera.position_z:g} is not under the water (the "
                 f"surface reaches down to z = {frame.lowest:.3f} m at t = {frame.time_s:g} s); viewing from "
-                "above the water is not implemented yet: lower the camera")
+                "above the water needs the camera above every crest: lower it under the troughs or raise it")
 
     def render(self, frame: Frame) -> StageOutput:
         outputs = [self._passes(caustics, i == len(self.caustics) - 1, frame)
@@ -224,6 +242,10 @@ class ReceiverStage(CausticStage):
         extra = {}
         # with a second method, the first one's camera time is its own entry
         camera_stage = "camera" if last else f"camera_{caustics.timing_name}"
+        above = getattr(self.camera, "above_water", False)
+        if above:
+            with watch.stage(camera_stage):
+                self.camera.begin_frame(frame.surface, frame.highest)
         for direction, irradiance, from_sky in self.light.passes():
             if from_sky:
                 with watch.stage("sky"):
@@ -251,7 +273,9 @@ class ReceiverStage(CausticStage):
         if sky:
             extra["sky_floor_irradiance"] = sky["floor"].astype(np.float32)
         if self.camera is not None:
-            extra["camera_radiance"] = combined["camera_radiance"].astype(np.float32)
+            radiance = combined["camera_radiance"]
+            radiance = self.camera.finish(radiance) if above else radiance
+            extra["camera_radiance"] = radiance.astype(np.float32)
             extra["camera_gbuffer"] = self.camera.gbuffer()
         with watch.stage("readback"):
             extra.update(face_receiver=rec.face_receiver_np[rec.floor_face_count:],

@@ -52,8 +52,10 @@ class SunMapCaustics:
         grid."""
         m = self.brightness.shape[0]
         if isinstance(water, ProceduralWater):
+            kernel = (sunmap_kernels.sunmap_pixel_procedural if self.per_pixel
+                      else sunmap_kernels.sunmap_procedural)
             wp.launch(
-                sunmap_kernels.sunmap_pixel_procedural if self.per_pixel else sunmap_kernels.sunmap_procedural,
+                kernel,
                 dim=(m, m),
                 inputs=[self.params, water.waves, float(time_s)],
                 outputs=[self.brightness],

@@ -261,3 +261,8 @@ def _check_photon_scene(cfg: Config) -> None:
              view[0] * up[1] - view[1] * up[0])
     if math.hypot(*cross) <= 1e-9 * math.hypot(*view) * max(math.hypot(*up), 1e-300):
         raise ConfigError(f"camera.up = {list(up)} is parallel to the view direction; choose another up")
+    if cam.enabled and cam.position_m[2] > 0.0 and cfg.caustics.method is not CausticsMethod.BEAMS:
+        raise ConfigError(f"camera.position_m z = {cam.position_m[2]:g} puts the camera above the water, "
+                          "which needs caustics.method = \"beams\" (the beams light every point the "
+                          f"refracted rays meet; the method is {cfg.caustics.method.value!r}); or lower the "
+                          "camera below z = 0")

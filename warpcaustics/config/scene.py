@@ -64,10 +64,11 @@ class ReceiverConfig:
 @dataclass(frozen=True)
 class CameraConfig:
     enabled: bool = False
-    """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``); the camera is
-    under water."""
+    """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``; above the water,
+    ``"beams"``)."""
     position_m: tuple[float, ...] = field(default=(0.0, -6.0, -1.0), metadata=_coordinate())
-    """Pinhole position (x, y, z) [m]; must be below the water surface."""
+    """Pinhole position (x, y, z) [m]: below the water surface (z < 0), or above every crest (z > 0:
+    the view from above the water, through the refracting surface)."""
     look_at_m: tuple[float, ...] = field(default=(0.0, 0.0, -3.0), metadata=_coordinate())
     """Point the camera looks at (x, y, z) [m]."""
     up: tuple[float, ...] = field(default=(0.0, 0.0, 1.0), metadata=_coordinate())
@@ -78,3 +79,6 @@ class CameraConfig:
     """Image width [pixels]."""
     height: int = field(default=240, metadata=_range(8, 8192))
     """Image height [pixels]."""
+    shaft_samples: int = field(default=32, metadata=_range(1, 1024))
+    """Above the water: midpoint samples of the single scattering along each refracted view ray,
+    from the surface to the receiver it meets [-]."""

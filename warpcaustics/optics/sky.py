@@ -72,3 +72,29 @@ def cie_relative_radiance(sky_type: int, directions: np.ndarray, sun_direction: 
     sun_zenith = math.acos(min(max(float(s[2]), -1.0), 1.0))
     scale = _indicatrix(t, np.array(sun_zenith)) * _gradation(t, np.array(1.0))
     return _indicatrix(t, chi) * _gradation(t, d[..., 2]) / scale
+
+
+def sky_radiance(sky_type: int | None, directions: np.ndarray, sun_direction: np.ndarray,
+                 horizontal_irradiance: np.ndarray, quadrature: int = 256) -> np.ndarray:
+    """(..., K) spectral radiance [W m⁻² sr⁻¹ nm⁻¹] of the sky towards unit ``directions`` (..., 3),
+    zero below the horizon: the shape of CIE type ``sky_type`` (None: a uniform sky) scaled so that
+    the sky's irradiance on a horizontal plane is ``horizontal_irradiance`` (K,), i.e. L(ω) =
+    E_h rel(ω) / ∫ rel cos θ dΩ; the integral by the midpoint rule on ``quadrature`` rings of
+    equal cos²θ and twice as many azimuths (exactly π for the uniform sky)."""
+    d = np.asarray(directions, np.float64)
+    e = np.asarray(horizontal_irradiance, np.float64)
+    above = d[..., 2] > 0.0
+    if sky_type is None:
+        rel = above.astype(np.float64)
+        norm = math.pi
+    else:
+        up = np.where(above[..., None], d, np.array([0.0, 0.0, 1.0]))
+        rel = np.where(above, cie_relative_radiance(sky_type, up, sun_direction), 0.0)
+        # cos θ dΩ = ½ d(sin²θ) dφ: rings equal in sin²θ carry equal weight for a uniform sky
+        sin2 = (np.arange(quadrature) + 0.5) / quadrature
+        phi = (np.arange(2 * quadrature) + 0.5) * math.pi / quadrature
+        sin_t = np.sqrt(sin2)[:, None]
+        cos_t = np.sqrt(1.0 - sin2)[:, None]
+        grid = np.stack(np.broadcast_arrays(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t), axis=-1)
+        norm = float(cie_relative_radiance(sky_type, grid, sun_direction).mean()) * math.pi
+    return rel[..., None] * e / norm

@@ -40,6 +40,7 @@ from warpcaustics.kernels.caustics.beams.section import (
 from warpcaustics.kernels.caustics.beams.volume import (
     ScreenBins,
     ShaftBeams,
+    point_inscatter,
     scan_chord,
     scan_plane_radiance,
 )
@@ -58,6 +59,7 @@ __all__ = [
     "floor_texels",
     "horizontal_spans",
     "inside_triangle",
+    "point_inscatter",
     "point_irradiance",
     "refine_quads",
     "scan_chord",

@@ -5,15 +5,18 @@
 import warp as wp
 
 from warpcaustics.kernels.caustics.beams.irradiance import flux_density
-from warpcaustics.kernels.caustics.beams.raster import TileGrid, in_frame, tile_index
+from warpcaustics.kernels.caustics.beams.raster import TileGrid, in_frame, tile_index, tile_of
 from warpcaustics.kernels.caustics.beams.section import (
     BeamCorners,
     Beams,
     barycentrics,
     clamped_sample,
     copy_offset,
+    copy_range,
     load_corners,
     safe_area,
+    sample_beam,
+    section_vertex,
     shadow_slack,
     xy,
 )
@@ -362,3 +365,59 @@ def scan_plane_radiance(
         pixel_chords(bins, cam, rays, depth, sb, j, i, radiance, pairs)
     else:
         tile_chords(bins, cam, rays, depth, sb, j, i, radiance, pairs)
+
+
+@wp.kernel
+def point_inscatter(
+    grid: TileGrid,
+    tile_start: wp.array[wp.int32],
+    tile_count: wp.array[wp.int32],
+    tile_items: wp.array[wp.int32],
+    sb: ShaftBeams,
+    points: wp.array[wp.vec3],
+    views: wp.array[wp.vec3],
+    along_m: wp.array[wp.float32],
+    piece_m: wp.array[wp.float32],
+    radiance: wp.array2d[wp.float32],
+):
+    """One midpoint piece of a view ray's in-scattering integral, added to ``radiance`` (K, P): at
+    each point x of a ray seen along ``views`` (unit, away from the eye), ``piece · σ_s p(cos θ)
+    E⊥(x) exp(−c (ℓ(x) + s))`` summed over the beams of the point's horizontal tile (and their
+    periodic images) that hold it before their end: the same integrand as :func:`chord_radiance`,
+    sampled along a ray that does not start at the pinhole (the view from above the water, whose
+    rays refract at the surface). ``along_m``: s, the distance from where the ray entered the water."""
+    p_index = wp.tid()
+    piece = piece_m[p_index]
+    if piece <= 0.0:
+        return
+    x = points[p_index]
+    v = views[p_index]
+    t = tile_of(grid, xy(x))
+    if t < 0:
+        return
+    bm = sb.beams
+    start = tile_start[t]
+    for item in range(tile_count[t]):
+        b = tile_items[start + item]
+        s0 = section_vertex(bm.base[b, 0], bm.direction[b, 0], x[2])
+        s1 = section_vertex(bm.base[b, 1], bm.direction[b, 1], x[2])
+        s2 = section_vertex(bm.base[b, 2], bm.direction[b, 2], x[2])
+        lo = wp.min(wp.min(s0, s1), s2)
+        hi = wp.max(wp.max(s0, s1), s2)
+        kx0, kx1 = copy_range(lo[0], hi[0], x[0], 0.0, bm.extent_m, bm.periodic)
+        ky0, ky1 = copy_range(lo[1], hi[1], x[1], 0.0, bm.extent_m, bm.periodic)
+        for ky in range(ky0, ky1 + 1):
+            for kx in range(kx0, kx1 + 1):
+                q = x + wp.vec3(float(kx) * bm.extent_m, float(ky) * bm.extent_m, 0.0)
+                smp = sample_beam(bm, b, q)
+                if smp.inside == 0 or smp.beyond_end_m > shadow_slack(smp.area):
+                    continue
+                phase = phase_value(sb.phase_kind, sb.hg_g, sb.angles_rad, sb.log_phase, sb.cone_phase,
+                                    -wp.dot(smp.d, v))
+                f = piece * phase * flux_density(bm, b, smp, q[2], bm.periodic) / wp.abs(smp.d[2])
+                g = b / bm.beams_per_group
+                for jj in range(bm.wavelengths_per_group):
+                    k = g * bm.wavelengths_per_group + jj
+                    path = smp.path_m + along_m[p_index]
+                    light = bm.sun_irradiance[k] * wp.exp(-bm.attenuation_per_m[k] * path)
+                    radiance[k, p_index] = radiance[k, p_index] + f * sb.scattering_per_m[k] * light

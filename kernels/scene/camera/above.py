@@ -1,0 +1,178 @@
+"""The camera above the water (de la Fuente Caballé 2011 §4.2's scene division, by ray casting):
+each pixel's ray meets the moving surface, where Fresnel splits it into the reflected ray (the sky
+and the sun's glint, shaded on the host) and the refracted ray, which this module follows down to
+the first receiver; rays that miss the water meet the receivers in the air or the sky.
+
+The surface is a triangle mesh of the frame's displaced vertices (a periodic sea gets one more row
+and column, the first ones moved by a period, so the seam is closed), traced through
+``copies`` × ``copies`` periodic images; beyond them a periodic sea continues as still water at
+z = 0. Normals are the vertices' interpolated across each triangle (smooth shading, as the flux
+ratio's vertex normals)."""
+
+import warp as wp
+
+from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera, pixel_ray
+
+wp.set_module_options({"enable_backward": False})
+
+AIR = wp.constant(0)
+"""The ray does not meet the water: the sky, or a receiver in the air."""
+WATER = wp.constant(1)
+"""The ray meets the moving surface."""
+STILL = wp.constant(2)
+"""The ray meets the still sea beyond the periodic images traced."""
+
+
+@wp.kernel
+def water_vertices(
+    positions: wp.array2d[wp.vec3],
+    normals: wp.array2d[wp.vec3],
+    periodic: int,
+    extent_m: float,
+    points: wp.array[wp.vec3],
+    point_normals: wp.array[wp.vec3],
+):
+    """The mesh's vertices, row-major over (N + periodic)²: vertex (j, i) is the surface's; on a
+    periodic sea row or column N is row or column 0 moved by a period."""
+    j, i = wp.tid()
+    n = positions.shape[0]
+    side = n + periodic
+    p = positions[j % n, i % n]
+    if i >= n:
+        p = p + wp.vec3(extent_m, 0.0, 0.0)
+    if j >= n:
+        p = p + wp.vec3(0.0, extent_m, 0.0)
+    points[j * side + i] = p
+    point_normals[j * side + i] = normals[j % n, i % n]
+
+
+@wp.func
+def smooth_normal(points: wp.array[wp.vec3], point_normals: wp.array[wp.vec3], indices: wp.array[wp.int32],
+                  face: int, p: wp.vec3) -> wp.vec3:
+    """The vertex normals of ``face`` interpolated at its point ``p`` (barycentrics from the areas)."""
+    a = indices[3 * face]
+    b = indices[3 * face + 1]
+    c = indices[3 * face + 2]
+    pa = points[a]
+    pb = points[b]
+    pc = points[c]
+    n = wp.cross(pb - pa, pc - pa)
+    den = wp.dot(n, n)
+    if den <= 0.0:
+        return wp.normalize(point_normals[a])
+    la = wp.dot(wp.cross(pb - p, pc - p), n) / den
+    lb = wp.dot(wp.cross(pc - p, pa - p), n) / den
+    lc = 1.0 - la - lb
+    return wp.normalize(la * point_normals[a] + lb * point_normals[b] + lc * point_normals[c])
+
+
+@wp.kernel
+def surface_hits(
+    cam: PinholeCamera,
+    mesh: wp.uint64,
+    points: wp.array[wp.vec3],
+    point_normals: wp.array[wp.vec3],
+    indices: wp.array[wp.int32],
+    extent_m: float,
+    periodic: int,
+    copies: int,
+    rays: wp.array2d[wp.vec3],
+    hit: wp.array2d[wp.vec3],
+    normal: wp.array2d[wp.vec3],
+    kind: wp.array2d[wp.int32],
+):
+    """Each pixel's ray against the water: the nearest hit over the periodic images, the smooth
+    normal there (pointing up, out of the water), and :data:`WATER`, :data:`STILL` or :data:`AIR`."""
+    j, i = wp.tid()
+    ray = pixel_ray(cam, i, j)
+    rays[j, i] = ray
+    best = float(1.0e30)
+    best_face = int(-1)
+    best_shift = wp.vec3(0.0)
+    r = copies / 2
+    for ky in range(-r, r + 1):
+        for kx in range(-r, r + 1):
+            shift = wp.vec3(float(kx) * extent_m, float(ky) * extent_m, 0.0)
+            q = wp.mesh_query_ray(mesh, cam.position - shift, ray, best)
+            if q.result and q.t < best:
+                best = q.t
+                best_face = q.face
+                best_shift = shift
+    kind[j, i] = AIR
+    hit[j, i] = cam.position
+    normal[j, i] = wp.vec3(0.0, 0.0, 1.0)
+    if best_face >= 0:
+        p = cam.position + best * ray
+        kind[j, i] = WATER
+        hit[j, i] = p
+        normal[j, i] = smooth_normal(points, point_normals, indices, best_face, p - best_shift)
+    elif periodic != 0 and ray[2] < 0.0:
+        kind[j, i] = STILL
+        hit[j, i] = cam.position + (-cam.position[2] / ray[2]) * ray
+
+
+@wp.kernel
+def first_receiver(
+    mesh: wp.uint64,
+    face_receiver: wp.array[wp.int32],
+    origins: wp.array2d[wp.vec3],
+    directions: wp.array2d[wp.vec3],
+    position: wp.array2d[wp.vec3],
+    normal: wp.array2d[wp.vec3],
+    depth: wp.array2d[wp.float32],
+    receiver: wp.array2d[wp.int32],
+):
+    """The first receiver along each pixel's ray from ``origins`` along the unit ``directions``
+    (below the surface: the refracted ray; in the air: the camera's): position, normal facing the
+    ray, distance and receiver id (−1 and depth 1e30 for none)."""
+    j, i = wp.tid()
+    o = origins[j, i]
+    d = directions[j, i]
+    q = wp.mesh_query_ray(mesh, o, d, 1.0e5)
+    if q.result:
+        n = q.normal
+        if wp.dot(n, d) > 0.0:
+            n = -n
+        position[j, i] = o + q.t * d
+        normal[j, i] = n
+        depth[j, i] = q.t
+        receiver[j, i] = face_receiver[q.face]
+    else:
+        position[j, i] = o + 1.0e5 * d
+        normal[j, i] = -d
+        depth[j, i] = 1.0e30
+        receiver[j, i] = -1
+
+
+@wp.kernel
+def segment_samples(
+    origins: wp.array2d[wp.vec3],
+    directions: wp.array2d[wp.vec3],
+    length_m: wp.array2d[wp.float32],
+    samples: int,
+    n: int,
+    points: wp.array[wp.vec3],
+    views: wp.array[wp.vec3],
+    along_m: wp.array[wp.float32],
+    piece_m: wp.array[wp.float32],
+):
+    """Sample ``n`` of ``samples`` midpoints along each pixel's underwater segment (flat, pixel-major):
+    the point, the view ray's direction, its distance from the surface and the piece's length (0
+    where the pixel has no segment)."""
+    j, i = wp.tid()
+    w = origins.shape[1]
+    p = j * w + i
+    length = length_m[j, i]
+    piece = length / float(samples)
+    s = (float(n) + 0.5) * piece
+    points[p] = origins[j, i] + s * directions[j, i]
+    views[p] = directions[j, i]
+    along_m[p] = s
+    piece_m[p] = piece
+
+
+@wp.kernel
+def scale_by(factor: wp.array3d[wp.float32], values: wp.array3d[wp.float32]):
+    """values *= factor, element by element (the water's radiance leaving through the surface)."""
+    k, j, i = wp.tid()
+    values[k, j, i] = values[k, j, i] * factor[k, j, i]

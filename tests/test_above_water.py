@@ -1,0 +1,135 @@
+"""The camera above the water (de la Fuente 2011 §4.2's scene division): still water against the
+analytic reflected + transmitted radiance, the sky seen directly, and the errors."""
+
+import math
+
+import numpy as np
+import pytest
+
+import warpcaustics as wc
+from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.optics import spectra
+from warpcaustics.optics.phase import PhaseFunction
+
+from helpers import fresnel_t_angles
+
+IOR = 1.333
+DEPTH_M = 2.0
+CAMERA = np.array([0.3, -1.0, 1.5])
+
+
+def _scene(**extra):
+    base = {
+        "caustics.method": "beams",
+        "water.model": "flat",
+        "water.extent_m": 8.0,
+        "water.resolution": 32,
+        "caustics.map_resolution": 32,
+        "floor.depth_m": DEPTH_M,
+        "floor.albedo": 0.5,
+        "optics.ior": IOR,
+        "optics.water_type": "coastal_ocean",
+        "optics.wavelengths": "rgb",
+        "sun.elevation_deg": 50.0,
+        "sun.azimuth_deg": 30.0,
+        "sun.angular_diameter_deg": 0.0,  # a point sun: the analytic light below, and no glint
+        "camera.enabled": True,
+        "camera.position_m": CAMERA.tolist(),
+        "camera.look_at_m": [0.0, 0.5, -DEPTH_M],
+        "camera.fov_deg": 30.0,
+        "camera.width": 24,
+        "camera.height": 16,
+        "camera.shaft_samples": 64,
+    }
+    base.update(extra)
+    return wc.load_scene(None, base)
+
+
+def _pixel_rays(cfg):
+    """(H, W, 3) unit pixel rays of the pinhole (kernels/scene/camera/pinhole.py's formula, float64)."""
+    cam = cfg.camera
+    f = np.asarray(cam.look_at_m, float) - np.asarray(cam.position_m, float)
+    f /= np.linalg.norm(f)
+    r = np.cross(f, cam.up)
+    r /= np.linalg.norm(r)
+    u = np.cross(r, f)
+    t = math.tan(math.radians(cam.fov_deg) / 2)
+    x = 2 * (np.arange(cam.width) + 0.5) / cam.width - 1
+    y = 1 - 2 * (np.arange(cam.height) + 0.5) / cam.height
+    d = f + (x[None, :, None] * t * cam.width / cam.height) * r + (y[:, None, None] * t) * u
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def test_still_water_matches_the_analytic_radiance():
+    """Still water, a point sun, no sky, coastal water (scattering, HG phase) over a grey floor:
+    each pixel is (1 − R(θ_v))/n² × [ρ/π E_floor e^{−c d} + ∫₀^d σ_s p(θ) E⊥ e^{−c(ℓ(s)+s)} ds]
+    (float64, written here), with E_floor = E_sun cosθ_s T(θ_s) e^{−cD/cosθ_t}, E⊥ = E_sun T(θ_s)
+    cosθ_s / cosθ_t, d = D/cosθ_v' the refracted view ray's length, ℓ(s) = s cosθ_v'/cosθ_t and
+    cos θ = −t_sun·t_view; the reflection of a black sky adds nothing. The shafts' 64 midpoint
+    samples leave < 1e-5; the rest is float32."""
+    scene = _scene()
+    renderer = wc.Renderer(scene, "cpu")
+    result = renderer.render(0.0)
+    cfg = scene.config
+    optics = spectra.water_optics(cfg.optics, spectra.bins_for(cfg.optics))
+    c = optics.attenuation_per_m[:, None, None]
+    b = optics.scattering_per_m[:, None, None]
+    e_sun = result.sun_irradiance[:, None, None]
+
+    sun = scene.sun_direction
+    theta_s = math.acos(sun[2])
+    t_s = fresnel_t_angles(np.array([theta_s]), 1.0, IOR)[0]
+    cos_ts = math.sqrt(1 - (math.sin(theta_s) / IOR) ** 2)
+    d_sun = -np.array([sun[0] / IOR, sun[1] / IOR, cos_ts])  # the refracted sun, going down
+    d_sun /= np.linalg.norm(d_sun)
+
+    v = _pixel_rays(cfg)
+    cos_v = -v[..., 2]
+    sin_v = np.sqrt(1 - cos_v**2)
+    t_view = fresnel_t_angles(np.arccos(cos_v), 1.0, IOR)
+    cos_vt = np.sqrt(1 - (sin_v / IOR) ** 2)
+    tv = np.concatenate([v[..., :2] / IOR, -cos_vt[..., None]], axis=-1)  # refracted view ray
+    d = DEPTH_M / cos_vt
+    # the floor point each refracted ray meets, as the renderer found it
+    hit = CAMERA + (CAMERA[2] / cos_v)[..., None] * v + d[..., None] * tv
+    np.testing.assert_allclose(result.camera_gbuffer["position"], hit, atol=2e-5)
+
+    e_floor = e_sun * math.cos(theta_s) * t_s * np.exp(-c * DEPTH_M / cos_ts)
+    floor = 0.5 / math.pi * e_floor * np.exp(-c * d)
+    phase_function = PhaseFunction.from_optics(cfg.optics, "cpu")
+    phase = phase_function.evaluate(-(tv @ d_sun).ravel(), "cpu").reshape(d.shape)
+    alpha = c * (cos_vt / cos_ts + 1.0)
+    shafts = b * phase * e_sun * t_s * math.cos(theta_s) / cos_ts * -np.expm1(-alpha * d) / alpha
+    expected = t_view / IOR**2 * (floor + shafts)
+    # the in-scattered part alone (the camera's buffer of the one pass), then the image
+    np.testing.assert_allclose(renderer.method.camera.shafts.numpy(), shafts, rtol=2e-4)
+    np.testing.assert_allclose(result.camera_radiance, expected, rtol=2e-4)
+
+
+def test_the_reflection_of_a_uniform_sky_is_r_e_over_pi():
+    """A uniform sky of horizontal irradiance E_sky: the water reflects R(θ_v) E_sky/π into each
+    pixel (the surface part, which the light passes do not give), and a pixel above the horizon
+    sees E_sky/π itself."""
+    scene = _scene(**{"sky.model": "uniform", "sky.diffuse_fraction": 0.2, "sky.directions": 4,
+                      "camera.look_at_m": [0.3, 3.0, 1.2], "camera.fov_deg": 60.0})
+    renderer = wc.Renderer(scene, "cpu")
+    renderer.render(0.0)
+    camera = renderer.method.camera
+    e_sky = scene.sky_irradiance(renderer.light.sun_irradiance)[:, None, None]
+    v = _pixel_rays(scene.config)
+    down = v[..., 2] < 0
+    assert 0.2 < down.mean() < 0.8
+    r = 1.0 - fresnel_t_angles(np.arccos(np.clip(-v[..., 2], 0, 1)), 1.0, IOR)
+    expected = np.where(down, r * e_sky / math.pi, e_sky / math.pi)
+    np.testing.assert_allclose(camera.surface_radiance, expected, rtol=1e-5)
+
+
+def test_above_water_errors():
+    """The view from above needs beams, and the camera above every crest."""
+    with pytest.raises(ConfigError, match="camera.position_m"):
+        _scene(**{"caustics.method": "photons"})
+    scene = _scene(**{"water.model": "fft", "water.wind_speed_m_s": 8.0,
+                      "camera.position_m": [0.3, -1.0, 0.01],
+                      "camera.shaft_samples": 2})
+    with pytest.raises(WarpcausticsError, match="raise the camera"):
+        wc.render(scene, device="cpu")
