@@ -374,7 +374,9 @@ def test_photon_scene_errors_are_one_line():
                 "camera.look_at_m": [0, 0, -3],
             },
         )
-    scene = _flat(60.0, 3.0, **{"camera.enabled": True, "camera.position_m": [0.0, -2.0, 0.5]})
+    with pytest.raises(ConfigError, match="camera.position_m z = 0.5 puts the camera above the water"):
+        _flat(60.0, 3.0, **{"camera.enabled": True, "camera.position_m": [0.0, -2.0, 0.5]})
+    scene = _flat(60.0, 3.0, **{"camera.enabled": True, "camera.position_m": [0.0, -2.0, 0.0]})
     with pytest.raises(WarpcausticsError, match="not under the water"):
         wc.render(scene, device="cpu")
 

@@ -16,11 +16,11 @@ from warpcaustics.config import Config, Intersection
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
 from warpcaustics.optics.refraction import still_water_refraction
-from warpcaustics.scene.receivers import WALLS_ID
+from warpcaustics.scene.receivers import FIRST_MESH_ID, WALLS_ID
 from warpcaustics.water import Surface
 
-PHOTON_BYTES = 12 + 12 + 4 + 12 + 4
-"""Per photon: origin, direction, weight, hit, face."""
+PHOTON_BYTES = 12 + 12 + 4 + 12 + 4 + 4
+"""Per photon: origin, direction, weight, hit, face, water path before its last segment."""
 
 
 def photon_count(cfg: Config, n: int, groups: int, periodic: bool) -> int:
@@ -32,8 +32,9 @@ def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face
     """Device memory of the photon stage, receivers included [bytes]."""
     m = cfg.caustics.map_resolution
     r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
+    carried = 4 if cfg.caustics.bounces > 1 else 0  # the weight left after the bounces
     return (
-        photon_count(cfg, n, groups, periodic) * PHOTON_BYTES
+        photon_count(cfg, n, groups, periodic) * (PHOTON_BYTES + carried)
         + 2 * k * m * m * 4
         + m * m * 4
         + r * r * 16
@@ -50,6 +51,14 @@ class PhotonStats:
     """Photons with non-zero weight (lit from the front, refracted downwards)."""
     landed: int
     """Photons that found a receiver."""
+    reflected_w_nm: np.ndarray | None = None
+    """``caustics.bounces`` > 1: (K,) flux reflected at glass receivers' faces (Fresnel) [W nm⁻¹],"""
+    beyond_limit_w_nm: np.ndarray | None = None
+    """that met a glass or specular receiver after its last bounce,"""
+    trapped_w_nm: np.ndarray | None = None
+    """still inside a glass receiver after its internal reflections,"""
+    missed_w_nm: np.ndarray | None = None
+    """and that met no receiver after a bounce; all at the point they left, attenuated on the way."""
 
 
 def light_view_direction(sun_dir: np.ndarray, group_ior: np.ndarray) -> np.ndarray:
@@ -76,6 +85,23 @@ def light_view_frame(points: np.ndarray, view_dir: np.ndarray, resolution: int):
     texel = span * (1.0 + 2.0 / resolution) / resolution
     origin = u * (a.min() - texel) + v * (b.min() - texel)
     return origin, u, v, texel
+
+
+def receiver_optics(cfg, receivers, group_ior: np.ndarray, device: str) -> photon_kernels.Optics:
+    """Per receiver id (floor, walls, ``receivers[i]``) its refractive index (0: opaque) and whether
+    it is a mirror, for ``caustics.bounces`` > 1."""
+    count = len(receivers.names)
+    ior = np.zeros(count, np.float32)
+    specular = np.zeros(count, np.int32)
+    for i, r in enumerate(cfg.receivers):
+        ior[FIRST_MESH_ID + i] = r.ior or 0.0
+        specular[FIRST_MESH_ID + i] = int(r.specular)
+    optics = photon_kernels.Optics()
+    optics.ior = wp.array(ior, dtype=wp.float32, device=device)
+    optics.specular = wp.array(specular, dtype=wp.int32, device=device)
+    optics.water_ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
+    optics.object_bounces = cfg.caustics.bounces - 1
+    return optics
 
 
 class PhotonCaustics(PassCaustics):
@@ -136,6 +162,15 @@ class PhotonCaustics(PassCaustics):
         self.newton_iterations = (
             cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
         )
+        self.path_before = wp.zeros(count, dtype=wp.float32, device=device)
+        """Water path before each photon's last segment [m] (0 without bounces)."""
+        self.carried = self.weight
+        """What each photon carries onto its receiver: its weight, less what the bounces left."""
+        self.optics = None
+        if cfg.caustics.bounces > 1:
+            self.carried = wp.empty(count, dtype=wp.float32, device=device)
+            self.tallies = wp.zeros((photon_kernels.TALLIES, k), dtype=wp.float64, device=device)
+            self.optics = receiver_optics(cfg, receivers, group_ior, device)
 
     def _light_view(self, view_dir: np.ndarray, resolution: int) -> photon_kernels.LightView:
         # The view needs the receivers where photons land: on a periodic sea that is the patch
@@ -193,24 +228,28 @@ class PhotonCaustics(PassCaustics):
             outputs=[self.origin, self.direction, self.weight],
             device=dev,
         )
-        wp.launch(
-            photon_kernels.trace_photons,
-            dim=self.weight.shape[0],
-            inputs=[
-                self.receivers.mesh.id,
-                self.view,
-                self.receivers.face_receiver,
-                self.newton_iterations,
-                extent,
-                int(self.periodic),
-                float(self.plane_z),
-                self.origin,
-                self.direction,
-                self.weight,
-            ],
-            outputs=[self.hit, self.face],
-            device=dev,
-        )
+        if self.optics is None:
+            wp.launch(
+                photon_kernels.trace_photons,
+                dim=self.weight.shape[0],
+                inputs=[self.receivers.mesh.id, self.view, self.receivers.face_receiver,
+                        self.newton_iterations, extent, int(self.periodic), float(self.plane_z), self.origin,
+                        self.direction, self.weight],
+                outputs=[self.hit, self.face],
+                device=dev,
+            )
+        else:
+            self.tallies.zero_()
+            wp.launch(
+                photon_kernels.trace_bounces,
+                dim=self.weight.shape[0],
+                inputs=[self.receivers.mesh.id, self.receivers.face_receiver, self.optics, extent,
+                        int(self.periodic), float(self.plane_z), self.sun_irradiance, self.attenuation_per_m,
+                        self.photons_per_group, self.sun_irradiance.shape[0] // self.groups, self.origin,
+                        self.direction, self.weight],
+                outputs=[self.carried, self.path_before, self.hit, self.face, self.tallies],
+                device=dev,
+            )
         self.texels.zero_()
         self.face_flux.zero_()
         wp.launch(
@@ -233,9 +272,10 @@ class PhotonCaustics(PassCaustics):
     def traced(self) -> photon_kernels.Photons:
         """The photons of the pass being traced as the deposit and the camera read them."""
         ph = photon_kernels.Photons()
-        for name in ("hit", "face", "origin", "direction", "weight", "photons_per_group", "sun_irradiance",
-                     "attenuation_per_m", "quads", "subdivisions"):
+        for name in ("hit", "face", "origin", "direction", "path_before", "photons_per_group",
+                     "sun_irradiance", "attenuation_per_m", "quads", "subdivisions"):
             setattr(ph, name, getattr(self, name))
+        ph.weight = self.carried
         ph.wavelengths_per_group = self.sun_irradiance.shape[0] // self.groups
         ph.extent_m, ph.periodic = float(self.cfg.water.extent_m), int(self.periodic)
         ph.floor_face_count = self.receivers.floor_face_count
@@ -259,11 +299,18 @@ class PhotonCaustics(PassCaustics):
 
     def _stats(self) -> PhotonStats:
         w = self.weight.numpy()
-        return PhotonStats(
+        stats = PhotonStats(
             emitted=len(w),
             carrying=int(np.count_nonzero(w > 0)),
             landed=int(np.count_nonzero(self.face.numpy() >= 0)),
         )
+        if self.optics is not None:
+            t = self.tallies.numpy()
+            stats.reflected_w_nm = t[photon_kernels.REFLECTED]
+            stats.beyond_limit_w_nm = t[photon_kernels.BEYOND_LIMIT]
+            stats.trapped_w_nm = t[photon_kernels.TRAPPED]
+            stats.missed_w_nm = t[photon_kernels.MISSED]
+        return stats
 
 
 class PhotonStage(ReceiverStage):

@@ -145,7 +145,8 @@ class PassCaustics:
                 radiance = camera.radiance.numpy().astype(np.float64)
         with watch.stage("readback"):
             return LightPass(floor.numpy().astype(np.float64), self._transmitted_flux(),
-                             self._face_flux_w_nm(), vars(self._stats()), radiance)
+                             self._face_flux_w_nm(),
+                             {k: v for k, v in vars(self._stats()).items() if v is not None}, radiance)
 
 
 class ReceiverStage(CausticStage):

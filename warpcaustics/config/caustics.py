@@ -68,6 +68,11 @@ class CausticsConfig:
     of a large sea; 0 = the whole water extent."""
     map_center_m: tuple[float, ...] = field(default=(0.0, 0.0), metadata=_coordinate())
     """Centre (x, y) of the floor-map window [m]."""
+    bounces: int = field(default=1, metadata=_range(1, 3))
+    """Specular interactions a photon may make: 1 = the water surface's refraction alone; 2 or 3 add
+    one or two passes through a glass receiver (``receivers[].ior``: in and out is one) or
+    reflections off a mirror (``receivers[].specular``) before the light lands (``photons`` with the
+    exact intersection) [-]."""
     intersection: Intersection = Intersection.EXACT
     """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
     ``newton`` (Shah's iteration on a receiver-position buffer rendered from the light, along the

@@ -219,6 +219,29 @@ def _check_eikonal_threshold(cfg: Config) -> None:
                           "caustic texture: it needs caustics.method = \"eikonal\"; or leave it unset")
 
 
+def _check_bounces(cfg: Config) -> None:
+    """Glass and mirror receivers need bounces, which the exact photons implement."""
+    c = cfg.caustics
+    special = [i for i, r in enumerate(cfg.receivers) if r.ior is not None or r.specular]
+    for i in special:
+        r = cfg.receivers[i]
+        if r.ior is not None and r.specular:
+            raise ConfigError(f"receivers[{i}] sets both ior and specular; a receiver is glass (ior) or a "
+                              "mirror (specular), not both")
+    if c.bounces > 1:
+        if c.method is not CausticsMethod.PHOTONS or c.intersection is not Intersection.EXACT:
+            raise ConfigError(f"caustics.bounces = {c.bounces} is implemented for caustics.method = "
+                              "\"photons\" with caustics.intersection = \"exact\" (the method is "
+                              f"{c.method.value!r}, {c.intersection.value!r}); or set caustics.bounces = 1")
+        if not special:
+            raise ConfigError(f"caustics.bounces = {c.bounces} has nothing to bounce off: give a receiver "
+                              "ior (glass) or specular = true; or set caustics.bounces = 1")
+    elif special:
+        key = "ior" if cfg.receivers[special[0]].ior is not None else "specular"
+        raise ConfigError(f"receivers[{special[0]}].{key} needs caustics.bounces = 2 or 3 (with 1 the light "
+                          "stops at the first receiver); or remove it")
+
+
 def _check_photon_scene(cfg: Config) -> None:
     """Receivers other than a flat floor, and the camera, need the photon or beam method."""
     _check_beam_levels(cfg)
@@ -261,6 +284,7 @@ def _check_photon_scene(cfg: Config) -> None:
              view[0] * up[1] - view[1] * up[0])
     if math.hypot(*cross) <= 1e-9 * math.hypot(*view) * max(math.hypot(*up), 1e-300):
         raise ConfigError(f"camera.up = {list(up)} is parallel to the view direction; choose another up")
+    _check_bounces(cfg)
     if cam.enabled and cam.position_m[2] > 0.0 and cfg.caustics.method is not CausticsMethod.BEAMS:
         raise ConfigError(f"camera.position_m z = {cam.position_m[2]:g} puts the camera above the water, "
                           "which needs caustics.method = \"beams\" (the beams light every point the "

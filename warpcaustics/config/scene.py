@@ -59,6 +59,12 @@ class ReceiverConfig:
     """Diffuse albedo: one value (grey) or three (linear sRGB, as for the floor) [-]."""
     albedo_file: str | None = None
     """CSV of a reflectance spectrum (as ``floor.albedo_file``); replaces ``albedo``."""
+    ior: float | None = field(default=None, metadata=_range(1.0, 4.0))
+    """With ``caustics.bounces`` > 1: a clear, non-absorbing dielectric of this refractive index
+    (glass ≈ 1.5) that the light passes through (Fresnel at both faces) instead of landing on;
+    unset = opaque and diffuse [-]."""
+    specular: bool = False
+    """With ``caustics.bounces`` > 1: a perfect mirror that reflects all the light it meets."""
 
 
 @dataclass(frozen=True)

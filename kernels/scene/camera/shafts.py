@@ -125,7 +125,7 @@ def shaft_lines(
                         geometry
                         * ph.sun_irradiance[k]
                         * scattering_per_m[k]
-                        * wp.exp(-ph.attenuation_per_m[k] * (ell + s)),
+                        * wp.exp(-ph.attenuation_per_m[k] * (ph.path_before[p] + ell + s)),
                     )
 
 

@@ -208,7 +208,7 @@ def splat_photons(
         return
     x = ph.hit[p] + wp.vec3(float(copy % 3 - 1) * extent_m, float(copy / 3 - 1) * extent_m, 0.0)
     c = project(cam, x)
-    ell = wp.length(ph.hit[p] - ph.origin[p])  # the copy's path is the photon's own
+    ell = ph.path_before[p] + wp.length(ph.hit[p] - ph.origin[p])  # the copy's path is the photon's own
     g = p / ph.photons_per_group
     w = ph.weight[p]
     eu, ev, ok = photon_lattice(
