@@ -268,6 +268,9 @@ def main(argv: list[str] | None = None) -> int:
     # The camera above the water against the camera under it (benchmarks/above_water.py).
     above_water = _in_child("run", args.quick, args.device, module="above_water")
 
+    # Photons through a glass receiver against the same receiver opaque (benchmarks/bounces.py).
+    bounces = _in_child("run", args.quick, args.device, module="bounces")
+
     # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
     eikonal = _in_child("run", args.quick, args.device, module="eikonal")
 
@@ -305,6 +308,7 @@ def main(argv: list[str] | None = None) -> int:
         "beams": beams,
         "sunmap": sunmap,
         "above_water": above_water,
+        "bounces": bounces,
         "eikonal": eikonal,
         "sun_disk": sun_disk,
         "multiple": multiple,
