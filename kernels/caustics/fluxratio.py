@@ -232,6 +232,82 @@ class FloorMap:
     for whole maps; a window's texels are few and fine, so all of them are clipped exactly."""
 
 
+@wp.func
+def spread_triangle(
+    dep: TriangleDeposit,
+    q0: wp.vec2,
+    e1: wp.vec2,
+    e2: wp.vec2,
+    m: int,
+    wrap: int,
+    max_clipped: int,
+    inv_texel_area: float,
+    coarse_count: wp.array[wp.int32],
+):
+    """Spread ``dep``'s flux over the triangle (q0, q0 + e1, q0 + e2) [texels of an M × M map; q0
+    within it when ``wrap``]: each texel gets overlap area / triangle area × ``inv_texel_area`` of it,
+    the overlap clipped exactly (texels outside an unwrapped map are dropped). Triangles whose box
+    exceeds ``max_clipped`` texels go by area samples, counted in ``coarse_count``."""
+    q1 = q0 + e1
+    q2 = q0 + e2
+    u_lo = wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0])))
+    v_lo = wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1])))
+    u_hi = wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0])))
+    v_hi = wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1])))
+    single_texel = u_lo == u_hi and v_lo == v_hi
+    if wrap == 0:  # only the texels inside the map are visited
+        u_lo = wp.max(u_lo, 0.0)
+        v_lo = wp.max(v_lo, 0.0)
+        u_hi = wp.min(u_hi, float(m - 1))
+        v_hi = wp.min(v_hi, float(m - 1))
+        if u_lo > u_hi or v_lo > v_hi:
+            return  # the footprint misses the map
+    if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(max_clipped):
+        # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
+        wp.atomic_add(coarse_count, 0, 1)
+        deposit_by_samples(dep, q0, e1, e2, m, wrap, inv_texel_area)
+        return
+    i_lo = int(u_lo)
+    j_lo = int(v_lo)
+    i_hi = int(u_hi)
+    j_hi = int(v_hi)
+    # Coordinates relative to the footprint's first texel keep the clipping arithmetic small.
+    corner = wp.vec2(u_lo, v_lo)
+    q0 = q0 - corner
+    q1 = q1 - corner
+    q2 = q2 - corner
+    area = 0.5 * wp.abs(e1[0] * e2[1] - e2[0] * e1[1])
+    if area < DEGENERATE_AREA_TEXELS or single_texel:
+        c = (q0 + q1 + q2) / 3.0
+        tx = texel(i_lo + int(wp.floor(c[0])), m, wrap)
+        ty = texel(j_lo + int(wp.floor(c[1])), m, wrap)
+        add_to_texel(dep, tx, ty, inv_texel_area)
+        return
+    px = vec8()
+    py = vec8()
+    px[0] = q0[0]
+    py[0] = q0[1]
+    px[1] = q1[0]
+    py[1] = q1[1]
+    px[2] = q2[0]
+    py[2] = q2[1]
+    for ci in range(i_hi - i_lo + 1):
+        cx, cy, cn = clip_to_slab(px, py, 3, 0, float(ci), float(ci + 1))
+        if cn < 3:
+            continue
+        # Only the rows this column's piece of the footprint spans.
+        y_min = cy[0]
+        y_max = cy[0]
+        for v in range(1, cn):
+            y_min = wp.min(y_min, cy[v])
+            y_max = wp.max(y_max, cy[v])
+        for cj in range(wp.max(int(wp.floor(y_min)), 0), wp.min(int(wp.floor(y_max)), j_hi - j_lo) + 1):
+            rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
+            if rn >= 3:
+                w = polygon_area(rx, ry, rn) / area * inv_texel_area
+                add_to_texel(dep, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
+
+
 @wp.kernel
 def deposit_footprints(
     hit_xy: wp.array3d[wp.vec2],
@@ -286,65 +362,7 @@ def deposit_footprints(
     q0 = (a - floor_map.origin) * scale
     if wrap != 0:
         q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    q1 = q0 + e1
-    q2 = q0 + e2
-    inv_texel_area = scale * scale  # 1 / texel area [m^-2]
-    u_lo = wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0])))
-    v_lo = wp.floor(wp.min(q0[1], wp.min(q1[1], q2[1])))
-    u_hi = wp.floor(wp.max(q0[0], wp.max(q1[0], q2[0])))
-    v_hi = wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1])))
-    single_texel = u_lo == u_hi and v_lo == v_hi
-    if wrap == 0:  # only the texels inside the map are visited
-        u_lo = wp.max(u_lo, 0.0)
-        v_lo = wp.max(v_lo, 0.0)
-        u_hi = wp.min(u_hi, float(m - 1))
-        v_hi = wp.min(v_hi, float(m - 1))
-        if u_lo > u_hi or v_lo > v_hi:
-            return  # the footprint misses the map
-    if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(floor_map.max_clipped):
-        # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
-        wp.atomic_add(coarse_count, 0, 1)
-        deposit_by_samples(dep, q0, e1, e2, m, wrap, inv_texel_area)
-        return
-    i_lo = int(u_lo)
-    j_lo = int(v_lo)
-    i_hi = int(u_hi)
-    j_hi = int(v_hi)
-    # Coordinates relative to the footprint's first texel keep the clipping arithmetic small.
-    corner = wp.vec2(u_lo, v_lo)
-    q0 = q0 - corner
-    q1 = q1 - corner
-    q2 = q2 - corner
-    area = 0.5 * wp.abs(e1[0] * e2[1] - e2[0] * e1[1])
-    if area < DEGENERATE_AREA_TEXELS or single_texel:
-        c = (q0 + q1 + q2) / 3.0
-        tx = texel(i_lo + int(wp.floor(c[0])), m, wrap)
-        ty = texel(j_lo + int(wp.floor(c[1])), m, wrap)
-        add_to_texel(dep, tx, ty, inv_texel_area)
-        return
-    px = vec8()
-    py = vec8()
-    px[0] = q0[0]
-    py[0] = q0[1]
-    px[1] = q1[0]
-    py[1] = q1[1]
-    px[2] = q2[0]
-    py[2] = q2[1]
-    for ci in range(i_hi - i_lo + 1):
-        cx, cy, cn = clip_to_slab(px, py, 3, 0, float(ci), float(ci + 1))
-        if cn < 3:
-            continue
-        # Only the rows this column's piece of the footprint spans.
-        y_min = cy[0]
-        y_max = cy[0]
-        for v in range(1, cn):
-            y_min = wp.min(y_min, cy[v])
-            y_max = wp.max(y_max, cy[v])
-        for cj in range(wp.max(int(wp.floor(y_min)), 0), wp.min(int(wp.floor(y_max)), j_hi - j_lo) + 1):
-            rx, ry, rn = clip_to_slab(cx, cy, cn, 1, float(cj), float(cj + 1))
-            if rn >= 3:
-                w = polygon_area(rx, ry, rn) / area * inv_texel_area
-                add_to_texel(dep, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
+    spread_triangle(dep, q0, e1, e2, m, wrap, floor_map.max_clipped, scale * scale, coarse_count)
 
 
 @wp.kernel
