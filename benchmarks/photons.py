@@ -37,9 +37,10 @@ QUICK_CAMERA = {"water.resolution": 64, "caustics.photon_subdivisions": 2, "caus
 
 
 def photon_scene(n: int, s: int, m: int, intersection: str, wavelengths=WAVELENGTHS):
-    """The ocean with photons, under the point sun of the numpy twin."""
+    """The ocean with photons, under the point sun of the numpy twin, deposited per texel (the twin's
+    histogram; the footprint splats are measured in benchmarks/photon_splats.py)."""
     return point_sun_scene(ROOT / "configs" / "ocean.toml", {
-        "caustics.method": "photons", "caustics.intersection": intersection,
+        "caustics.method": "photons", "caustics.intersection": intersection, "caustics.photon_splat": "texel",
         "caustics.photon_subdivisions": s, "caustics.map_resolution": m, "water.resolution": n,
         "optics.wavelengths": wavelengths})
 

@@ -297,14 +297,16 @@ class Photons:
 def deposit_photons(
     ph: Photons,
     floor_inv_area: wp.array2d[wp.float32],
+    splatted: wp.array[wp.int32],
     floor_texels: wp.array3d[wp.float32],
     face_flux: wp.array2d[wp.float32],
 ):
     """Add photon i's flux to the floor map texel under its hit (divided by that texel's true
-    floor area: irradiance) or, for other receivers, to its face's flux (F_other, K) [W nm^-1]."""
+    floor area: irradiance) or, for other receivers, to its face's flux (F_other, K) [W nm^-1].
+    Photons with ``splatted[i]`` = 1 were spread over their footprint already."""
     i = wp.tid()
     f = ph.face[i]
-    if f < 0:
+    if f < 0 or splatted[i] != 0:
         return
     g = i / ph.photons_per_group
     p = ph.hit[i]

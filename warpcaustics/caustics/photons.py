@@ -12,15 +12,16 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
-from warpcaustics.config import Config, Intersection
+from warpcaustics.config import Config, Intersection, PhotonSplat
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
+from warpcaustics.kernels.caustics import photon_footprints as footprint_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
 from warpcaustics.optics.refraction import still_water_refraction
 from warpcaustics.scene.receivers import FIRST_MESH_ID, WALLS_ID
 from warpcaustics.water import Surface
 
-PHOTON_BYTES = 12 + 12 + 4 + 12 + 4 + 4
-"""Per photon: origin, direction, weight, hit, face, water path before its last segment."""
+PHOTON_BYTES = 12 + 12 + 4 + 12 + 4 + 4 + 4
+"""Per photon: origin, direction, weight, hit, face, water path before its last segment, splatted."""
 
 
 def photon_count(cfg: Config, n: int, groups: int, periodic: bool) -> int:
@@ -33,8 +34,11 @@ def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face
     m = cfg.caustics.map_resolution
     r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
     carried = 4 if cfg.caustics.bounces > 1 else 0  # the weight left after the bounces
+    footprint = cfg.caustics.photon_splat is PhotonSplat.FOOTPRINT
+    splat = (4 * k if footprint else 0)  # each photon's flux per band for its footprint
     return (
-        photon_count(cfg, n, groups, periodic) * (PHOTON_BYTES + carried)
+        photon_count(cfg, n, groups, periodic) * (PHOTON_BYTES + carried + splat)
+        + (k * m * m * 4 if footprint else 0)
         + 2 * k * m * m * 4
         + m * m * 4
         + r * r * 16
@@ -162,6 +166,11 @@ class PhotonCaustics(PassCaustics):
         self.newton_iterations = (
             cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
         )
+        self.splatted = wp.zeros(count, dtype=wp.int32, device=device)
+        """1 where a photon was spread over its footprint on the floor map (``photon_splat``)."""
+        self.footprint = None
+        if cfg.caustics.photon_splat is PhotonSplat.FOOTPRINT:
+            self._footprint_buffers(cfg, count, k, m)
         self.path_before = wp.zeros(count, dtype=wp.float32, device=device)
         """Water path before each photon's last segment [m] (0 without bounces)."""
         self.carried = self.weight
@@ -171,6 +180,23 @@ class PhotonCaustics(PassCaustics):
             self.carried = wp.empty(count, dtype=wp.float32, device=device)
             self.tallies = wp.zeros((photon_kernels.TALLIES, k), dtype=wp.float64, device=device)
             self.optics = receiver_optics(cfg, receivers, group_ior, device)
+
+    def _footprint_buffers(self, cfg: Config, count: int, k: int, m: int) -> None:
+        """The footprint splats' map (irradiance per horizontal texel area), per-photon flux, and
+        the floor map's frame (the whole patch, wrapping on a periodic sea)."""
+        dev = self.device
+        self.footprint = wp.empty((m, m, k), dtype=wp.float32, device=dev)
+        self.splat_flux = wp.empty((count, 1, 1, k), dtype=wp.float32, device=dev)
+        self.coarse_count = wp.zeros(1, dtype=wp.int32, device=dev)
+        extent = cfg.water.extent_m
+        fm = floor_kernels.FloorMap()
+        fm.origin = wp.vec2(-0.5 * extent, -0.5 * extent)
+        fm.centre = wp.vec2(0.0, 0.0)
+        fm.scale = m / extent
+        fm.wrap = int(self.periodic)
+        fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS
+        self.floor_map = fm
+        self.spacing_m = extent / self.n / self.subdivisions
 
     def _light_view(self, view_dir: np.ndarray, resolution: int) -> photon_kernels.LightView:
         # The view needs the receivers where photons land: on a periodic sea that is the patch
@@ -252,14 +278,25 @@ class PhotonCaustics(PassCaustics):
             )
         self.texels.zero_()
         self.face_flux.zero_()
+        traced = self.traced()
+        if self.footprint is not None:
+            self.footprint.zero_()
+            wp.launch(footprint_kernels.splat_footprints, dim=self.weight.shape[0],
+                      inputs=[traced, self.receivers.face_receiver, self.receivers.face_normal,
+                              self.spacing_m, self.floor_map],
+                      outputs=[self.splat_flux, self.footprint, self.coarse_count, self.splatted], device=dev)
         wp.launch(
             photon_kernels.deposit_photons,
             dim=self.weight.shape[0],
-            inputs=[self.traced(), self.floor_inv_area],
+            inputs=[traced, self.floor_inv_area, self.splatted],
             outputs=[self.texels, self.face_flux],
             device=dev,
         )
         m = self.texels.shape[0]
+        if self.footprint is not None:
+            wp.launch(footprint_kernels.add_footprints, dim=(m, m, self.texels.shape[2]),
+                      inputs=[self.footprint, (self.cfg.water.extent_m / m) ** 2, self.floor_inv_area],
+                      outputs=[self.texels], device=dev)
         wp.launch(
             floor_kernels.texels_to_bands,
             dim=(m, m),

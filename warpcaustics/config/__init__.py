@@ -20,6 +20,7 @@ from warpcaustics.config.caustics import (
     CausticsConfig,
     CausticsMethod,
     Intersection,
+    PhotonSplat,
     SunMapVariant,
 )
 from warpcaustics.config.fields import PLANNED_VALUES
@@ -59,6 +60,7 @@ __all__ = [
     "OpticsConfig",
     "OutputConfig",
     "PetzoldStation",
+    "PhotonSplat",
     "PhaseFunctionKind",
     "ProbeConfig",
     "ReceiverConfig",

@@ -32,6 +32,11 @@ class Intersection(str, enum.Enum):
     EXACT = "exact"
 
 
+class PhotonSplat(str, enum.Enum):
+    TEXEL = "texel"
+    FOOTPRINT = "footprint"
+
+
 class SunMapVariant(str, enum.Enum):
     PER_VERTEX = "per_vertex"
     PER_PIXEL = "per_pixel"
@@ -77,6 +82,11 @@ class CausticsConfig:
     """How a ``photons`` photon finds its receiver: ``exact`` (ray query on the receivers' BVH) or
     ``newton`` (Shah's iteration on a receiver-position buffer rendered from the light, along the
     sun's refracted direction under still water)."""
+    photon_splat: PhotonSplat = PhotonSplat.FOOTPRINT
+    """How a ``photons`` photon lights the floor map: ``texel`` (its flux into the texel under its
+    hit) or ``footprint`` (spread evenly over its lattice cell, the parallelogram its grid
+    neighbours' hits span, clipped exactly into the texels; Frisvad et al. 2014's footprint from
+    finite differences; a photon without a cell keeps its texel)."""
     photon_subdivisions: int = field(default=4, metadata=_range(1, 64))
     """s: photons per surface cell are s×s [-]."""
     newton_iterations: int = field(default=3, metadata=_range(0, 64))
