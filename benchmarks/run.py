@@ -268,6 +268,9 @@ def main(argv: list[str] | None = None) -> int:
     # The camera above the water against the camera under it (benchmarks/above_water.py).
     above_water = _in_child("run", args.quick, args.device, module="above_water")
 
+    # Photon footprint splats against texel deposits (benchmarks/photon_splats.py).
+    photon_splats = _in_child("run", args.quick, args.device, module="photon_splats")
+
     # Photons through a glass receiver against the same receiver opaque (benchmarks/bounces.py).
     bounces = _in_child("run", args.quick, args.device, module="bounces")
 
@@ -309,6 +312,7 @@ def main(argv: list[str] | None = None) -> int:
         "sunmap": sunmap,
         "above_water": above_water,
         "bounces": bounces,
+        "photon_splats": photon_splats,
         "eikonal": eikonal,
         "sun_disk": sun_disk,
         "multiple": multiple,
