@@ -4,13 +4,14 @@ A photon stands for its stratum of the surface: an s×s share of a surface cell.
 refraction to the floor, the stratum becomes the photon's lattice cell, spanned by the steps to its
 grid neighbours' hits (``photon_lattice``: the finite-difference form of the ray differentials of
 Igehy 1999 that photon differential splatting uses, Schjøth et al. 2007; Frisvad, Schjøth, Erleben
-& Sporring 2014, CGF 33(6), whose footprint the two positional differentials span). The photon's flux is spread evenly over that parallelogram, centred on its hit, and
-deposited into the texels by exact area clipping (``fluxratio.spread_triangle``, two triangles):
-every texel gets overlap / cell area of it, so the flux is kept exactly, and the cells of a regular
-(affine) lattice tile the plane, so still water gives the analytic irradiance in every texel at any
-photon density. Focused light has small cells and stays sharp; spread light has large ones and is
-smooth. A photon without a cell (a silhouette, the edge of the lit region, a neighbour on another
-receiver) keeps the texel deposit.
+& Sporring 2014, CGF 33(6), whose footprint the two positional differentials span). The photon's
+flux is spread evenly over that parallelogram, centred on its hit, and deposited into the texels
+by exact area clipping (``fluxratio.spread_triangle``, two triangles): every texel gets overlap /
+cell area of it, so the flux is kept exactly, and the cells of a regular (affine) lattice tile the
+plane, so still water gives the analytic irradiance in every texel at any photon density. Focused
+light has small cells and stays sharp; spread light has large ones and is smooth. A photon without
+a cell (a silhouette, the edge of the lit region, a neighbour on another receiver) keeps the texel
+deposit.
 """
 
 import warp as wp
