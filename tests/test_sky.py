@@ -249,3 +249,26 @@ def test_cie_clear_sky_over_flat_water_is_the_analytic_integral():
 
         expected = e_sky[k] * hemisphere(through) / horizontal
         assert r.sky_floor_irradiance[k].mean() == pytest.approx(expected, rel=2e-3)
+
+
+@pytest.mark.parametrize("sky_type", [None, 1, 5, 12, 15])
+def test_sky_radiance_integrates_to_the_horizontal_irradiance(sky_type):
+    """optics/sky.py ``sky_radiance`` (what the camera above the water sees reflected): ∫ L cosθ dΩ
+    over the upper hemisphere is the requested horizontal irradiance per band, by a Gauss–Legendre
+    rule in cosθ (256 nodes) times the periodic trapezoid rule in φ (512), not the function's own
+    midpoint rule in sin²θ: 1e-4; zero below the horizon."""
+    from warpcaustics.optics.sky import sky_radiance
+
+    sun = np.array([0.3, -0.4, 0.866])
+    sun /= np.linalg.norm(sun)
+    e = np.array([0.8, 1.7])
+    x, w = np.polynomial.legendre.leggauss(256)
+    u, w = 0.5 * (x + 1.0), 0.5 * w  # cosθ on [0, 1]
+    phi = np.arange(512) * 2.0 * math.pi / 512
+    s_t = np.sqrt(1.0 - u * u)[:, None]
+    d = np.stack(np.broadcast_arrays(s_t * np.cos(phi), s_t * np.sin(phi), u[:, None]), axis=-1)
+    radiance = sky_radiance(sky_type, d, sun, e)  # (256, 512, 2)
+    total = (radiance * (w * u)[:, None, None]).sum(axis=(0, 1)) * (2.0 * math.pi / 512)
+    np.testing.assert_allclose(total, e, rtol=1e-4)
+    below = sky_radiance(sky_type, np.array([[0.0, 0.6, -0.8]]), sun, e)
+    assert np.all(below == 0.0)
