@@ -342,12 +342,19 @@ def module_main(argv: list[str] | None, name: str, run, doc: str) -> int:
     return 0
 
 
+def _jsonable(value):
+    """numpy arrays and scalars in a record (a frame's per-band tallies) as plain lists and numbers."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
 def save_record(record: dict, out: Path | None, name: str, quick: bool, device: str) -> Path:
     """Write a benchmark's JSON record to ``out`` or benchmarks/results/<name>[_quick]_<device>.json."""
     tag = f"{name}{'_quick' if quick else ''}_{device.replace(':', '')}"
     out = out or ROOT / "benchmarks" / "results" / f"{tag}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(record, indent=2) + "\n")
+    out.write_text(json.dumps(record, indent=2, default=_jsonable) + "\n")
     print(f"wrote {out}")
     return out
 
