@@ -6,8 +6,8 @@ sun, the displaced surface as a dielectric triangle mesh (its periodic images ar
 beyond the patch so that light entering near the edges still lands), a white diffuse floor, and a
 pinhole straight above the floor's centre, under the water, whose film maps the floor one-to-one
 (a plane parallel to the film; irradiance E = π L on a white Lambertian floor); ``max_depth = 3``
-keeps only sun → water → floor paths (with 4 the light reflected down again off the surface's
-underside adds ~20 %). A reference is converged once (``--reference-spp``, in passes with their own
+keeps only sun → water → floor paths (with 4 the white floor's own light, sent back down by the
+surface's underside, adds ~20 %). A reference is converged once (``--reference-spp``, in passes with their own
 seeds); then, for each of our methods, its relative L1 against that reference, its time (best of 3
 warm renders, one CPU core), Mitsuba's time for the same L1 on its own L1-against-time curve (its
 renders at increasing samples, other seeds; log-log interpolation, or extrapolated as t ∝ L1⁻²
