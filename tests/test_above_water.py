@@ -133,3 +133,31 @@ def test_above_water_errors():
                       "camera.shaft_samples": 2})
     with pytest.raises(WarpcausticsError, match="raise the camera"):
         wc.render(scene, device="cpu")
+
+
+def test_the_sun_s_glint_is_r_times_the_disk_radiance():
+    """Still water and the 0.53° sun's disk: the pixels whose mirror ray falls inside the disk see
+    R(θ_v) E_sun/Ω (Ω = 2π(1 − cos r), a uniform disk), the others no reflection (no sky); float64
+    geometry and Fresnel written here."""
+    elevation, azimuth = 40.0, 30.0
+    el, az = math.radians(elevation), math.radians(azimuth)
+    sun = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    mirror = np.array([-sun[0], -sun[1], sun[2]])  # the sun's reflection seen from above
+    camera = np.array([0.0, 0.0, 1.0])
+    look = camera - 3.0 * mirror  # looking down along the reflected sunlight, reversed
+    scene = _scene(**{"sun.elevation_deg": elevation, "sun.azimuth_deg": azimuth,
+                      "sun.angular_diameter_deg": 0.53, "sun.disk_samples": 2,
+                      "camera.position_m": camera.tolist(), "camera.look_at_m": look.tolist(),
+                      "camera.fov_deg": 2.0, "camera.width": 32, "camera.height": 32,
+                      "camera.shaft_samples": 1})
+    renderer = wc.Renderer(scene, "cpu")
+    renderer.render(0.0)
+    v = _pixel_rays(scene.config)
+    reflected = v * np.array([1.0, 1.0, -1.0])
+    radius = math.radians(0.53) / 2
+    on_disk = reflected @ sun >= math.cos(radius)
+    assert 20 < on_disk.sum() < 32 * 32 - 20  # the disk's edge crosses the image
+    r = 1.0 - fresnel_t_angles(np.arccos(-v[..., 2]), 1.0, IOR)
+    e_sun = renderer.light.sun_irradiance[:, None, None]
+    expected = np.where(on_disk, r * e_sun / (2 * math.pi * (1 - math.cos(radius))), 0.0)
+    np.testing.assert_allclose(renderer.method.camera.surface_radiance, expected, rtol=1e-5)
