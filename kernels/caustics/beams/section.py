@@ -328,6 +328,20 @@ def copy_range(lo: float, hi: float, a: float, width: float, extent_m: float, pe
 
 
 @wp.func
+def section_copies(bm: Beams, b: int, p: wp.vec3):
+    """(kx0, kx1, ky0, ky1): the whole periods k for which point p moved by k L may lie in beam b's
+    horizontal section at p's height (its box; k = 0 only on a walled pool)."""
+    s0 = section_vertex(bm.base[b, 0], bm.direction[b, 0], p[2])
+    s1 = section_vertex(bm.base[b, 1], bm.direction[b, 1], p[2])
+    s2 = section_vertex(bm.base[b, 2], bm.direction[b, 2], p[2])
+    lo = wp.min(wp.min(s0, s1), s2)
+    hi = wp.max(wp.max(s0, s1), s2)
+    kx0, kx1 = copy_range(lo[0], hi[0], p[0], 0.0, bm.extent_m, bm.periodic)
+    ky0, ky1 = copy_range(lo[1], hi[1], p[1], 0.0, bm.extent_m, bm.periodic)
+    return kx0, kx1, ky0, ky1
+
+
+@wp.func
 def period_shift(target: wp.vec2, p: wp.vec2, extent_m: float, periodic: int) -> wp.vec2:
     """The whole-period shift that moves p nearest to target (zero on a walled pool)."""
     if periodic == 0:

@@ -12,11 +12,10 @@ from warpcaustics.kernels.caustics.beams.section import (
     barycentrics,
     clamped_sample,
     copy_offset,
-    copy_range,
     load_corners,
     safe_area,
     sample_beam,
-    section_vertex,
+    section_copies,
     shadow_slack,
     xy,
 )
@@ -399,13 +398,7 @@ def point_inscatter(
     start = tile_start[t]
     for item in range(tile_count[t]):
         b = tile_items[start + item]
-        s0 = section_vertex(bm.base[b, 0], bm.direction[b, 0], x[2])
-        s1 = section_vertex(bm.base[b, 1], bm.direction[b, 1], x[2])
-        s2 = section_vertex(bm.base[b, 2], bm.direction[b, 2], x[2])
-        lo = wp.min(wp.min(s0, s1), s2)
-        hi = wp.max(wp.max(s0, s1), s2)
-        kx0, kx1 = copy_range(lo[0], hi[0], x[0], 0.0, bm.extent_m, bm.periodic)
-        ky0, ky1 = copy_range(lo[1], hi[1], x[1], 0.0, bm.extent_m, bm.periodic)
+        kx0, kx1, ky0, ky1 = section_copies(bm, b, x)
         for ky in range(ky0, ky1 + 1):
             for kx in range(kx0, kx1 + 1):
                 q = x + wp.vec3(float(kx) * bm.extent_m, float(ky) * bm.extent_m, 0.0)
