@@ -9,7 +9,7 @@ from scipy import integrate
 
 import warpcaustics as wc
 from warpcaustics.batch.stats import cv_without_noise
-from warpcaustics.caustics.multiple import MultipleScattering
+from warpcaustics.caustics.multiple import MultipleScattering, balance
 from warpcaustics.errors import ConfigError
 from warpcaustics.kernels.caustics import multiple as mc_kernels
 
@@ -47,9 +47,8 @@ def test_walk_without_absorption_conserves_energy():
         "cpu",
     )
     floor, st = walk.run(surface, visible)
-    t = np.array(st["transmitted"])
     assert np.all(np.array(st["absorbed"]) == 0.0)
-    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["truncated"])) / t
+    closing = balance(st)
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
     np.testing.assert_allclose(floor.sum(axis=(1, 2)) * walk.texel_area_m2, st["floor"], rtol=1e-5)
     assert np.all(np.array(st["escaped"]) > 0.0)  # some light is scattered back up
@@ -68,8 +67,7 @@ def test_unscattered_part_follows_beer_lambert():
     photons = st["photons"] / 3
     sigma = np.sqrt(expected * (1 - expected) / photons)
     assert np.all(np.abs(fraction - expected) < 4 * sigma)
-    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
-               + np.array(st["truncated"]) + np.array(st["roulette"])) / t
+    closing = balance(st)
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
 
 
@@ -183,8 +181,7 @@ def test_walk_of_a_uniform_sky_over_still_water_is_the_analytic_integral():
             expected = uniform_sky_on_floor(e_sky[k], a, 2.0)
             sigma = math.sqrt(max(reached[k] * (1.0 - reached[k]), 0.0) / photons)
             assert floor[k].mean() == pytest.approx(expected, rel=1e-3 + 4 * sigma / reached[k])
-        closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
-                   + np.array(st["truncated"]) + np.array(st["roulette"])) / t
+        closing = balance(st)
         np.testing.assert_allclose(closing, 1.0, atol=1e-6)
         assert np.all(np.array(st["unscattered"]) == np.array(st["floor"]))
 
@@ -193,9 +190,8 @@ def test_sky_walk_without_absorption_conserves_energy():
     """The sky's photons scatter (b = 0.5, 1, 2 /m) but nothing is absorbed: every watt of skylight
     that enters the water reaches the floor, escapes or is stopped (1e-6)."""
     _, walk, floor, st, _ = sky_walk(np.zeros(3), np.array([0.5, 1.0, 2.0]))
-    t = np.array(st["transmitted"])
     assert np.all(np.array(st["absorbed"]) == 0.0)
-    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["truncated"])) / t
+    closing = balance(st)
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
     np.testing.assert_allclose(floor.sum(axis=(1, 2)) * walk.texel_area_m2, st["floor"], rtol=1e-5)
     assert np.all(np.array(st["escaped"]) > 0.0)
@@ -214,8 +210,7 @@ def test_render_walks_the_sky_apart_from_the_sun():
     st = r.multiple_scattering_stats
     sky_st = st["sky"]
     t = np.array(sky_st["transmitted"])
-    closing = (np.array(sky_st["floor"]) + np.array(sky_st["escaped"]) + np.array(sky_st["absorbed"])
-               + np.array(sky_st["truncated"]) + np.array(sky_st["roulette"])) / t
+    closing = balance(sky_st)
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
     # skylight entering still water: the patch's area × E_sky × the mean Fresnel transmittance over
     # the 16 cosine-weighted directions
@@ -329,8 +324,7 @@ def test_russian_roulette_ends_long_paths_without_bias():
     r = wc.render(scene, device="cpu")
     st = r.multiple_scattering_stats
     t = np.array(st["transmitted"])
-    closing = (np.array(st["floor"]) + np.array(st["escaped"]) + np.array(st["absorbed"])
-               + np.array(st["truncated"]) + np.array(st["roulette"])) / t
+    closing = balance(st)
     np.testing.assert_allclose(closing, 1.0, atol=1e-6)
     assert np.all(np.array(st["truncated"]) == 0.0)
     assert subnormal_count(r.floor_irradiance) == 0

@@ -12,6 +12,7 @@ from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutp
 from warpcaustics.config import Scattering
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
+from warpcaustics.scene.receivers import albedo_spectrum
 from warpcaustics.water import Surface
 
 
@@ -133,9 +134,12 @@ class FluxRatioStage(CausticStage):
             sky = {}
             if light.sky_directions is not None:
                 sky = dict(sky_dirs=light.sky_directions, sky_irradiance=np.stack(light.sky_irradiance_np))
+            floor_albedo = albedo_spectrum(cfg.floor.albedo, light.bins, cfg.floor.albedo_file,
+                                           scene.base_dir, "floor")
             self.multiple = MultipleScattering(cfg, light.sun_directions, float(light.group_ior[0]),
                                                light.sun_irradiance, light.optics.absorption_per_m,
-                                               light.optics.scattering_per_m, device, **sky)
+                                               light.optics.scattering_per_m, device,
+                                               floor_albedo=floor_albedo, **sky)
         disk_share = light.sun_irradiance / len(light.sun_directions)
         self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
                                    device, periodic=water.periodic, window=window,

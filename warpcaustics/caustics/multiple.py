@@ -4,7 +4,9 @@ A reference mode for flux-ratio scenes on a periodic sea: the floor map comes fr
 random walk of photons that scatter on (by the configured phase function) instead of being lost
 from the beam; the single-scattering flux-ratio map of the same frame is kept as the comparison.
 The sky, when there is one, is walked apart from the sun (its own floor map and tallies), its
-photons taking the sky's directions in turn.
+photons taking the sky's directions in turn. The walk's boundaries are the moving surface (Fresnel
+reflection and transmission at its local normal, total internal reflection) and the floor
+(``floor.albedo``, Lambertian); the map is the irradiance incident on the floor.
 """
 
 from __future__ import annotations
@@ -17,10 +19,23 @@ from warpcaustics.kernels.caustics import multiple as mc_kernels
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.water import Surface
 
-TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated", "roulette")
-"""The columns of the walk's tallies [W nm⁻¹ per band]; ``roulette``: the weight of the photons that
-Russian roulette ended less what its survivors gained (zero on average), so transmitted = floor +
-escaped + absorbed + truncated + roulette exactly."""
+TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated", "roulette",
+               "floor_reflected", "surface_reflected")
+"""The columns of the walk's tallies [W nm⁻¹ per band]. ``floor``: every arrival on the floor (a photon
+reflected back down counts again), ``floor_reflected``: what the floor's albedo sent back up,
+``surface_reflected``: what the surface reflected back into the water (Fresnel and total internal
+reflection; it stays in the walk), ``unscattered``: the floor's light that came straight from the
+surface; ``roulette``: the weight of the photons that Russian roulette ended less what its survivors
+gained (zero on average). So transmitted = floor − floor_reflected + escaped + absorbed + truncated +
+roulette exactly (:func:`balance`)."""
+
+
+def balance(stats: dict) -> np.ndarray:
+    """(K,) the walk's books per band: what they account for over what entered the water (1 when
+    every watt is found: on the floor, escaped, absorbed, truncated or in the roulette)."""
+    kept = (np.asarray(stats["floor"]) - np.asarray(stats["floor_reflected"]) + np.asarray(stats["escaped"])
+            + np.asarray(stats["absorbed"]) + np.asarray(stats["truncated"]) + np.asarray(stats["roulette"]))
+    return kept / np.asarray(stats["transmitted"])
 
 TURN_STREAM = 0x2545F491
 """Added to a walk's seed for the random turn of the directions over each cell's photons."""
@@ -47,11 +62,16 @@ class MultipleScattering:
 
     def __init__(self, cfg: Config, sun_dirs: np.ndarray, ior: float, sun_irradiance: np.ndarray,
                  absorption_per_m: np.ndarray, scattering_per_m: np.ndarray, device: str, *,
+                 floor_albedo: np.ndarray | None = None, surface_reflects: bool = True,
                  sky_dirs: np.ndarray | None = None, sky_irradiance: np.ndarray | None = None):
         """``sun_dirs``: (S, 3) the sun's direction, or the directions over its disk, which the
         photons take in turn, sharing ``sun_irradiance`` (K,) equally. ``sky_dirs`` (D, 3) and
         ``sky_irradiance`` (D, K): the sky's directions and each one's irradiance on a plane
-        perpendicular to it [W m⁻² nm⁻¹], for :meth:`run_sky`."""
+        perpendicular to it [W m⁻² nm⁻¹], for :meth:`run_sky`. ``floor_albedo`` (K,): the floor's
+        Lambertian albedo per band (None: a black floor, which ends every photon reaching it).
+        ``surface_reflects=False`` lets all upwelling light through the surface (no Fresnel
+        reflection, no total internal reflection): only for comparisons with solvers that have no
+        reflecting top."""
         self.device = device
         dirs = np.asarray(sun_dirs, np.float32).reshape(-1, 3)
         self.sun_dirs = wp.array(dirs, dtype=wp.vec3, device=device)
@@ -78,6 +98,7 @@ class MultipleScattering:
             w.map_scale = m / side
             w.samples = cfg.optics.mc_samples
             w.max_events = cfg.optics.mc_max_events
+            w.surface_reflects = int(surface_reflects)
             w.seed = seed
             w.turn_seed = (seed + TURN_STREAM) % 2**31
             return w
@@ -85,6 +106,7 @@ class MultipleScattering:
         self.walk = walk(cfg.optics.mc_seed)
         self.sky_walk = walk((cfg.optics.mc_seed + SKY_STREAM) % 2**31)
         self.texel_area_m2 = (side / m) ** 2
+        self.extent_m = float(cfg.water.extent_m)
 
         def arr(a):
             return wp.array(np.asarray(a, np.float32), dtype=wp.float32, device=device)
@@ -92,6 +114,7 @@ class MultipleScattering:
         self.absorption = arr(absorption_per_m)
         self.scattering = arr(scattering_per_m)
         self.inverse_cdf = arr(inverse_cdf_table(PhaseFunction.from_optics(cfg.optics, device), device))
+        self.floor_albedo = arr(np.zeros(k) if floor_albedo is None else np.broadcast_to(floor_albedo, (k,)))
         self.texels = wp.zeros((m, m, k), dtype=wp.float32, device=device)
         self.tallies = wp.zeros((k, mc_kernels.TALLIES), dtype=wp.float64, device=device)
 
@@ -111,11 +134,19 @@ class MultipleScattering:
     def _walk(self, surface, visible, dirs, irradiance, walk) -> tuple[np.ndarray, dict]:
         n = surface.resolution
         k = self.tallies.shape[0]
+        heights = surface.positions.numpy()[..., 2]
+        margin = 1e-5 * (1.0 + float(np.abs(heights).max()))  # the bilinear field stays inside
+        walk.surface_low = float(heights.min()) - margin
+        walk.surface_high = float(heights.max()) + margin
+        cell = self.extent_m / n  # the bilinear field's slope is bounded by its steepest edges
+        sx = np.abs(np.roll(heights, -1, axis=1) - heights).max() / cell
+        sy = np.abs(np.roll(heights, -1, axis=0) - heights).max() / cell
+        walk.surface_slope = wp.vec2(float(sx) * (1.0 + 1e-5), float(sy) * (1.0 + 1e-5))
         self.texels.zero_()
         self.tallies.zero_()
         wp.launch(mc_kernels.random_walk, dim=(k, n, n, walk.samples * walk.samples),
                   inputs=[walk, surface.positions, surface.normals, visible, dirs, irradiance,
-                          self.absorption, self.scattering, self.inverse_cdf],
+                          self.absorption, self.scattering, self.inverse_cdf, self.floor_albedo],
                   outputs=[self.texels, self.tallies], device=self.device)
         floor = np.moveaxis(self.texels.numpy(), 2, 0) / self.texel_area_m2
         tallies = self.tallies.numpy()
