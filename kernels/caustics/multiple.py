@@ -177,6 +177,20 @@ def surface_crossing(walk: Walk, positions: wp.array2d[wp.vec3], pos: wp.vec3, d
 
 
 @wp.func
+def reflect_at_surface(walk: Walk, normals: wp.array2d[wp.vec3], pos: wp.vec3, d: wp.vec3):
+    """(share of the weight reflected back into the water, direction after the reflection) of a
+    photon leaving through the surface at ``pos``: Fresnel at the interpolated normal, water to air,
+    1 past the critical angle; nothing is kept where the surface does not reflect
+    (``walk.surface_reflects = 0``) or the normal faces away from the crossing (it leaves)."""
+    nrm = wp.normalize(grid_bilinear(normals, walk.extent_m, 1, pos[0], pos[1]))
+    cos_i = wp.dot(d, nrm)
+    kept = float(0.0)
+    if cos_i > 0.0 and walk.surface_reflects != 0:
+        kept = 1.0 - fresnel_transmittance(cos_i, 1.0 / walk.eta)
+    return kept, wp.normalize(d - 2.0 * cos_i * nrm)
+
+
+@wp.func
 def lambertian_up(u1: float, u2: float) -> wp.vec3:
     """An upward direction from a horizontal Lambertian reflector: cosine-weighted (Malley's method,
     Pharr, Jakob & Humphreys, PBRT 3rd ed. §13.6.3)."""
@@ -291,17 +305,12 @@ def random_walk(
             d = lambertian_up(wp.randf(state), wp.randf(state))
         elif out >= 0.0:  # the surface from below: Fresnel, or total internal reflection
             pos = pos + out * d
-            nrm = wp.normalize(grid_bilinear(normals, walk.extent_m, 1, pos[0], pos[1]))
-            cos_i = wp.dot(d, nrm)
-            kept = float(0.0)  # an interpolated normal facing away from the crossing: it leaves
-            if cos_i > 0.0 and walk.surface_reflects != 0:
-                kept = 1.0 - fresnel_transmittance(cos_i, 1.0 / walk.eta)
+            kept, d = reflect_at_surface(walk, normals, pos, d)
             wp.atomic_add(tallies, b, ESCAPED, wp.float64(weight * (1.0 - kept)))
             if kept <= 0.0:
                 return
             wp.atomic_add(tallies, b, SURFACE_REFLECTED, wp.float64(weight * kept))
             weight = weight * kept
-            d = wp.normalize(d - 2.0 * cos_i * nrm)
         else:  # an interaction in the water
             pos = pos + free * d
             if event < walk.max_events:
