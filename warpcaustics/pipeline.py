@@ -31,7 +31,7 @@ def keeps_sky_shading(cfg) -> bool:
     """Whether the crests' shading from each sky direction is kept, (D, N, N), rather than one
     (N, N) buffer reused per direction: the random walk takes the directions in turn, and a method
     may revisit them (:attr:`CausticStage.keeps_sky_shading`)."""
-    return cfg.optics.scattering is Scattering.MULTIPLE or METHODS[cfg.caustics.method].keeps_sky_shading
+    return cfg.optics.scattering is not Scattering.SINGLE or METHODS[cfg.caustics.method].keeps_sky_shading
 
 
 def scene_bytes(scene: Scene, device: str = "cuda") -> int:

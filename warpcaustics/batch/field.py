@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from warpcaustics.config import SkyModel
+from warpcaustics.config import Scattering, SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
@@ -233,8 +233,11 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
         per_frame = [c for _, c in total]
         # the sky as a uniform background: its K directions' own caustics removed
         _, cv_uniform_sky = pooled_statistics(direct, sky)
-        # and the sun's scattered light, lost by single scattering, back as a uniform background
-        t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
+        # and the sun's scattered light, lost by single scattering, back as a uniform background (a
+        # map that holds the scattered light already, optics.scattering = "small_angle", adds none)
+        t = 1.0
+        if config.optics.scattering is Scattering.SINGLE:
+            t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
         scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky)]
         _, cv_scattered = pooled_statistics(direct, scattered)
         wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s

@@ -1,5 +1,6 @@
 """Floor caustics by flux ratio (``caustics.method = "fluxratio"``, host side): triangle fluxes, then
-footprint deposits; with ``optics.scattering = "multiple"`` the random walk's map replaces it. The
+footprint deposits; with ``optics.scattering = "multiple"`` the random walk's map replaces it, with
+``"small_angle"`` the scattered light of the small-angle transfer is added to it. The
 approximate floor-map methods (sun map, eikonal, wave3d) build on :class:`FluxRatioStage`."""
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.caustics.multiple import MultipleScattering
+from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
 from warpcaustics.config import Scattering
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
@@ -117,7 +119,8 @@ class FloorCaustics:
 class FluxRatioStage(CausticStage):
     """``fluxratio``: the floor map from each surface triangle's refracted footprint, one pass per
     direction of the sun's disk and of the sky; the random walk's map instead with
-    ``optics.scattering = "multiple"`` (the single-scattering map as its comparison)."""
+    ``optics.scattering = "multiple"``, or the map with the small-angle scattered light added with
+    ``"small_angle"`` (either with the single-scattering map as its comparison)."""
 
     name = "fluxratio"
 
@@ -129,8 +132,8 @@ class FluxRatioStage(CausticStage):
         self.refracted = Refracted.allocate(len(light.group_ior), n, device)
         window = ((cfg.caustics.map_extent_m, tuple(cfg.caustics.map_center_m))
                   if cfg.caustics.map_extent_m else None)
-        self.multiple = None
-        if cfg.optics.scattering is Scattering.MULTIPLE:
+        self.multiple = self.small_angle = None
+        if cfg.optics.scattering is not Scattering.SINGLE:
             sky = {}
             if light.sky_directions is not None:
                 sky = dict(sky_dirs=light.sky_directions, sky_irradiance=np.stack(light.sky_irradiance_np))
@@ -140,6 +143,9 @@ class FluxRatioStage(CausticStage):
                                                light.sun_irradiance, light.optics.absorption_per_m,
                                                light.optics.scattering_per_m, device,
                                                floor_albedo=floor_albedo, **sky)
+        if cfg.optics.scattering is Scattering.SMALL_ANGLE:
+            self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
+                                                    light.optics.scattering_per_m)
         disk_share = light.sun_irradiance / len(light.sun_directions)
         self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
                                    device, periodic=water.periodic, window=window,
@@ -149,14 +155,14 @@ class FluxRatioStage(CausticStage):
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
         cfg = scene.config
         m = cfg.caustics.map_resolution
-        walk = k * m * m * 4 if cfg.optics.scattering is Scattering.MULTIPLE else 0  # the walk's texels
+        walk = k * m * m * 4 if cfg.optics.scattering is not Scattering.SINGLE else 0  # the walk's texels
         return floor_bytes(scene.water_resolution, m, k, groups) + walk
 
     def render(self, frame: Frame) -> StageOutput:
         floor, transmitted, extra, single = self.flux_ratio(frame)
         if single is None:
             return StageOutput(floor, transmitted, self.name, extra)
-        return StageOutput(floor, transmitted, "multiple", extra,
+        return StageOutput(floor, transmitted, self.scene.config.optics.scattering.value, extra,
                            comparison=StageOutput(single[0], single[1], "single", single[2]))
 
     def flux_ratio(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, dict, tuple | None]:
@@ -175,9 +181,15 @@ class FluxRatioStage(CausticStage):
         with watch.stage("readback"):
             # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
             floor_np = floor.numpy().copy()
+        if self.small_angle is not None:
+            self.small_angle.reset(frame.surface.positions.numpy()[..., 2])
+            with watch.stage("small_angle"):  # the disk's directions share one transfer, its centre's
+                centre = np.mean(self.light.sun_directions, axis=0)
+                self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1])
+        single_sky = None
         if self.light.sky_directions is not None:
             sky_np, sky_flux = self._sky(frame)
-            extra["sky_floor_irradiance"] = sky_np
+            extra["sky_floor_irradiance"] = single_sky = sky_np
             floor_np, flux = floor_np + sky_np, flux + sky_flux
         transmitted = flux[0]
         extra["delivered_flux_w_nm"] = flux[1]
@@ -195,21 +207,38 @@ class FluxRatioStage(CausticStage):
             floor_np = floor_np + sky_np
             transmitted = transmitted + np.asarray(walk["sky"]["transmitted"])
         extra["multiple_scattering_stats"] = walk
+        if self.small_angle is not None:  # the single-scattering map and its scattered light
+            floor_flux = np.asarray(walk["floor"])
+            if "sky" in walk:
+                floor_flux = floor_flux + np.asarray(walk["sky"]["floor"])
+            with watch.stage("small_angle"):
+                scattered, walk["small_angle"] = self.small_angle.finish(floor_flux)
+            floor_np = single[0] + sum(scattered.values())
+            if "sky" in scattered:
+                extra["sky_floor_irradiance"] = single_sky + scattered["sky"]
         return floor_np, transmitted, extra, single
 
     def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
         """The sky's floor map and (2, K) flux (entering, delivered): one shaded refraction and
-        deposit per sky direction, each with its share of the sky's irradiance."""
+        deposit per sky direction, each with its share of the sky's irradiance. With the small-angle
+        transfer each direction's map is read back and given its own transfer (its own path)."""
         light = self.light
         transmitted = 0.0
+        total = None
         for i, (direction, irradiance) in enumerate(zip(light.sky_directions, light.sky_irradiance_per_dir)):
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
                 visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out)
-            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=i == 0,
+            separate = self.small_angle is not None
+            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=i == 0 or separate,
                                         irradiance=irradiance)
             transmitted = transmitted + flux
-        return floor.numpy().copy(), transmitted
+            if separate:
+                one = floor.numpy().copy()
+                total = one if total is None else total + one
+                with frame.watch.stage("small_angle"):
+                    self.small_angle.add(one, direction, flux[1], group="sky")
+        return (floor.numpy().copy() if total is None else total), transmitted
 
     def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
                  irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:

@@ -126,7 +126,7 @@ def _check_sky(cfg: Config) -> None:
 
 
 def _check_scattering(cfg: Config) -> None:
-    if cfg.optics.scattering is not Scattering.MULTIPLE:
+    if cfg.optics.scattering is Scattering.SINGLE:
         return
     needs = []
     if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
@@ -136,7 +136,9 @@ def _check_scattering(cfg: Config) -> None:
     if cfg.optics.dispersion:
         needs.append("optics.dispersion = false")
     if needs:
-        raise ConfigError("optics.scattering = \"multiple\" (a reference random walk) needs "
+        what = ("a reference random walk" if cfg.optics.scattering is Scattering.MULTIPLE
+                else "the small-angle transfer, its mean from the random walk")
+        raise ConfigError(f"optics.scattering = \"{cfg.optics.scattering.value}\" ({what}) needs "
                           + "; ".join(needs))
 
 

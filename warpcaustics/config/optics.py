@@ -31,6 +31,7 @@ class WaterType(str, enum.Enum):
 class Scattering(str, enum.Enum):
     SINGLE = "single"
     MULTIPLE = "multiple"
+    SMALL_ANGLE = "small_angle"
 
 
 class PhaseFunctionKind(str, enum.Enum):
@@ -102,7 +103,10 @@ class OpticsConfig:
     scattering: Scattering = Scattering.SINGLE
     """``single``: light scattered out of the direct beam is lost (c = a + b attenuates it);
     ``multiple``: a Monte Carlo random walk carries it on (a reference mode: ``fluxratio`` on a
-    periodic sea; the single-scattering map is kept beside it)."""
+    periodic sea; the single-scattering map is kept beside it); ``small_angle``: the
+    single-scattering map plus its scattered light by the small-angle transfer of the water column
+    (Wells 1973), scaled to the random walk's mean — the walk's amount of scattered light without
+    its noise (same scenes as ``multiple``)."""
     mc_samples: int = field(default=4, metadata=_range(1, 64))
     """Photons per surface cell side of the ``multiple`` random walk (s² per cell and band) [-]."""
     mc_max_events: int = field(default=64, metadata=_range(1, 10000))

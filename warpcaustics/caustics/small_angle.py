@@ -1,0 +1,113 @@
+"""Scattered light by the small-angle transfer, on the host: ``optics.scattering = "small_angle"``.
+
+The flux-ratio map of each light pass (the sun, each sky direction) is the unscattered pattern;
+:class:`SmallAngleScattering` adds, per pass, its scattered light F⁻¹[Ŝ (e^{b s G(q s)} − 1)]
+(:mod:`warpcaustics.optics.small_angle`: Wells 1973's transfer of the water column, with the
+beam's path s = D / cos θ_w to the floor and its obliquity), then scales the scattered light of all
+passes so that its mean over the patch is the random walk's: the walk's floor flux less the
+single-scattering map's. The map is the single-scattering map plus that scattered light — the
+unscattered pattern exact, the scattered light with the structure of the small-angle approximation
+and the amount of the walk, free of the walk's noise.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from warpcaustics.config import Config
+from warpcaustics.optics.small_angle import scattered_light
+
+
+class SmallAngleScattering:
+    """Collects the passes of one frame (:meth:`add`) and returns the scattered light (:meth:`finish`)."""
+
+    def __init__(self, cfg: Config, ior: float, scattering_per_m: np.ndarray):
+        self.optics = cfg.optics
+        self.depth_m = float(cfg.floor.depth_m)
+        self.ior = float(ior)
+        self.b = np.asarray(scattering_per_m, np.float64)
+        m = cfg.caustics.map_resolution
+        side, centre = cfg.map_window
+        self.texel_m = side / m
+        centres = (np.arange(m) + 0.5) * self.texel_m - 0.5 * side
+        self.texel_x, self.texel_y = np.meshgrid(centres + centre[0], centres + centre[1])  # [iy, ix]
+        self.extent_m = float(cfg.water.extent_m)
+        self.area = self.extent_m**2
+        self.heights = None
+
+    def reset(self, heights: np.ndarray) -> None:
+        """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
+        self.heights = np.asarray(heights, np.float64)
+        self.scattered = {}
+        self.single_mean = np.zeros_like(self.b)
+        self.transferred_mean = np.zeros_like(self.b)
+        self.paths = []
+
+    def beam(self, direction: np.ndarray) -> tuple[np.ndarray, float]:
+        """(unit direction in the water, path to the floor [m]) of light from ``direction`` (unit,
+        towards the light) refracted by still water."""
+        d = np.asarray(direction, np.float64)
+        sin_w = math.hypot(d[0], d[1]) / self.ior
+        cos_w = math.sqrt(1.0 - sin_w * sin_w)
+        h = math.hypot(d[0], d[1])
+        horizontal = (-d[0] / h, -d[1] / h) if h > 0 else (0.0, 0.0)
+        down = np.array([horizontal[0] * sin_w, horizontal[1] * sin_w, -cos_w])
+        return down, self.depth_m / cos_w
+
+    def local_paths(self, down: np.ndarray) -> np.ndarray:
+        """(M, M) the path [m] through the water of the light reaching each texel: from the surface
+        where it entered (the height there, bilinear, at the still-water refraction's offset) down
+        the beam to the floor."""
+        cos_w = -down[2]
+        offset = self.depth_m / cos_w  # along the beam, back to the mean level
+        x = self.texel_x - down[0] * offset
+        y = self.texel_y - down[1] * offset
+        n = self.heights.shape[0]
+        u = (x / self.extent_m + 0.5) * n - 0.5
+        v = (y / self.extent_m + 0.5) * n - 0.5
+        i0, j0 = np.floor(u).astype(int), np.floor(v).astype(int)
+        tu, tv = u - i0, v - j0
+        i0, j0 = i0 % n, j0 % n
+        i1, j1 = (i0 + 1) % n, (j0 + 1) % n
+        h = self.heights
+        height = ((1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1])
+                  + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1]))
+        return (self.depth_m + height) / cos_w
+
+    def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
+            group: str = "sun") -> None:
+        """One pass: its single-scattering map (K, M, M) [W m⁻² nm⁻¹], the direction of its light
+        (towards it), the flux its map holds over the whole patch (K,) [W nm⁻¹], and the group its
+        scattered light is reported in (``sun``, ``sky``). The light each texel's ray lost to
+        scattering on its own path, S (e^{b s(x)} − 1), is what the transfer spreads, normalised
+        to the mean path's e^{b s̄} − 1 that the transfer's own k = 0 term carries."""
+        down, path = self.beam(direction)
+        local = self.local_paths(down)
+        lost = np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]
+        part = scattered_light(single * lost, self.texel_m, self.optics, path, self.b, down)
+        self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
+        mean = np.asarray(delivered_flux, np.float64) / self.area
+        self.single_mean += mean
+        # the transfer's k = 0 term over the patch: the map's weighting by the local paths, measured
+        # on the map (the whole patch, or a window standing for it)
+        on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
+        weighting = np.divide((single * lost).mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
+                              where=on_map > 0)
+        self.transferred_mean += mean * weighting * np.expm1(self.b * path)
+        self.paths.append(path)
+
+    def finish(self, walk_floor_flux: np.ndarray) -> tuple[dict, dict]:
+        """({group: (K, M, M)} the passes' scattered light scaled to the walk's mean (the walk's floor
+        flux over the patch, (K,) [W nm⁻¹], less the single-scattering map's), and what was done:
+        the scale per band (the walk's scattered light over the small-angle approximation's, which
+        keeps every scattered photon going forward), the passes' paths."""
+        walk_mean = np.asarray(walk_floor_flux, np.float64) / self.area
+        wanted = np.maximum(walk_mean - self.single_mean, 0.0)
+        scale = np.divide(wanted, self.transferred_mean, out=np.zeros_like(wanted),
+                          where=self.transferred_mean > 0)
+        scattered = {group: part * scale[:, None, None] for group, part in self.scattered.items()}
+        info = {"scale": scale.tolist(), "scattered_mean": wanted.tolist(),
+                "single_mean": self.single_mean.tolist(), "paths_m": [float(p) for p in self.paths]}
+        return scattered, info
