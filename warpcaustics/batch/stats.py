@@ -187,6 +187,32 @@ def probe_points(cfg: StatsConfig, map_center_m: tuple[float, float]) -> list[tu
     return [(p.x_m, p.y_m) for p in cfg.probes] or [tuple(map_center_m)]
 
 
+def integrate_series(series: np.ndarray, dt_s: float, integration_s: float) -> np.ndarray:
+    """(T', P) the samples' running mean over the last ``integration_s`` [s]: the integral of the
+    piecewise-linear E(t) through the samples (spaced ``dt_s``) over [t − T, t], divided by T, at
+    each sample t with a whole window behind it (the first ⌈T/dt⌉ samples are dropped). T = 0
+    returns the series itself; a window shorter than a sample spacing averages between neighbours."""
+    e = np.asarray(series, np.float64)
+    if integration_s <= 0.0:
+        return e
+    steps = integration_s / dt_s
+    first = int(math.ceil(steps - 1e-9))
+    if first >= e.shape[0]:
+        raise ValueError(f"stats.integration_s = {integration_s} needs more than {first} samples "
+                         f"{dt_s} s apart; the animation has {e.shape[0]}")
+    # cumulative trapezoid integral of the piecewise-linear interpolant, in units of dt
+    cumulative = np.concatenate([np.zeros((1,) + e.shape[1:]), np.cumsum(0.5 * (e[1:] + e[:-1]), axis=0)])
+    ends = np.arange(first, e.shape[0], dtype=np.float64)
+
+    def integral_to(u: np.ndarray) -> np.ndarray:  # ∫₀^u E, u in samples (fractional)
+        i = np.minimum(np.floor(u).astype(int), e.shape[0] - 2)
+        f = (u - i)[:, None]
+        left, right = e[i], e[i + 1]
+        return cumulative[i] + f * left + 0.5 * f * f * (right - left)
+
+    return (integral_to(ends) - integral_to(ends - steps)) / steps
+
+
 def series_statistics(series: np.ndarray, dt_s: float, flash_threshold: float) -> dict:
     """Statistics of time series E(t) (T, P) sampled every ``dt_s``: per probe the mean, CV, the
     flash frequency (upward crossings of ``flash_threshold``·mean per second) and the one-sided

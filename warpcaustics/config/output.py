@@ -61,3 +61,8 @@ class StatsConfig:
     probes: tuple[ProbeConfig, ...] = ()
     """Floor points whose irradiance over an animation is reported (``[[stats.probes]]`` tables
     with x_m, y_m); none given: the floor map's centre."""
+    integration_s: float = field(default=0.0, metadata=_range(0.0, 1.0e4))
+    """A radiometer's integration time [s]: the probes' E(t) over an animation is also reported
+    averaged over the last ``integration_s`` before each sample (``time_statistics.integrated``);
+    0 = instantaneous samples only. Gernez & Antoine (2009) sampled at 6 Hz and did not publish it:
+    compare 0 and 1/6 s."""

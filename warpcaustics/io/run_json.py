@@ -52,7 +52,7 @@ def frame_statistics_entry(r) -> dict:
 def time_statistics(frames: list[dict], first) -> dict | None:
     """Statistics of the probes' E(t) over an animation (three frames or more, equally spaced);
     ``first`` is the first frame's RenderResult (for the config and the map)."""
-    from warpcaustics.batch.stats import probe_points, series_statistics
+    from warpcaustics.batch.stats import integrate_series, probe_points, series_statistics
 
     if len(frames) < 3:
         return None
@@ -60,8 +60,14 @@ def time_statistics(frames: list[dict], first) -> dict | None:
     times = np.array([f["time_s"] for f in frames])
     series = np.array([f["statistics"]["probe_irradiance_w_m2"] for f in frames])
     dt = float(np.mean(np.diff(times)))
-    return {"probes_m": [list(p) for p in probe_points(stats_cfg, first.map_center_m)], "dt_s": dt,
-            **series_statistics(series, dt, stats_cfg.flash_threshold)}
+    out = {"probes_m": [list(p) for p in probe_points(stats_cfg, first.map_center_m)], "dt_s": dt,
+           **series_statistics(series, dt, stats_cfg.flash_threshold)}
+    if stats_cfg.integration_s > 0.0:
+        integrated = integrate_series(series, dt, stats_cfg.integration_s)
+        if len(integrated) >= 3:  # a radiometer's samples, each its mean over the integration time
+            out["integrated"] = {"integration_s": stats_cfg.integration_s, "samples": len(integrated),
+                                 **series_statistics(integrated, dt, stats_cfg.flash_threshold)}
+    return out
 
 
 def write_run_json(out_dir: Path, results: list, *, frames: list[dict] | None = None) -> Path:
