@@ -283,6 +283,9 @@ def main(argv: list[str] | None = None) -> int:
     # The multiple-scattering random walk's photon rate (benchmarks/multiple.py).
     multiple = _in_child("run", args.quick, args.device, module="multiple")
 
+    # The small-angle scattering mode against single scattering (benchmarks/small_angle.py).
+    small_angle = _in_child("run", args.quick, args.device, module="small_angle")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -316,6 +319,7 @@ def main(argv: list[str] | None = None) -> int:
         "eikonal": eikonal,
         "sun_disk": sun_disk,
         "multiple": multiple,
+        "small_angle": small_angle,
         "sweep": sweeps,
         "memory": memory,
     }

@@ -1,0 +1,53 @@
+"""The small-angle scattering mode against single scattering on the same frame.
+
+``python -m benchmarks.small_angle`` (part of ``python -m benchmarks.run``; ``--quick``: 256² over
+8 m): the field set-up (``configs/field/gernez2009.toml``: a 1024² JONSWAP sea over 32 m, 16 sun-disk
+and 16 sky directions, a 1 m window of 512² texels, 510 nm) rendered with ``optics.scattering =
+"single"`` and ``"small_angle"`` (the scattered light of each pass by the small-angle transfer, its
+mean from a random walk at one photon per cell), warm frames, median of ``repeats``, one core. Prints
+the time of each and their ratio; the record says where the small-angle time goes (the walk, the
+transfer's FFTs, the sky's per-direction read-backs).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from benchmarks.run import ROOT, device_record, median_time
+
+FULL = {}
+QUICK = {"water.resolution": 256, "water.extent_m": 8.0, "caustics.map_resolution": 256}
+
+
+def run(quick: bool, device: str) -> dict:
+    import warpcaustics as wc
+
+    repeats = 2 if quick else 3
+    overrides = {"optics.mc_samples": 1, "floor.albedo": 0.0, **(QUICK if quick else FULL)}
+    times, stages = {}, {}
+    for mode in ("single", "small_angle"):
+        scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml",
+                              {**overrides, "optics.scattering": mode})
+        renderer = wc.Renderer(scene, device=device)
+        renderer.render(0.0)  # warm-up (and the phase function's spread table)
+        times[mode] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
+        result = renderer.render(0.5)
+        stages[mode] = {k: round(v, 4) for k, v in result.timings_s.items()}
+    n = scene.config.water.resolution
+    row = {"water_n": n, "map": scene.config.caustics.map_resolution, "single_s": times["single"],
+           "small_angle_s": times["small_angle"], "ratio": times["small_angle"] / times["single"],
+           "stages_s": stages}
+    print(f"small_angle  field frame N={n} | single {times['single']:.2f} s | small_angle "
+          f"{times['small_angle']:.2f} s | ×{row['ratio']:.2f}", flush=True)
+    return {"benchmark": "small_angle_scattering", **device_record(device), "repeats": repeats,
+            "results": [row]}
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "small_angle", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
