@@ -113,13 +113,16 @@ def plot(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    modes = [k for k in rows[0] if k not in ("depth_m", "measured") and not k.endswith("_s")]
-    depth = [r["depth_m"] for r in rows]
+    modes = list(dict.fromkeys(k for r in rows for k in r if k not in ("depth_m", "measured")
+                               and not k.endswith("_s")))
     fig, axes = plt.subplots(1, 3, figsize=(11, 4), sharey=True)
     for band, (ax, nm) in enumerate(zip(axes, (443, 532, 670))):
-        ax.plot([r["measured"][band] for r in rows], depth, "ko-", label="measured (Darecki et al. 2011)")
+        ax.plot([r["measured"][band] for r in rows], [r["depth_m"] for r in rows], "ko-",
+                label="measured (Darecki et al. 2011)")
         for mode, style in zip(modes, ("s--", "d-", "^-", "v-")):
-            ax.plot([r[mode][band] for r in rows], depth, style, label=f"model, {mode}")
+            have = [r for r in rows if mode in r]
+            ax.plot([r[mode][band] for r in have], [r["depth_m"] for r in have], style,
+                    label=f"model, {mode}")
         ax.set_xscale("log")
         ax.set_title(f"{nm} nm")
         ax.set_xlabel("CV of Ed")
