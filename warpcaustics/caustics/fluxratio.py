@@ -225,11 +225,11 @@ class FluxRatioStage(CausticStage):
         light = self.light
         transmitted = 0.0
         total = None
+        separate = self.small_angle is not None
         for i, (direction, irradiance) in enumerate(zip(light.sky_directions, light.sky_irradiance_per_dir)):
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
                 visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out)
-            separate = self.small_angle is not None
             floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=i == 0 or separate,
                                         irradiance=irradiance)
             transmitted = transmitted + flux

@@ -18,6 +18,7 @@ import numpy as np
 
 from warpcaustics.config import Config
 from warpcaustics.optics.small_angle import scattered_light
+from warpcaustics.scene.receivers import periodic_bilinear
 
 
 class SmallAngleScattering:
@@ -49,9 +50,9 @@ class SmallAngleScattering:
         """(unit direction in the water, path to the floor [m]) of light from ``direction`` (unit,
         towards the light) refracted by still water."""
         d = np.asarray(direction, np.float64)
-        sin_w = math.hypot(d[0], d[1]) / self.ior
-        cos_w = math.sqrt(1.0 - sin_w * sin_w)
         h = math.hypot(d[0], d[1])
+        sin_w = h / self.ior
+        cos_w = math.sqrt(1.0 - sin_w * sin_w)
         horizontal = (-d[0] / h, -d[1] / h) if h > 0 else (0.0, 0.0)
         down = np.array([horizontal[0] * sin_w, horizontal[1] * sin_w, -cos_w])
         return down, self.depth_m / cos_w
@@ -64,16 +65,7 @@ class SmallAngleScattering:
         offset = self.depth_m / cos_w  # along the beam, back to the mean level
         x = self.texel_x - down[0] * offset
         y = self.texel_y - down[1] * offset
-        n = self.heights.shape[0]
-        u = (x / self.extent_m + 0.5) * n - 0.5
-        v = (y / self.extent_m + 0.5) * n - 0.5
-        i0, j0 = np.floor(u).astype(int), np.floor(v).astype(int)
-        tu, tv = u - i0, v - j0
-        i0, j0 = i0 % n, j0 % n
-        i1, j1 = (i0 + 1) % n, (j0 + 1) % n
-        h = self.heights
-        height = ((1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1])
-                  + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1]))
+        height = periodic_bilinear(self.heights, self.extent_m, x, y)
         return (self.depth_m + height) / cos_w
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,

@@ -45,6 +45,22 @@ def petzold_table(station: str) -> tuple[np.ndarray, np.ndarray, float, float]:
     return theta, p, cone, f
 
 
+def table_on_grid(theta: np.ndarray, p: np.ndarray, cone: float, grid: np.ndarray) -> np.ndarray:
+    """p [1/sr] of a :func:`petzold_table` on any angle grid [rad]: ln p linear in θ between the
+    table's angles (as on the device), the constant ``cone`` below its first angle."""
+    theta = np.asarray(theta, np.float64)
+    table = np.exp(np.interp(grid, theta, np.log(np.asarray(p, np.float64))))
+    return np.where(grid < theta[0], cone, table)
+
+
+def solid_angle_weights(theta: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Trapezoid weights of 2π p(θ) sin θ dθ on the grid ``theta`` [rad]: Σ weights × f(θ) is
+    ∫ f p dΩ over the sphere."""
+    step = np.diff(theta)
+    width = 0.5 * (np.concatenate([step, [0.0]]) + np.concatenate([[0.0], step]))
+    return 2.0 * np.pi * p * np.sin(theta) * width
+
+
 def mean_cosine(theta: np.ndarray, p: np.ndarray, cone: float) -> float:
     """∫ cosθ p dΩ over the sphere for a table (ln p linear in θ) plus its forward cone."""
     fine = np.linspace(theta[0], np.pi, 400001)

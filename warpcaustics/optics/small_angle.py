@@ -33,7 +33,7 @@ import functools
 import numpy as np
 
 from warpcaustics.config import OpticsConfig, PhaseFunctionKind
-from warpcaustics.optics.phase import mean_cosine, petzold_table
+from warpcaustics.optics.phase import mean_cosine, petzold_table, solid_angle_weights, table_on_grid
 
 SPREAD_NODES = 2000
 """Points of the G(x) table, log-spaced in x = q s from 1e-3 to 1e7 (rad)."""
@@ -49,19 +49,14 @@ def phase_on_grid(kind: PhaseFunctionKind, hg_g: float | None, station: str) -> 
         g = hg_g if hg_g is not None else mean_cosine(theta_t, p_t, cone)
         mu = np.cos(grid)
         return grid, (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * mu) ** 1.5)
-    p = np.where(grid < theta_t[0], cone, np.exp(np.interp(grid, theta_t, np.log(p_t))))
-    return grid, p
+    return grid, table_on_grid(theta_t, p_t, cone, grid)
 
 
 def phase_hankel(theta: np.ndarray, p: np.ndarray, nu: np.ndarray) -> np.ndarray:
     """p̃(ν) = 2π ∫ p(θ) J₀(ν θ) sin θ dθ (trapezoid on the given grid), 1 at ν = 0 for a normalised p."""
     from scipy.special import j0
 
-    width = np.empty_like(theta)
-    step = np.diff(theta)
-    width[0], width[-1] = step[0] / 2, step[-1] / 2
-    width[1:-1] = (step[1:] + step[:-1]) / 2
-    weight = 2.0 * np.pi * p * np.sin(theta) * width
+    weight = solid_angle_weights(theta, p)
     out = np.empty(len(nu))
     for i in range(0, len(nu), 64):  # (64, grid) blocks keep memory small
         out[i : i + 64] = j0(np.outer(nu[i : i + 64], theta)) @ weight

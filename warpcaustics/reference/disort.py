@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from warpcaustics.optics.phase import solid_angle_weights, table_on_grid
 from warpcaustics.reference.floor import fresnel_transmittance
 
 
@@ -42,11 +43,8 @@ def table_moments(theta: np.ndarray, p: np.ndarray, cone_p: float, count: int) -
     cone = np.linspace(0.0, theta[0], 2001)
     body = theta[0] + np.geomspace(1e-9, np.pi - theta[0], 400000)
     grid = np.concatenate([cone, body[body < np.pi], [np.pi]])
-    pf = np.where(grid < theta[0], cone_p, np.exp(np.interp(grid, theta, np.log(np.asarray(p, np.float64)))))
     # trapezoid weights of 2π p sinθ dθ, then P_l(cos θ) by Bonnet's recurrence
-    step = np.diff(grid)
-    width = 0.5 * (np.concatenate([step, [0.0]]) + np.concatenate([[0.0], step]))
-    weight = 2.0 * np.pi * pf * np.sin(grid) * width
+    weight = solid_angle_weights(grid, table_on_grid(theta, p, cone_p, grid))
     mu = np.cos(grid)
     moments = np.empty(count)
     p_prev, p_cur = np.ones_like(mu), mu

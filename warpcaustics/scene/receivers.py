@@ -55,11 +55,11 @@ def floor_relief_height(
         phase = 2.0 * math.pi * (x * math.cos(az) + y * math.sin(az)) / floor.ripple_wavelength_m
         z += floor.ripple_amplitude_m * np.sin(phase)
     elif floor.shape is FloorShape.FILE:
-        z += _periodic_bilinear(relief, extent_m, x, y)
+        z += periodic_bilinear(relief, extent_m, x, y)
     return z
 
 
-def _periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Bilinear interpolation of cell-centre samples h[iy, ix] over the patch, wrapping at its edges."""
     n = h.shape[0]
     u = (x + 0.5 * extent_m) * n / extent_m - 0.5
