@@ -110,3 +110,26 @@ def test_bad_input_is_one_line(tmp_path, capsys):
     with pytest.raises(ConfigError, match="--series"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", series=("tide",), quick=True)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_map_that_holds_the_scattered_light_gets_none_added(tmp_path):
+    """With optics.scattering = "small_angle" the floor map holds the scattered light already, so
+    the column that puts the sun's scattered light back as a uniform background adds none: its
+    direct transmission is 1 and it equals the uniform-sky column; with single scattering it is the
+    Beer–Lambert share below 1 and the column's CV is lower."""
+    pytest.importorskip("matplotlib")
+    water = "model = 'fft'\nresolution = 16\nextent_m = 4.0\nspectrum = 'jonswap'\n"
+    rows = {}
+    for mode in ("single", "small_angle"):
+        scene = _scene(tmp_path, water=water)
+        scene.write_text(scene.read_text().replace("[optics]\n", f"[optics]\nscattering = '{mode}'\n"))
+        out = tmp_path / mode
+        assert main(["field", "gernez2009", str(scene), "--out", str(out), "--quick", "--frames", "2",
+                     "--device", "cpu", "--quiet"]) == 0
+        rows[mode] = list(csv.DictReader((out / "gernez2009.csv").open()))
+    for r in rows["small_angle"]:
+        assert float(r["direct_transmission"]) == 1.0
+        assert float(r["model_cv_uniform_sky_scattered"]) == float(r["model_cv_uniform_sky"])
+    for r in rows["single"]:
+        assert float(r["direct_transmission"]) < 1.0
+        assert float(r["model_cv_uniform_sky_scattered"]) < float(r["model_cv_uniform_sky"])
