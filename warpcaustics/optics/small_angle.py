@@ -93,11 +93,11 @@ def spread(optics: OpticsConfig, x: np.ndarray) -> np.ndarray:
     return np.where(x <= xs[-1], np.interp(x, xs, table), table[-1] * xs[-1] / np.maximum(x, xs[-1]))
 
 
-def scattered_gain(optics: OpticsConfig, kx: np.ndarray, ky: np.ndarray, path_m: float, b: float,
-                   direction: np.ndarray) -> np.ndarray:
-    """e^{b s G(q s)} − 1 on the floor frequencies (kx, ky) [rad m⁻¹] for a beam with unit
-    direction ``direction`` (in the water, pointing down) and path ``path_m`` to the floor: the
-    transfer of the single-scattering map into the scattered light."""
+def forward_path(optics: OpticsConfig, kx: np.ndarray, ky: np.ndarray, path_m: float,
+                 direction: np.ndarray) -> np.ndarray:
+    """∫₀^s p̃(q u) du = s G(q s) [m] on the floor frequencies (kx, ky) [rad m⁻¹] for a beam with unit
+    direction ``direction`` (in the water, pointing down) and path s = ``path_m`` to the floor; the
+    scattered light's transfer is e^{b s G(q s)} − 1, for every band's b."""
     d = np.asarray(direction, np.float64)
     cos_w = abs(d[2])
     horizontal = np.hypot(d[0], d[1])
@@ -108,7 +108,7 @@ def scattered_gain(optics: OpticsConfig, kx: np.ndarray, ky: np.ndarray, path_m:
     along = (kx * ax + ky * ay) / cos_w
     across = -kx * ay + ky * ax
     q = np.hypot(along, across)
-    return np.expm1(b * path_m * spread(optics, q * path_m))
+    return path_m * spread(optics, q * path_m)
 
 
 def scattered_light(single: np.ndarray, texel_m: float, optics: OpticsConfig, path_m: float,
@@ -120,8 +120,8 @@ def scattered_light(single: np.ndarray, texel_m: float, optics: OpticsConfig, pa
     k = 2.0 * np.pi * np.fft.fftfreq(m, d=texel_m)
     kx, ky = np.meshgrid(k, k)  # [iy, ix]
     spectrum = np.fft.fft2(np.asarray(single, np.float64), axes=(-2, -1))
+    forward = forward_path(optics, kx, ky, path_m, direction)
     out = np.empty(single.shape, np.float64)
     for band, b in enumerate(np.asarray(scattering_per_m, np.float64)):
-        gain = scattered_gain(optics, kx, ky, path_m, float(b), direction)
-        out[band] = np.fft.ifft2(spectrum[band] * gain).real
+        out[band] = np.fft.ifft2(spectrum[band] * np.expm1(b * forward)).real
     return out
