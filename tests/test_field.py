@@ -109,7 +109,28 @@ def test_bad_input_is_one_line(tmp_path, capsys):
                              tmp_path / "o", quick=True)
     with pytest.raises(ConfigError, match="--series"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", series=("tide",), quick=True)
+    with pytest.raises(ConfigError, match="--zeniths: 21 is not a measured point"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", zeniths=(20.0, 21.0), quick=True)
+    with pytest.raises(ConfigError, match="--set sun.elevation_deg"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sun.elevation_deg": 30.0},
+                             quick=True)
+    with pytest.raises(ConfigError, match="sky.model"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sky.model": "none"}, quick=True)
+    assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "o"),
+                 "--zeniths", "20,x"]) == 2
+    assert "--zeniths '20,x' must be comma-separated numbers" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_points_are_chosen_from_the_record():
+    """--zeniths / --sqrt-winds keep the record's own points at those values, in the record's
+    values and order of the series; None keeps a whole series."""
+    points = field.gernez2009_points()
+    chosen = field.select_points(points, (20.0, 50.0, 80.0), (1.2, 3.6))
+    assert [p.sun_zenith_deg for p in chosen if p.series == "zenith"] == [20.0, 50.0, 80.0]
+    assert [round(math.sqrt(p.wind_m_s), 6) for p in chosen if p.series == "wind"] == [1.2, 3.6]
+    assert field.select_points(points, None, None) == points
+    assert all(p.series == "zenith" for p in field.select_points(points, None, ()))
 
 
 def test_a_map_that_holds_the_scattered_light_gets_none_added(tmp_path):

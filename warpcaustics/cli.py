@@ -10,7 +10,7 @@ from pathlib import Path
 
 from warpcaustics import __version__
 from warpcaustics.batch.compare import FLOOR_METHODS
-from warpcaustics.errors import WarpcausticsError
+from warpcaustics.errors import ConfigError, WarpcausticsError
 
 EXIT_USER_ERROR = 2
 
@@ -112,8 +112,13 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--series", default="zenith,wind", metavar="S",
                     help="comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); default both")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
+    fd.add_argument("--zeniths", metavar="LIST",
+                    help="only these measured sun zeniths [deg], comma-separated (default all)")
+    fd.add_argument("--sqrt-winds", metavar="LIST",
+                    help="only these measured √wind classes [√(m/s)], comma-separated (default all)")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)
+    _set_arg(fd, ", on every point (a row of the error budget)")
     fd.add_argument("--quick", action="store_true",
                     help="a coarse run of three points, to check the command (not a comparison)")
     fd.add_argument("--quiet", action="store_true", help="no progress lines")
@@ -134,6 +139,16 @@ def _overrides(args: argparse.Namespace) -> dict:
     from warpcaustics.config import parse_override
 
     return dict(parse_override(text) for text in args.overrides)
+
+
+def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
+    """A comma-separated list of numbers, or None when the flag was not given."""
+    if text is None:
+        return None
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise ConfigError(f"{flag} {text!r} must be comma-separated numbers, e.g. 20,50,80") from None
 
 
 def _config(args: argparse.Namespace) -> int:
@@ -327,7 +342,9 @@ def main(argv: list[str] | None = None) -> int:
 
             paths = run_gernez2009(args.scene, args.out, series=tuple(args.series.split(",")),
                                    frames=args.frames, workers=args.workers, device=args.device,
-                                   quick=args.quick, quiet=args.quiet, force=args.force)
+                                   quick=args.quick, quiet=args.quiet, force=args.force,
+                                   overrides=_overrides(args), zeniths=_floats(args.zeniths, "--zeniths"),
+                                   sqrt_winds=_floats(args.sqrt_winds, "--sqrt-winds"))
             print("wrote " + ", ".join(str(p) for p in paths.values()))
             return 0
         if args.command == "report":

@@ -51,6 +51,10 @@ QUICK_OVERRIDES = {
 tests). Its CVs are not a comparison: the surface cells (0.5 m) are far too coarse to focus."""
 
 
+POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s")
+"""The keys each point sets (Point.overrides): a --set of one of them would be overwritten."""
+
+
 @dataclass(frozen=True)
 class Point:
     """One condition of the comparison and the paper's CV there."""
@@ -97,6 +101,27 @@ def gernez2009_points(series: tuple[str, ...] = SERIES) -> list[Point]:
     return points
 
 
+def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
+                  sqrt_winds: tuple[float, ...] | None) -> list[Point]:
+    """The points of the zenith series at ``zeniths`` [deg] and of the wind series at ``sqrt_winds``
+    [√(m/s)] (None: all of that series); a value the record does not hold is an error naming them."""
+    chosen = []
+    for series, wanted, key in (("zenith", zeniths, lambda p: p.sun_zenith_deg),
+                                ("wind", sqrt_winds, lambda p: math.sqrt(p.wind_m_s))):
+        have = [p for p in points if p.series == series]
+        if wanted is None:
+            chosen += have
+            continue
+        for value in wanted:
+            match = [p for p in have if abs(key(p) - value) < 1e-6]
+            if not match:
+                flag = "--zeniths" if series == "zenith" else "--sqrt-winds"
+                held = ", ".join(f"{key(p):g}" for p in have) or "none (not in --series)"
+                raise ConfigError(f"{flag}: {value:g} is not a measured point; the record holds {held}")
+            chosen += match
+    return chosen
+
+
 def pooled_statistics(
     frames: list[tuple[float, float]], background: list[float] | None = None
 ) -> tuple[float, float]:
@@ -134,9 +159,14 @@ def run_gernez2009(
     quick: bool = False,
     quiet: bool = False,
     force: bool = False,
+    overrides: dict | None = None,
+    zeniths: tuple[float, ...] | None = None,
+    sqrt_winds: tuple[float, ...] | None = None,
 ) -> dict[str, Path]:
     """Render every point of the comparison (a resumable sweep into ``out``), pool each point's
-    frames and write ``gernez2009.csv`` and ``gernez2009.png``."""
+    frames and write ``gernez2009.csv`` and ``gernez2009.png``. ``overrides``: config keys set on
+    every point (``--set``: a row of the error budget); ``zeniths`` / ``sqrt_winds``: only these of
+    the record's points (None: all)."""
     from warpcaustics.batch.sweep import expand_sweep, format_report, run_sweep
     from warpcaustics.scene import load_scene
 
@@ -146,11 +176,15 @@ def run_gernez2009(
     if frames < 1:
         raise ConfigError(f"--frames = {frames} must be at least 1")
     scene_path = Path(scene).resolve()
-    fixed = dict(QUICK_OVERRIDES) if quick else {}
+    varied = sorted(set(overrides or {}) & set(POINT_KEYS))
+    if varied:
+        raise ConfigError(f"--set {varied[0]}: the comparison sets it at each point; choose the points "
+                          "with --zeniths / --sqrt-winds instead")
+    fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
     base = load_scene(scene_path, fixed)
     _check_scene(base.config)
     pyplot(PLOT_NEEDS)  # before the sweep, not after it
-    points = gernez2009_points(series)
+    points = select_points(gernez2009_points(series), zeniths, sqrt_winds)
     if quick:  # the first and last zenith, the first wind
         ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
@@ -188,7 +222,8 @@ def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]
 
 def _check_scene(config) -> None:
     """The comparison needs one band at the paper's 510 nm (its CV is of that band), a sky that can
-    take the paper's diffuse share and a stateless sea (each frame pooled is its own task)."""
+    take the paper's diffuse share (uniform or a CIE sky, scaled to it) and a stateless sea (each
+    frame pooled is its own task)."""
     wl = config.optics.wavelengths
     one_band = (wl.list_nm == (510.0,)) or (
         not wl.list_nm and wl.bins == 1 and wl.min_nm <= 510.0 <= wl.max_nm
@@ -202,9 +237,10 @@ def _check_scene(config) -> None:
             f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
             "independent frames of a wind sea: use water.model = 'fft'"
         )
-    if config.sky.model is not SkyModel.UNIFORM:
+    if config.sky.model is SkyModel.NONE:
         raise ConfigError(
-            "the Gernez 2009 comparison needs the sky's diffuse share: set sky.model = 'uniform'"
+            "the Gernez 2009 comparison needs the sky's diffuse share: set sky.model = 'uniform' or "
+            "'cie_clear'"
         )
 
 

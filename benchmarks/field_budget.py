@@ -1,0 +1,124 @@
+"""The error budget of the field comparison (issue 27): ``python -m benchmarks.field_budget``.
+
+Each row is ``warpcaustics field gernez2009 configs/field/gernez2009.toml`` at three of the paper's
+sun zeniths (20°, 50°, 80°) and three of its wind classes (√U = 1.2, 2.4, 3.6, at a 40° sun), with
+one change to the set-up (``--set``), so that each row's change to the model's CV against the
+baseline's is that change's share of the gap. The command each row runs is printed with it and
+written to the table. Rows are resumable sweeps under ``--out`` (default ``out/field_budget``);
+``--rows`` picks some. The table goes to ``benchmarks/results/field_budget.csv`` and is printed as
+markdown (docs/validation.md holds the figures). No parameter here is fitted to a CV: each row is
+a source's value or a resolution, named beside it.
+
+``--quick``: the field command's ``--quick`` (a 64² surface) on two rows, to keep the script
+running; its CVs are not a budget.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "configs/field/gernez2009.toml"
+ZENITHS = (20.0, 50.0, 80.0)
+SQRT_WINDS = (1.2, 2.4, 3.6)
+
+ROWS: dict[str, tuple[dict, str]] = {
+    "baseline": ({}, "configs/field/gernez2009.toml as it is (small-angle scattering, Petzold)"),
+    "single_scattering": ({"optics.scattering": "single"}, "scattered light dropped (c = a + b)"),
+    "cells_1.6cm": ({"water.extent_m": 16.0}, "1024² over 16 m: 1.6 cm cells (waves > 16 m dropped)"),
+    "cells_0.8cm": ({"water.extent_m": 8.0}, "1024² over 8 m: 7.8 mm cells (waves > 8 m dropped)"),
+    "damped_10cm": ({"water.small_wave_m": 0.1}, "waves under ~10 cm damped (Tessendorf's l = 0.1 m)"),
+    "elfouhaily": ({"water.spectrum": "elfouhaily"}, "Elfouhaily et al. 1997 spectrum and spreading"),
+    "elfouhaily_0.8cm": ({"water.spectrum": "elfouhaily", "water.extent_m": 8.0},
+                         "Elfouhaily et al. 1997 on 7.8 mm cells"),
+    "cie_clear": ({"sky.model": "cie_clear"}, "CIE clear sky (type 12) at the paper's diffuse share"),
+    "choppy": ({"water.choppiness": 1.0}, "Lagrangian (choppy) displacement, λ = 1"),
+    "spreading_s2": ({"water.spreading_s": 2.0}, "broad cos-2s spreading, s = 2 (default 10)"),
+    "fetch_200km": ({"water.fetch_m": 200000.0}, "fetch 200 km (near fully developed; default 20 km)"),
+}
+"""name → (overrides, what it changes). The field command sets the sun, the sky's share and the
+wind at each point."""
+
+
+def command(name: str, out: Path, workers: int, quick: bool) -> list[str]:
+    """The ``warpcaustics field`` arguments of one row."""
+    args = ["field", "gernez2009", str(SCENE.relative_to(ROOT)), "--out", str(out / name),
+            "--zeniths", ",".join(f"{z:g}" for z in ZENITHS),
+            "--sqrt-winds", ",".join(f"{w:g}" for w in SQRT_WINDS),
+            "--workers", str(workers), "--quiet"]
+    for key, value in ROWS[name][0].items():
+        args += ["--set", f"{key}={value!r}" if isinstance(value, str) else f"{key}={value}"]
+    return args + (["--quick"] if quick else [])
+
+
+def run_row(name: str, out: Path, workers: int, quick: bool) -> list[dict]:
+    from warpcaustics.cli import main
+
+    args = command(name, out, workers, quick)
+    print("warpcaustics " + " ".join(args), flush=True)
+    start = time.perf_counter()
+    if main(args) != 0:
+        raise SystemExit(f"row {name!r} failed")
+    seconds = time.perf_counter() - start
+    with (out / name / "gernez2009.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    return [{"row": name, "seconds": round(seconds, 1), **r} for r in rows]
+
+
+def table(results: list[dict]) -> str:
+    """Markdown: one line per row, the model's CV (as rendered) at each point with its change against
+    the baseline, and the geometric mean of its ratios to the measured medians."""
+    points = [(r["series"], r["sun_zenith_deg"], r["sqrt_wind"]) for r in results
+              if r["row"] == results[0]["row"]]
+    head = [f"{z}°" if s == "zenith" else f"√U {w}" for s, z, w in points]
+    lines = ["| row | " + " | ".join(head) + " | mean ratio to measured |",
+             "|---|" + "---|" * (len(head) + 1)]
+    measured = {p: float(r["measured_cv"]) for r in results
+                for p in [(r["series"], r["sun_zenith_deg"], r["sqrt_wind"])]}
+    base = {(r["series"], r["sun_zenith_deg"], r["sqrt_wind"]): float(r["model_cv"])
+            for r in results if r["row"] == "baseline"}
+    for name in dict.fromkeys(r["row"] for r in results):
+        cells, ratios = [], []
+        for p in points:
+            cv = next(float(r["model_cv"]) for r in results if r["row"] == name
+                      and (r["series"], r["sun_zenith_deg"], r["sqrt_wind"]) == p)
+            change = f" ({cv / base[p] - 1.0:+.0%})" if p in base and name != "baseline" else ""
+            cells.append(f"{cv:.3f}{change}")
+            ratios.append(cv / measured[p])
+        geometric = math.exp(sum(map(math.log, ratios)) / len(ratios))
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {geometric:.2f} |")
+    lines.append("| measured | " + " | ".join(f"{measured[p]:.3f}" for p in points) + " | 1 |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rows", default=",".join(ROWS), help=f"comma-separated, of: {', '.join(ROWS)}")
+    parser.add_argument("--out", default=str(ROOT / "out/field_budget"), help="folder of the rows' sweeps")
+    parser.add_argument("--workers", type=int, default=1, help="worker processes per row (default 1)")
+    parser.add_argument("--quick", action="store_true", help="two coarse rows (checks the script)")
+    parser.add_argument("--csv", default=str(ROOT / "benchmarks/results/field_budget.csv"),
+                        help="where the table goes")
+    args = parser.parse_args(argv)
+    names = ["baseline", "choppy"] if args.quick else args.rows.split(",")
+    unknown = [n for n in names if n not in ROWS]
+    if unknown:
+        parser.error(f"unknown row {unknown[0]!r}; rows: {', '.join(ROWS)}")
+    out = Path(args.out) / ("quick" if args.quick else "")
+    results = [r for name in names for r in run_row(name, out, args.workers, args.quick)]
+    if not args.quick:
+        with open(args.csv, "w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=list(results[0]))
+            writer.writeheader()
+            writer.writerows(results)
+    print(table(results) if "baseline" in names else "\n".join(map(str, results)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
