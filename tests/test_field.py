@@ -154,3 +154,58 @@ def test_a_map_that_holds_the_scattered_light_gets_none_added(tmp_path):
     for r in rows["single"]:
         assert float(r["direct_transmission"]) < 1.0
         assert float(r["model_cv_uniform_sky_scattered"]) < float(r["model_cv_uniform_sky"])
+
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+DARECKI = ROOT / "configs/field/darecki2011.toml"
+
+
+def test_darecki_config_holds_the_records_conditions():
+    """configs/field/darecki2011.toml: the record's bands, collector, mid sun and wind, and a water
+    whose c(555) is the record's 0.68 1/m to 0.5 % (its chlorophyll, solved by chlorophyll_for,
+    is found again from the record)."""
+    import warpcaustics as wc
+    from warpcaustics.batch.field import darecki2011
+
+    rec = jerlov.darecki2011_irradiance_cv()
+    cfg = wc.load_scene(DARECKI).config
+    assert cfg.optics.wavelengths.list_nm == tuple(float(w) for w in rec.wavelengths_nm)
+    assert cfg.stats.collector_mm == rec.collector_mm
+    assert 90.0 - cfg.sun.elevation_deg == pytest.approx(np.mean(rec.sun_zenith_deg))
+    assert cfg.water.wind_speed_m_s == pytest.approx(np.mean(rec.wind_m_s))
+    c555 = darecki2011.beam_attenuation(cfg, 555.0)
+    assert c555 == pytest.approx(rec.beam_attenuation_555, rel=5e-3)
+    chl = darecki2011.chlorophyll_for(cfg, rec.beam_attenuation_555)
+    assert chl == pytest.approx(cfg.optics.chlorophyll_mg_m3, rel=1e-3)
+
+
+def test_darecki_command_on_still_water_measures_no_fluctuation(tmp_path):
+    """The depth-profile command end to end (--quick): under still water the CV is 0 in every band
+    at every depth, beside the record's values; a plot is written."""
+    pytest.importorskip("matplotlib")
+    flat = tmp_path / "flat.toml"
+    flat.write_text(DARECKI.read_text().replace('model = "fft"', 'model = "flat"'))
+    out = tmp_path / "o"
+    assert main(["field", "darecki2011", str(flat), "--out", str(out), "--quick", "--frames", "1",
+                 "--depths", "0.86,9.58", "--device", "cpu", "--quiet"]) == 0
+    rows = list(csv.DictReader((out / "darecki2011.csv").open()))
+    rec = jerlov.darecki2011_irradiance_cv()
+    assert [(float(r["depth_m"]), float(r["wavelength_nm"])) for r in rows] == [
+        (d, float(w)) for d in (0.86, 9.58) for w in rec.wavelengths_nm]
+    assert all(float(r["model_cv"]) < 1e-5 for r in rows)
+    assert [float(r["measured_cv"]) for r in rows[:3]] == pytest.approx(rec.cv[0].tolist(), abs=1e-4)
+    assert (out / "darecki2011.png").stat().st_size > 0
+
+
+def test_darecki_bad_input_is_one_line(tmp_path, capsys):
+    with pytest.raises(ConfigError, match="--depths: 5 is not a measured depth"):
+        field.run_darecki2011(DARECKI, tmp_path / "o", depths=(5.0,), quick=True)
+    with pytest.raises(ConfigError, match=r"optics.wavelengths = \[443.0, 532.0, 670.0\]"):
+        field.run_darecki2011(DARECKI, tmp_path / "o", overrides={"optics.wavelengths": [510.0]}, quick=True)
+    with pytest.raises(ConfigError, match="stats.per_band = true"):
+        field.run_darecki2011(DARECKI, tmp_path / "o", overrides={"stats.per_band": False}, quick=True)
+    with pytest.raises(ConfigError, match="--set floor.depth_m"):
+        field.run_darecki2011(DARECKI, tmp_path / "o", overrides={"floor.depth_m": 2.0}, quick=True)
+    assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"), "--zeniths", "20"]) == 2
+    assert "--zeniths is not a flag of darecki2011" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

@@ -185,6 +185,27 @@ def test_sky_and_direct_parts_have_their_own_statistics():
     assert 0.0 < s["direct_irradiance_w_m2"]["cv"] and s["sky_irradiance_w_m2"]["cv"] > 0.0
 
 
+def test_per_band_statistics_are_each_bands_own():
+    """stats.per_band: each band's statistics after the collector; the band holding
+    stats.wavelength_nm equals the one reported for it, and each band's mean and CV are numpy's
+    over that band's map (collector 0: the texels themselves)."""
+    import warpcaustics as wc
+    from warpcaustics.batch.stats import frame_statistics
+
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 32, "caustics.map_resolution": 32,
+                                                 "optics.wavelengths": [443.0, 532.0, 670.0],
+                                                 "stats.per_band": True, "stats.wavelength_nm": 532.0})
+    r = wc.render(scene, device="cpu")
+    s = frame_statistics(r, scene.config.stats)
+    assert list(s["bands"]) == ["443nm_w_m2_nm", "532nm_w_m2_nm", "670nm_w_m2_nm"]
+    assert s["bands"]["532nm_w_m2_nm"] == s["band_532nm_w_m2_nm"]
+    for k, key in enumerate(s["bands"]):
+        band = np.asarray(r.floor_irradiance[k], np.float64)
+        assert s["bands"][key]["mean"] == pytest.approx(band.mean(), rel=1e-9)
+        assert s["bands"][key]["cv"] == pytest.approx(band.std() / band.mean(), rel=1e-9)
+    assert "bands" not in frame_statistics(r, wc.load_scene(CONFIGS / "ocean.toml").config.stats)
+
+
 @pytest.mark.parametrize("integration_s", [0.05, 1.0 / 6.0, 0.37, 1.0])
 def test_integration_of_a_sinusoid_is_its_sinc(integration_s):
     """E(t) = 1 + A sin(2πft) (f = 2 Hz) sampled at 200 Hz, averaged over the last T before each

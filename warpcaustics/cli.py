@@ -102,25 +102,29 @@ def _parser() -> argparse.ArgumentParser:
                         description="Print DIR/summary.csv and write DIR/summary.png.")
     rp.add_argument("out", metavar="DIR", help="the folder of a sweep")
 
-    fd = sub.add_parser("field", help="compare the model with field measurements (Gernez & Antoine 2009)",
+    fd = sub.add_parser("field", help="compare the model with field measurements (Gernez & Antoine 2009, "
+                                      "Darecki et al. 2011)",
                         description="Render SCENE at the conditions of a field data set (a resumable sweep "
                                     "into DIR), and write the model against the measurements as CSV and PNG.")
-    fd.add_argument("dataset", choices=["gernez2009"], help="the field data set")
+    fd.add_argument("dataset", choices=["gernez2009", "darecki2011"], help="the field data set")
     fd.add_argument("scene", metavar="SCENE",
                     help="the scene of its conditions, e.g. configs/field/gernez2009.toml")
     fd.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
-    fd.add_argument("--series", default="zenith,wind", metavar="S",
-                    help="comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); default both")
-    fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
+    fd.add_argument("--series", metavar="S",
+                    help="gernez2009: comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); "
+                         "default both")
     fd.add_argument("--zeniths", metavar="LIST",
-                    help="only these measured sun zeniths [deg], comma-separated (default all)")
+                    help="gernez2009: only these measured sun zeniths [deg], comma-separated (default all)")
     fd.add_argument("--sqrt-winds", metavar="LIST",
-                    help="only these measured √wind classes [√(m/s)], comma-separated (default all)")
+                    help="gernez2009: only these measured √wind classes [√(m/s)], comma-separated")
+    fd.add_argument("--depths", metavar="LIST",
+                    help="darecki2011: only these measured depths [m], comma-separated (default all)")
+    fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)
     _set_arg(fd, ", on every point (a row of the error budget)")
     fd.add_argument("--quick", action="store_true",
-                    help="a coarse run of three points, to check the command (not a comparison)")
+                    help="a coarse run of two or three points, to check the command (not a comparison)")
     fd.add_argument("--quiet", action="store_true", help="no progress lines")
     fd.add_argument("--force", action="store_true", help="add this run to a folder holding another one")
 
@@ -149,6 +153,27 @@ def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
         return tuple(float(x) for x in text.split(","))
     except ValueError:
         raise ConfigError(f"{flag} {text!r} must be comma-separated numbers, e.g. 20,50,80") from None
+
+
+def _field(args: argparse.Namespace) -> int:
+    """``warpcaustics field``: each data set takes its own point flags; another's is an error."""
+    from warpcaustics.batch.field import run_darecki2011, run_gernez2009
+
+    own = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011": ("depths",)}[args.dataset]
+    for name in ("series", "zeniths", "sqrt_winds", "depths"):
+        if name not in own and getattr(args, name) is not None:
+            raise ConfigError(f"--{name.replace('_', '-')} is not a flag of {args.dataset} "
+                              f"(its point flags: {', '.join('--' + n.replace('_', '-') for n in own)})")
+    common = dict(frames=args.frames, workers=args.workers, device=args.device, quick=args.quick,
+                  quiet=args.quiet, force=args.force, overrides=_overrides(args))
+    if args.dataset == "gernez2009":
+        paths = run_gernez2009(args.scene, args.out, series=tuple((args.series or "zenith,wind").split(",")),
+                               zeniths=_floats(args.zeniths, "--zeniths"),
+                               sqrt_winds=_floats(args.sqrt_winds, "--sqrt-winds"), **common)
+    else:
+        paths = run_darecki2011(args.scene, args.out, depths=_floats(args.depths, "--depths"), **common)
+    print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0
 
 
 def _config(args: argparse.Namespace) -> int:
@@ -338,15 +363,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "compare":
             return _compare(args)
         if args.command == "field":
-            from warpcaustics.batch.field import run_gernez2009
-
-            paths = run_gernez2009(args.scene, args.out, series=tuple(args.series.split(",")),
-                                   frames=args.frames, workers=args.workers, device=args.device,
-                                   quick=args.quick, quiet=args.quiet, force=args.force,
-                                   overrides=_overrides(args), zeniths=_floats(args.zeniths, "--zeniths"),
-                                   sqrt_winds=_floats(args.sqrt_winds, "--sqrt-winds"))
-            print("wrote " + ", ".join(str(p) for p in paths.values()))
-            return 0
+            return _field(args)
         if args.command == "report":
             from warpcaustics.batch.sweep import report_main
 

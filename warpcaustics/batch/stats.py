@@ -122,7 +122,8 @@ def field_statistics(field: np.ndarray, flash_threshold: float) -> dict:
 def frame_statistics(result, cfg: StatsConfig) -> dict:
     """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
-    band holding it [W m⁻² nm⁻¹], after the collector."""
+    band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``), after the
+    collector."""
     fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
     sky = result.sky_floor_irradiance
     if sky is not None:  # the direct sun's part and the sky's, each alone
@@ -139,6 +140,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         fields[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = np.asarray(
             result.floor_irradiance[band], np.float64
         )
+    if cfg.per_band:
+        for k, nm in enumerate(result.wavelengths_nm):
+            fields[f"bands/{nm:g}nm_w_m2_nm"] = np.asarray(result.floor_irradiance[k], np.float64)
     texel = result.map_extent_m / result.floor_irradiance.shape[-1]
     periodic = result.map_periodic
     out = {
@@ -148,9 +152,11 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "par_band_nm": covered,
     }
     for name, f in fields.items():
-        out[name] = field_statistics(
+        stats = field_statistics(
             collector_average(f, texel, cfg.collector_mm * 1e-3, periodic=periodic), cfg.flash_threshold
         )
+        group, _, band_name = name.rpartition("/")
+        (out.setdefault(group, {}) if group else out)[band_name] = stats
     return out
 
 

@@ -58,6 +58,9 @@ class StatsConfig:
     """A flash is irradiance above this many times the mean [-]."""
     wavelength_nm: float | None = field(default=None, metadata=_range(100.0, 5000.0))
     """Also report the statistics of the band holding this wavelength (e.g. 510 nm) [nm]."""
+    per_band: bool = False
+    """Also report the statistics of every band, each after the collector (run.json's ``bands``):
+    spectral CVs, e.g. Darecki et al. (2011)'s 443/532/670 nm."""
     probes: tuple[ProbeConfig, ...] = ()
     """Floor points whose irradiance over an animation is reported (``[[stats.probes]]`` tables
     with x_m, y_m); none given: the floor map's centre."""

@@ -20,15 +20,21 @@ homogeneous, stationary sea (ergodicity), which a linear random FFT sea is.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.batch.field.common import (
+    check_frames,
+    check_overrides,
+    frame_statistics_of,
+    pooled_statistics,
+    render_points,
+)
 from warpcaustics.config import Scattering, SkyModel
-from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 SERIES = ("zenith", "wind")
@@ -122,22 +128,6 @@ def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
     return chosen
 
 
-def pooled_statistics(
-    frames: list[tuple[float, float]], background: list[float] | None = None
-) -> tuple[float, float]:
-    """Mean and CV of all texels of several equal-sized frames, from each frame's (mean μᵢ, CVᵢ):
-    E[E²] = mean over frames of μᵢ²(1 + CVᵢ²), so CV² = E[E²]/μ² − 1 with μ the mean of the μᵢ.
-    ``background``: a uniform irradiance Bᵢ added to every texel of frame i (its mean grows by
-    Bᵢ, its variance does not)."""
-    mu = np.array([m for m, _ in frames], np.float64)
-    sd = mu * np.array([c for _, c in frames], np.float64)
-    if background is not None:
-        mu = mu + np.asarray(background, np.float64)
-    mean = float(mu.mean())
-    second = float(np.mean(mu**2 + sd**2))
-    return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0
-
-
 def direct_transmission(sun_zenith_deg: float, depth_m: float, ior: float, scattering_per_m: float) -> float:
     """exp(−b·d/cos θ_w): the share of the sun's refracted beam not scattered on its way down. The
     rest, lost by single scattering, is mostly scattered forward (Petzold's mean cosines are
@@ -167,19 +157,14 @@ def run_gernez2009(
     frames and write ``gernez2009.csv`` and ``gernez2009.png``. ``overrides``: config keys set on
     every point (``--set``: a row of the error budget); ``zeniths`` / ``sqrt_winds``: only these of
     the record's points (None: all)."""
-    from warpcaustics.batch.sweep import expand_sweep, format_report, run_sweep
     from warpcaustics.scene import load_scene
 
     unknown = set(series) - set(SERIES)
     if not series or unknown:
         raise ConfigError(f"--series {','.join(series)!r} must name some of: {', '.join(SERIES)}")
-    if frames < 1:
-        raise ConfigError(f"--frames = {frames} must be at least 1")
+    check_frames(frames)
+    check_overrides(overrides, POINT_KEYS, "--zeniths / --sqrt-winds")
     scene_path = Path(scene).resolve()
-    varied = sorted(set(overrides or {}) & set(POINT_KEYS))
-    if varied:
-        raise ConfigError(f"--set {varied[0]}: the comparison sets it at each point; choose the points "
-                          "with --zeniths / --sqrt-winds instead")
     fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
     base = load_scene(scene_path, fixed)
     _check_scene(base.config)
@@ -189,20 +174,9 @@ def run_gernez2009(
         ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
     overrides, variants = point_variants(points, base.config)
-    zipped = {k: [o[k] for o in variants] for k in variants[0]}
     times = tuple(i * frame_interval_s for i in range(frames))
-    sweep = expand_sweep(scene_path, fixed, {}, zipped, times, scene_path)
-    bad = next((t.error for t in sweep.tasks if t.error is not None), None)
-    if bad is not None:
-        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
-    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet, force=force)
-    if not quiet:
-        print(format_report(report))
-    if report.failed:
-        raise WarpcausticsError(
-            f"{len(report.failed)} task(s) failed (see {Path(out) / 'manifest.jsonl'}); "
-            "fix the cause and rerun the same command to finish them"
-        )
+    sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
+                          quiet=quiet, force=force)
     rows = _rows(points, overrides, sweep, Path(out), base.config)
     out = Path(out)
     paths = {"csv": out / "gernez2009.csv", "png": out / "gernez2009.png"}
@@ -258,13 +232,10 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     rows = []
     for point, o in zip(points, overrides):
         total, direct, sky = [], [], []
-        for task in sweep.tasks:
-            if all(task.overrides.get(k) == v for k, v in o.items()):
-                run = json.loads((out / task.id / "run.json").read_text())
-                s = run["frames"][0]["statistics"]
-                total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
-                direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
-                sky.append(s["sky_irradiance_w_m2"]["mean"])
+        for s in frame_statistics_of(sweep, out, o):
+            total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
+            direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
+            sky.append(s["sky_irradiance_w_m2"]["mean"])
         mean, cv = pooled_statistics(total)
         per_frame = [c for _, c in total]
         # the sky as a uniform background: its K directions' own caustics removed

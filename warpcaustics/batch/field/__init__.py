@@ -1,0 +1,33 @@
+"""Field comparisons: the model's irradiance fluctuations against published measurements, each a
+data set registered by name (``warpcaustics field NAME SCENE --out DIR``):
+
+- ``gernez2009`` (:mod:`.gernez2009`): CV against the sun's zenith and the wind at 3.2 m, 510 nm,
+  8 mm collector (Gernez & Antoine 2009, BOUSSOLE).
+- ``darecki2011`` (:mod:`.darecki2011`): CV against depth, 0.86-9.58 m, at 443/532/670 nm,
+  2.5 mm collector (Darecki, Stramski & Sokolski 2011, Santa Barbara Channel).
+
+Each renders its points as one resumable sweep (:mod:`.common`) and writes a CSV and a figure.
+"""
+
+from warpcaustics.batch.field.common import pooled_statistics
+from warpcaustics.batch.field.darecki2011 import run_darecki2011
+from warpcaustics.batch.field.gernez2009 import (
+    POINT_KEYS,
+    QUICK_OVERRIDES,
+    Point,
+    diffuse_fraction,
+    direct_transmission,
+    gernez2009_points,
+    point_variants,
+    run_gernez2009,
+    select_points,
+)
+
+DATASETS = {"gernez2009": run_gernez2009, "darecki2011": run_darecki2011}
+"""name → the function that runs its comparison."""
+
+__all__ = [
+    "DATASETS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction", "direct_transmission",
+    "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011", "run_gernez2009",
+    "select_points",
+]

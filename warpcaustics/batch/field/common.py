@@ -1,0 +1,75 @@
+"""What every field comparison shares: its points rendered as one resumable sweep (issue 7's
+runner, ``--workers`` processes), the frames of a point found again by its overrides, and the
+statistics pooled over them."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from warpcaustics.errors import ConfigError, WarpcausticsError
+
+
+def check_frames(frames: int) -> None:
+    if frames < 1:
+        raise ConfigError(f"--frames = {frames} must be at least 1")
+
+
+def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose: str) -> None:
+    """A ``--set`` of a key the comparison sets at each point would be overwritten: say so."""
+    varied = sorted(set(overrides or {}) & set(point_keys))
+    if varied:
+        raise ConfigError(f"--set {varied[0]}: the comparison sets it at each point; choose the points "
+                          f"with {choose} instead")
+
+
+def render_points(scene_path: Path, fixed: dict, variants: list[dict], times: tuple[float, ...],
+                  out: str | Path, *, workers: int, device: str | None, quiet: bool, force: bool):
+    """Render every variant (a dict of overrides on top of ``fixed``) at ``times`` as one sweep
+    into ``out``; returns the sweep. A variant the scene cannot take fails before anything renders;
+    failed tasks raise after the rest have run (rerun the same command to finish them)."""
+    from warpcaustics.batch.sweep import expand_sweep, format_report, run_sweep
+
+    zipped = {k: [o[k] for o in variants] for k in variants[0]}
+    sweep = expand_sweep(scene_path, fixed, {}, zipped, times, scene_path)
+    bad = next((t.error for t in sweep.tasks if t.error is not None), None)
+    if bad is not None:
+        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
+    report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet, force=force)
+    if not quiet:
+        print(format_report(report))
+    if report.failed:
+        raise WarpcausticsError(
+            f"{len(report.failed)} task(s) failed (see {Path(out) / 'manifest.jsonl'}); "
+            "fix the cause and rerun the same command to finish them"
+        )
+    return sweep
+
+
+def frame_statistics_of(sweep, out: str | Path, overrides: dict) -> list[dict]:
+    """The run.json statistics of every frame whose task has these overrides."""
+    found = []
+    for task in sweep.tasks:
+        if all(task.overrides.get(k) == v for k, v in overrides.items()):
+            run = json.loads((Path(out) / task.id / "run.json").read_text())
+            found += [f["statistics"] for f in run["frames"]]
+    return found
+
+
+def pooled_statistics(
+    frames: list[tuple[float, float]], background: list[float] | None = None
+) -> tuple[float, float]:
+    """Mean and CV of all texels of several equal-sized frames, from each frame's (mean μᵢ, CVᵢ):
+    E[E²] = mean over frames of μᵢ²(1 + CVᵢ²), so CV² = E[E²]/μ² − 1 with μ the mean of the μᵢ.
+    ``background``: a uniform irradiance Bᵢ added to every texel of frame i (its mean grows by
+    Bᵢ, its variance does not)."""
+    mu = np.array([m for m, _ in frames], np.float64)
+    sd = mu * np.array([c for _, c in frames], np.float64)
+    if background is not None:
+        mu = mu + np.asarray(background, np.float64)
+    mean = float(mu.mean())
+    second = float(np.mean(mu**2 + sd**2))
+    return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0

@@ -1,0 +1,192 @@
+"""Field comparison: the CV of downwelling irradiance against depth, Darecki et al. (2011).
+
+Darecki, Stramski & Sokolski (2011), "Measurements of high-frequency light fluctuations induced by
+sea surface waves with an Underwater Porcupine Radiometer System", J. Geophys. Res. 116, C00H09,
+Fig. 13a: the CV of Ed at 443, 532 and 670 nm at six depths from 0.86 to 9.58 m, Santa Barbara
+Channel, sun 30-33° from the zenith, wind 4.1-6.4 m/s, beam attenuation c(555) = 0.68 1/m, a
+2.5 mm collector. The values come from the ``jerlov`` package (``darecki2011_irradiance_cv``).
+
+``warpcaustics field darecki2011 SCENE --out DIR`` renders SCENE (``configs/field/darecki2011.toml``,
+which holds the record's conditions) with its floor at each of the record's depths, as one
+resumable sweep, pools each depth's frames per band (``stats.per_band``) and writes
+``darecki2011.csv`` and the profile CV(z) per band, ``darecki2011.png``. As for Gernez & Antoine,
+the model's CV is spatial (a window after the collector, pooled over frames) and the measurement's
+temporal; the two agree for a stationary, homogeneous sea.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from warpcaustics.batch.field.common import (
+    check_frames,
+    check_overrides,
+    frame_statistics_of,
+    pooled_statistics,
+    render_points,
+)
+from warpcaustics.errors import ConfigError
+from warpcaustics.io.files import atomic_path, pyplot, write_csv
+
+POINT_KEYS = ("floor.depth_m",)
+
+QUICK_OVERRIDES = {
+    "water.resolution": 64,
+    "water.extent_m": 8.0,
+    "caustics.map_resolution": 40,
+    "caustics.map_extent_m": 0.4,
+    "sun.disk_samples": 2,
+    "sky.directions": 2,
+}
+"""``--quick``: a coarse version of every task, to check the command end to end (not a comparison)."""
+
+PLOT_NEEDS = "the comparison's plot needs"
+
+
+def record():
+    """The measured profile (``jerlov.darecki2011_irradiance_cv``)."""
+    import jerlov
+
+    return jerlov.darecki2011_irradiance_cv()
+
+
+def beam_attenuation(config, wavelength_nm: float) -> float:
+    """c = a + b [1/m] of the scene's water at ``wavelength_nm``."""
+    from dataclasses import replace
+
+    from warpcaustics.optics.spectra import bins_for, water_optics
+
+    optics = replace(config.optics, wavelengths=replace(config.optics.wavelengths, list_nm=(wavelength_nm,)))
+    o = water_optics(optics, bins_for(optics))
+    return float(o.absorption_per_m[0] + o.scattering_per_m[0])
+
+
+def select_depths(depths_m: np.ndarray, wanted: tuple[float, ...] | None) -> list[float]:
+    """The record's depths at ``wanted`` (None: all); one the record lacks is an error."""
+    have = [float(d) for d in depths_m]
+    if wanted is None:
+        return have
+    for d in wanted:
+        if not any(abs(d - h) < 1e-6 for h in have):
+            raise ConfigError(f"--depths: {d:g} is not a measured depth; the record holds "
+                              + ", ".join(f"{h:g}" for h in have))
+    return [h for h in have if any(abs(d - h) < 1e-6 for d in wanted)]
+
+
+def _check_scene(config, rec) -> None:
+    """One band at each of the record's wavelengths, per-band statistics, a stateless sea."""
+    listed = tuple(config.optics.wavelengths.list_nm)
+    wanted = tuple(float(w) for w in rec.wavelengths_nm)
+    if listed != wanted:
+        raise ConfigError(f"the Darecki 2011 comparison is of the bands {list(wanted)} nm: set "
+                          f"optics.wavelengths = {list(wanted)}")
+    if not config.stats.per_band:
+        raise ConfigError("the Darecki 2011 comparison needs each band's statistics: set "
+                          "stats.per_band = true")
+    if config.water.stateful:
+        raise ConfigError(f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
+                          "independent frames of a wind sea: use water.model = 'fft'")
+
+
+def run_darecki2011(
+    scene: str | Path,
+    out: str | Path,
+    *,
+    depths: tuple[float, ...] | None = None,
+    frames: int = 3,
+    frame_interval_s: float = 0.5,
+    workers: int = 1,
+    device: str | None = None,
+    quick: bool = False,
+    quiet: bool = False,
+    force: bool = False,
+    overrides: dict | None = None,
+) -> dict[str, Path]:
+    """Render SCENE at each of the record's depths (or ``depths`` of them) as one resumable sweep
+    into ``out``, pool each depth's frames per band and write ``darecki2011.csv`` and
+    ``darecki2011.png``. ``overrides``: config keys set at every depth (``--set``)."""
+    from warpcaustics.scene import load_scene
+
+    check_frames(frames)
+    check_overrides(overrides, POINT_KEYS, "--depths")
+    rec = record()
+    scene_path = Path(scene).resolve()
+    fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
+    base = load_scene(scene_path, fixed)
+    _check_scene(base.config, rec)
+    pyplot(PLOT_NEEDS)  # before the sweep, not after it
+    chosen = select_depths(rec.depth_m, depths)
+    if quick:
+        chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
+    variants = [{"floor.depth_m": d} for d in chosen]
+    times = tuple(i * frame_interval_s for i in range(frames))
+    sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
+                          quiet=quiet, force=force)
+    c555 = beam_attenuation(base.config, 555.0)
+    rows = []
+    for depth in chosen:
+        k = int(np.argmin(np.abs(rec.depth_m - depth)))
+        stats = frame_statistics_of(sweep, out, {"floor.depth_m": depth})
+        for j, nm in enumerate(rec.wavelengths_nm):
+            band = [s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats]
+            _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
+            measured = float(rec.cv[k, j])
+            rows.append({
+                "depth_m": depth,
+                "wavelength_nm": float(nm),
+                "measured_cv": round(measured, 4),
+                "model_cv": round(cv, 4),
+                "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
+                "model_over_measured": round(cv / measured, 3),
+                "frames": len(band),
+                "model_c555_per_m": round(c555, 4),
+                "measured_c555_per_m": float(rec.beam_attenuation_555),
+            })
+    out = Path(out)
+    paths = {"csv": out / "darecki2011.csv", "png": out / "darecki2011.png"}
+    write_csv(paths["csv"], rows)
+    _plot(rows, paths["png"], quick)
+    return paths
+
+
+def _plot(rows: list[dict], path: Path, quick: bool) -> None:
+    """CV(z), one panel per band: the measured profile and the model's."""
+    plt = pyplot(PLOT_NEEDS)
+    bands = sorted({r["wavelength_nm"] for r in rows})
+    fig, axes = plt.subplots(1, len(bands), figsize=(3.8 * len(bands), 4.2), sharey=True, squeeze=False)
+    for ax, nm in zip(axes[0], bands):
+        rs = [r for r in rows if r["wavelength_nm"] == nm]
+        z = [r["depth_m"] for r in rs]
+        ax.plot([r["measured_cv"] for r in rs], z, "ko-", label="Darecki et al. 2011 (Fig. 13a)")
+        ax.errorbar([r["model_cv"] for r in rs], z, xerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
+                    color="tab:blue", capsize=3, label="model as rendered")
+        ax.set_xscale("log")
+        ax.set_title(f"{nm:g} nm")
+        ax.set_xlabel("CV of Ed")
+        ax.grid(alpha=0.3, which="both")
+    axes[0][0].invert_yaxis()
+    axes[0][0].set_ylabel("depth [m]")
+    axes[0][0].legend(fontsize=8)
+    if quick:
+        fig.suptitle("--quick: coarse check of the command, not a comparison", color="tab:red")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+
+
+def chlorophyll_for(config, c_per_m: float, wavelength_nm: float = 555.0) -> float:
+    """The chlorophyll [mg m⁻³] at which the scene's bio-optical water has beam attenuation
+    ``c_per_m`` at ``wavelength_nm`` (bisection in log chlorophyll on the package's own IOPs): how
+    ``configs/field/darecki2011.toml`` got its value from the record's c(555)."""
+    from dataclasses import replace
+
+    lo, hi = 1e-3, 100.0
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        cfg = replace(config, optics=replace(config.optics, chlorophyll_mg_m3=mid))
+        lo, hi = (mid, hi) if beam_attenuation(cfg, wavelength_nm) < c_per_m else (lo, mid)
+    return math.sqrt(lo * hi)
