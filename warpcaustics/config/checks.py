@@ -10,7 +10,7 @@ from warpcaustics.config.light import SkyModel, SunSpectrum
 from warpcaustics.config.optics import Scattering
 from warpcaustics.config.scene import FloorShape
 from warpcaustics.config.schema import Config
-from warpcaustics.config.water import WaterModel
+from warpcaustics.config.water import WaterModel, WaterSpectrum
 from warpcaustics.errors import ConfigError
 
 
@@ -27,10 +27,26 @@ def _check_consistency(cfg: Config) -> None:
         raise ConfigError("sun.file is missing; sun.spectrum = 'file' needs a CSV of wavelength [nm], "
                           "irradiance (set sun.file = \"sun.csv\")")
     _check_photon_scene(cfg)
+    _check_wave_age(cfg)
     n = cfg.water.resolution
     if cfg.water.model is WaterModel.FFT and n is not None and (n & (n - 1)):
         raise ConfigError(f"water.resolution = {n} must be a power of two for water.model = 'fft' "
                           f"(e.g. {1 << max(2, round(math.log2(n)))})")
+
+
+def _check_wave_age(cfg: Config) -> None:
+    """Elfouhaily et al.'s JONSWAP fits hold for inverse wave ages up to 5: a shorter fetch is
+    outside the spectrum's range."""
+    w = cfg.water
+    if w.model is not WaterModel.FFT or w.spectrum is not WaterSpectrum.ELFOUHAILY:
+        return
+    from warpcaustics.water.elfouhaily import OMEGA_C_RANGE, inverse_wave_age, shortest_fetch_m
+
+    omega_c = inverse_wave_age(w.wind_speed_m_s, w.fetch_m)
+    if omega_c > OMEGA_C_RANGE[1]:
+        raise ConfigError(f"water.fetch_m = {w.fetch_m:g} gives an inverse wave age {omega_c:.3g}, above "
+                          f"the {OMEGA_C_RANGE[1]:g} that water.spectrum = 'elfouhaily' is fitted to: use a "
+                          f"fetch of at least {shortest_fetch_m(w.wind_speed_m_s):.4g} m at this wind")
 
 
 def _check_file_key(key: str, file: str | None, selector: str, selected, reader, what: str,

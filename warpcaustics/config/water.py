@@ -20,6 +20,7 @@ class WaterModel(str, enum.Enum):
 class WaterSpectrum(str, enum.Enum):
     PHILLIPS = "phillips"
     JONSWAP = "jonswap"
+    ELFOUHAILY = "elfouhaily"
 
 
 @dataclass(frozen=True)
@@ -66,7 +67,8 @@ class WaterConfig:
     """``.npy`` 2-D float array of heights [m], ``h[iy, ix]``, at cell centres; relative paths
     are resolved against the config file's folder."""
     spectrum: WaterSpectrum = WaterSpectrum.PHILLIPS
-    """Wave spectrum of the ``fft`` ocean: ``phillips`` (Tessendorf) or ``jonswap`` (fetch-limited)."""
+    """Wave spectrum of the ``fft`` ocean: ``phillips`` (Tessendorf), ``jonswap`` (fetch-limited) or
+    ``elfouhaily`` (Elfouhaily et al. 1997: long and short waves, its own spreading)."""
     wind_speed_m_s: float = field(default=4.0, metadata=_positive(60.0))
     """Wind speed at 10 m [m/s]."""
     wind_direction_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
@@ -76,7 +78,7 @@ class WaterConfig:
     small_wave_m: float = field(default=0.0, metadata=_length())
     """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
     fetch_m: float = field(default=100_000.0, metadata=_positive(1.0e7))
-    """Distance over which the wind has blown (JONSWAP) [m]."""
+    """Distance over which the wind has blown (JONSWAP, Elfouhaily) [m]."""
     jonswap_gamma: float = field(default=3.3, metadata=_range(1.0, 10.0))
     """JONSWAP peak enhancement γ (1 = Pierson–Moskowitz shape) [-]."""
     spreading_s: float = field(default=10.0, metadata=_range(0.0, 1000.0))

@@ -20,20 +20,25 @@ from warpcaustics.water.ocean import (
     from_vec2,
     ifft2,
     initial_spectrum,
-    jonswap_spectrum,
-    ocean_spectrum,
-    phillips_spectrum,
     to_vec2,
     wavenumbers,
 )
 from warpcaustics.water.pool import ShallowWaterPool
 from warpcaustics.water.procedural import ProceduralWater
+from warpcaustics.water.spectra import (
+    SPECTRA,
+    elfouhaily_spectrum,
+    jonswap_spectrum,
+    ocean_spectrum,
+    phillips_spectrum,
+)
 from warpcaustics.water.surface import GRAVITY_M_S2, Surface, Water
 from warpcaustics.water.wavepool import WaveEquationPool
 
 __all__ = [
-    "FFTOcean", "FlatWater", "GRAVITY_M_S2", "HeightfieldWater", "ProceduralWater", "ShallowWaterPool",
-    "Surface", "WATER_MODELS", "Water", "WaveEquationPool", "cuda_fft_block_dim", "dispersion", "fft2",
+    "FFTOcean", "FlatWater", "GRAVITY_M_S2", "HeightfieldWater", "ProceduralWater", "SPECTRA",
+    "ShallowWaterPool", "Surface", "WATER_MODELS", "Water", "WaveEquationPool", "cuda_fft_block_dim",
+    "dispersion", "elfouhaily_spectrum", "fft2",
     "from_vec2", "ifft2", "initial_spectrum", "jonswap_spectrum", "make_water", "ocean_spectrum",
     "phillips_spectrum", "to_vec2", "water_bytes", "wavenumbers",
 ]

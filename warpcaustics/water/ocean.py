@@ -1,15 +1,16 @@
-"""Tessendorf's FFT ocean: Phillips and JONSWAP spectra with cos-2s spreading, the initial spectrum
-h̃0, 2-D FFTs in Warp (``wp.tile_fft`` rows, ``kernels/water/ocean.py``) and :class:`FFTOcean`
-(heights, slopes and choppy displacement by inverse FFT, finite-depth dispersion)."""
+"""Tessendorf's FFT ocean: the initial spectrum h̃0 from a directional spectrum (``water/spectra.py``),
+2-D FFTs in Warp (``wp.tile_fft`` rows, ``kernels/water/ocean.py``) and :class:`FFTOcean` (heights,
+slopes and choppy displacement by inverse FFT, finite-depth dispersion)."""
 
 from __future__ import annotations
 
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config, WaterSpectrum
+from warpcaustics.config import Config
 from warpcaustics.kernels.water import ocean as ocean_kernels
 from warpcaustics.scene.heights import DEFAULT_RESOLUTION
+from warpcaustics.water.spectra import ocean_spectrum
 from warpcaustics.water.surface import (
     FLOAT32_BYTES,
     GRAVITY_M_S2,
@@ -24,73 +25,6 @@ from warpcaustics.water.surface import (
 def wavenumbers(n: int, extent_m: float) -> np.ndarray:
     """Wavenumbers of the FFT grid, in numpy's FFT order [rad/m]."""
     return 2.0 * np.pi * np.fft.fftfreq(n, d=extent_m / n)
-
-
-def phillips_spectrum(kx: np.ndarray, ky: np.ndarray, *, amplitude: float, wind_speed_m_s: float,
-                      wind_direction_deg: float, small_wave_m: float) -> np.ndarray:
-    """Phillips spectrum P(k) [m^4] (Tessendorf 2001, eq. 40–41), zero at k = 0.
-
-    ``P = A exp(-1/(k l)^2)/k^4 |k̂·ŵ|^2 exp(-k^2 l_small^2)`` with ``l = V^2/g``; its integral over
-    the k-plane is the height variance ``A π l^2 / 2`` (without the small-wave factor).
-    """
-    k2 = kx**2 + ky**2
-    k = np.sqrt(k2)
-    big_l = wind_speed_m_s**2 / GRAVITY_M_S2
-    w = np.radians(wind_direction_deg)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cos_kw = (kx * np.cos(w) + ky * np.sin(w)) / k
-        p = amplitude * np.exp(-1.0 / (k2 * big_l**2)) / k2**2 * cos_kw**2 * np.exp(-k2 * small_wave_m**2)
-    p[k == 0.0] = 0.0
-    return p
-
-
-def jonswap_spectrum(kx: np.ndarray, ky: np.ndarray, *, wind_speed_m_s: float,
-                     wind_direction_deg: float, fetch_m: float, gamma: float, spreading_s: float,
-                     depth_m: float, small_wave_m: float) -> np.ndarray:
-    """JONSWAP directional wavenumber spectrum P(k) [m^4], zero at k = 0.
-
-    Frequency spectrum (Hasselmann et al. 1973, in the form of Horvath 2015, "Empirical
-    directional wave spectra for computer graphics", eq. 28–30):
-    ``S(ω) = α g² ω⁻⁵ exp(−5/4 (ω_p/ω)⁴) γ^r``, ``r = exp(−(ω − ω_p)² / (2σ²ω_p²))``,
-    σ = 0.07 for ω ≤ ω_p else 0.09, ``α = 0.076 (U²/(F g))^0.22``, ``ω_p = 22 (g²/(U F))^(1/3)``.
-    Directional spreading: Longuet-Higgins cos-2s, ``D(θ) ∝ |cos((θ − θ_w)/2)|^{2s}``, normalised
-    numerically over (−π, π]. Change of variables to the wavenumber plane with the finite-depth
-    dispersion relation: ``P(k) = S(ω(k)) D(θ) (dω/dk) / k`` so that ∫P d²k = ∫S dω.
-    """
-    g = GRAVITY_M_S2
-    k = np.hypot(kx, ky)
-    alpha = 0.076 * (wind_speed_m_s**2 / (fetch_m * g)) ** 0.22
-    omega_p = 22.0 * (g * g / (wind_speed_m_s * fetch_m)) ** (1.0 / 3.0)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        th = np.tanh(k * depth_m)
-        omega = np.sqrt(g * k * th)
-        domega_dk = g * (th + k * depth_m * (1.0 - th * th)) / (2.0 * omega)
-        sigma = np.where(omega <= omega_p, 0.07, 0.09)
-        r = np.exp(-((omega - omega_p) ** 2) / (2.0 * sigma**2 * omega_p**2))
-        s_omega = alpha * g * g / omega**5 * np.exp(-1.25 * (omega_p / omega) ** 4) * gamma**r
-        theta = np.arctan2(ky, kx) - np.radians(wind_direction_deg)
-        p = s_omega * cos2s_spreading(theta, spreading_s) * domega_dk / k * np.exp(-k * k * small_wave_m**2)
-    p[~np.isfinite(p) | (k == 0.0)] = 0.0
-    return p
-
-
-def cos2s_spreading(theta: np.ndarray, s: float) -> np.ndarray:
-    """Longuet-Higgins cos-2s directional spreading, normalised so ∫ D dθ = 1 over a full turn."""
-    fine = np.linspace(-np.pi, np.pi, 20001)
-    norm = np.trapezoid(np.abs(np.cos(fine / 2.0)) ** (2.0 * s), fine)
-    return np.abs(np.cos(theta / 2.0)) ** (2.0 * s) / norm
-
-
-def ocean_spectrum(cfg: Config, kx: np.ndarray, ky: np.ndarray) -> np.ndarray:
-    """The directional spectrum P(k) [m^4] named by ``water.spectrum``."""
-    w = cfg.water
-    if w.spectrum is WaterSpectrum.JONSWAP:
-        return jonswap_spectrum(kx, ky, wind_speed_m_s=w.wind_speed_m_s,
-                                wind_direction_deg=w.wind_direction_deg, fetch_m=w.fetch_m,
-                                gamma=w.jonswap_gamma, spreading_s=w.spreading_s,
-                                depth_m=cfg.floor.depth_m, small_wave_m=w.small_wave_m)
-    return phillips_spectrum(kx, ky, amplitude=w.phillips_amplitude, wind_speed_m_s=w.wind_speed_m_s,
-                             wind_direction_deg=w.wind_direction_deg, small_wave_m=w.small_wave_m)
 
 
 def initial_spectrum(spectrum: np.ndarray, extent_m: float, *, seed: int) -> np.ndarray:
