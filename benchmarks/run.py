@@ -286,6 +286,9 @@ def main(argv: list[str] | None = None) -> int:
     # The small-angle scattering mode against single scattering (benchmarks/small_angle.py).
     small_angle = _in_child("run", args.quick, args.device, module="small_angle")
 
+    # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
+    spectra = _in_child("run", args.quick, args.device, module="spectra")
+
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
 
@@ -320,6 +323,7 @@ def main(argv: list[str] | None = None) -> int:
         "sun_disk": sun_disk,
         "multiple": multiple,
         "small_angle": small_angle,
+        "spectra": spectra,
         "sweep": sweeps,
         "memory": memory,
     }

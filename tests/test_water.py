@@ -400,3 +400,21 @@ def test_water_bytes_counts_the_cuda_fft_scratch(model):
     cpu = water.water_bytes(scene.config, n, "cpu")
     assert water.water_bytes(scene.config, n, "cuda:0") - cpu == scratch
     assert water.water_bytes(scene.config, n) == cpu + scratch
+
+
+def test_water_depth_sets_the_depth_the_waves_feel():
+    """water.depth_m (0: floor.depth_m) is the depth of the dispersion and of JONSWAP's k–ω mapping:
+    an ocean over a 0.86 m sensor plane in 1000 m of sea draws the deep sea's spectrum and moves
+    at its frequencies, not a 0.86 m shallow sea's."""
+    from warpcaustics.config import config_from_dict
+
+    base = {"water.model": "fft", "water.spectrum": "jonswap", "water.resolution": 64, "water.extent_m": 16.0}
+    deep = config_from_dict({}, {**base, "floor.depth_m": 1000.0})
+    sensor = config_from_dict({}, {**base, "floor.depth_m": 0.86, "water.depth_m": 1000.0})
+    shallow = config_from_dict({}, {**base, "floor.depth_m": 0.86})
+    k = water.wavenumbers(64, 16.0)
+    kx, ky = np.meshgrid(k, k)
+    np.testing.assert_array_equal(water.ocean_spectrum(sensor, kx, ky), water.ocean_spectrum(deep, kx, ky))
+    assert not np.allclose(water.ocean_spectrum(shallow, kx, ky), water.ocean_spectrum(deep, kx, ky))
+    omega = water.FFTOcean.from_config(sensor, "cpu").omega.numpy()
+    np.testing.assert_allclose(omega, water.dispersion(np.hypot(kx, ky), 1000.0), rtol=1e-6)

@@ -83,6 +83,10 @@ class WaterConfig:
     """JONSWAP peak enhancement γ (1 = Pierson–Moskowitz shape) [-]."""
     spreading_s: float = field(default=10.0, metadata=_range(0.0, 1000.0))
     """Exponent s of the cos-2s directional spreading (JONSWAP); larger = narrower [-]."""
+    depth_m: float = field(default=0.0, metadata=_length())
+    """Depth of the sea the ``fft`` ocean's waves feel (finite-depth dispersion, JONSWAP's k–ω
+    mapping) [m]; 0 = ``floor.depth_m``. A floor that stands for a sensor plane in open water sets
+    the sea's own depth here (the field configs: deep water)."""
     choppiness: float = field(default=0.0, metadata=_range(0.0, 5.0))
     """Strength λ of the choppy horizontal displacement (Tessendorf eq. 29) [-]; 0 = none."""
     viscosity_m2_s: float = field(default=1.0e-4, metadata=_range(0.0, 1.0))

@@ -10,7 +10,7 @@ import warp as wp
 from warpcaustics.config import Config
 from warpcaustics.kernels.water import ocean as ocean_kernels
 from warpcaustics.scene.heights import DEFAULT_RESOLUTION
-from warpcaustics.water.spectra import ocean_spectrum
+from warpcaustics.water.spectra import ocean_spectrum, wave_depth_m
 from warpcaustics.water.surface import (
     FLOAT32_BYTES,
     GRAVITY_M_S2,
@@ -161,12 +161,13 @@ class FFTOcean:
     @classmethod
     def from_config(cls, cfg: Config, device: str, *, heights: np.ndarray | None = None,
                     floor_relief: np.ndarray | None = None) -> FFTOcean:
-        """The ocean of ``water.*`` (spectrum, wind, fetch, choppiness, seed) over ``floor.depth_m``."""
+        """The ocean of ``water.*`` (spectrum, wind, fetch, choppiness, seed) over water of
+        ``water.depth_m`` (0: ``floor.depth_m``)."""
         w = cfg.water
         n = w.resolution or DEFAULT_RESOLUTION
         k = wavenumbers(n, w.extent_m)
         spectrum = ocean_spectrum(cfg, *np.meshgrid(k, k))
-        return cls(initial_spectrum(spectrum, w.extent_m, seed=w.seed), w.extent_m, cfg.floor.depth_m,
+        return cls(initial_spectrum(spectrum, w.extent_m, seed=w.seed), w.extent_m, wave_depth_m(cfg),
                    device, choppiness=w.choppiness)
 
     @staticmethod

@@ -75,12 +75,17 @@ SPECTRA = {
     WaterSpectrum.JONSWAP: lambda cfg, kx, ky: jonswap_spectrum(
         kx, ky, wind_speed_m_s=cfg.water.wind_speed_m_s, wind_direction_deg=cfg.water.wind_direction_deg,
         fetch_m=cfg.water.fetch_m, gamma=cfg.water.jonswap_gamma, spreading_s=cfg.water.spreading_s,
-        depth_m=cfg.floor.depth_m, small_wave_m=cfg.water.small_wave_m),
+        depth_m=wave_depth_m(cfg), small_wave_m=cfg.water.small_wave_m),
     WaterSpectrum.ELFOUHAILY: lambda cfg, kx, ky: elfouhaily_spectrum(
         kx, ky, wind_speed_m_s=cfg.water.wind_speed_m_s, wind_direction_deg=cfg.water.wind_direction_deg,
         fetch_m=cfg.water.fetch_m, small_wave_m=cfg.water.small_wave_m),
 }
 """``water.spectrum`` → P(cfg, kx, ky) [m⁴]."""
+
+
+def wave_depth_m(cfg: Config) -> float:
+    """The depth the ocean's waves feel: ``water.depth_m``, or ``floor.depth_m`` when it is 0."""
+    return cfg.water.depth_m or cfg.floor.depth_m
 
 
 def ocean_spectrum(cfg: Config, kx: np.ndarray, ky: np.ndarray) -> np.ndarray:
