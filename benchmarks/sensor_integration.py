@@ -1,0 +1,99 @@
+"""The radiometer's integration time as a row of the error budget (issue 27 item 2):
+``python -m benchmarks.sensor_integration``.
+
+Gernez & Antoine (2009) sampled at 6 Hz and did not publish their integration time; a sensor that
+integrates over T reads the running mean of E(t) over T, and the brightest flashes are the
+briefest, so integration lowers the CV. This measures by how much, on the field set-up
+(``configs/field/gernez2009.toml``: 3.1 cm cells, 510 nm, small-angle scattering, a 1 m window
+through the 8 mm collector) on a 256² × 8 m window of that sea (the same cells; the 32 m patch
+only adds longer waves, which focus below 3 m), at the paper's diffuse share for each sun zenith:
+the spatial CV of the instantaneous map against that of the map averaged over the last T = 1/6 s
+(the 6 Hz sampling interval, the longest an integrating sensor at 6 Hz can have) and 1/12 s. The
+average is the trapezoid rule over maps ``dt`` apart (``stats.integrate_series``'s piecewise-linear
+series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 0.5 s apart, pooled.
+``--quick``: 64² surface, one zenith, one frame, T = 1/6 s at dt = 1/24 s (keeps the script running).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def maps_over(renderer, t_end: float, window_s: float, dt_s: float, texel: float, collector: float):
+    """The collector-averaged maps at times ``t_end − window_s … t_end``, about ``dt_s`` apart."""
+    from warpcaustics.batch.stats import collector_average
+
+    steps = max(1, round(window_s / dt_s))
+    times = t_end - window_s + np.arange(steps + 1) * (window_s / steps)
+    return [collector_average(renderer.render(float(t)).floor_irradiance[0], texel, collector, periodic=False)
+            for t in times]
+
+
+def trapezoid_mean(maps: list[np.ndarray]) -> np.ndarray:
+    """The time mean of equally spaced maps of a piecewise-linear E(t) (trapezoid rule)."""
+    weights = np.full(len(maps), 1.0)
+    weights[0] = weights[-1] = 0.5
+    return sum(w * m for w, m in zip(weights, maps)) / weights.sum()
+
+
+def measure(zeniths, windows, dt_s: float, frames: int, quick: bool) -> list[dict]:
+    import warpcaustics as wc
+    from warpcaustics.batch.field import diffuse_fraction
+
+    rows = []
+    for zenith in zeniths:
+        overrides = {"water.resolution": 64 if quick else 256, "water.extent_m": 2.0 if quick else 8.0,
+                     "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
+        if quick:
+            overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
+        scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", overrides)
+        cfg = scene.config
+        texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
+        collector = cfg.stats.collector_mm * 1e-3
+        renderer = wc.Renderer(scene, device="cpu")
+        start = time.perf_counter()
+        inst, integ = [], {w: [] for w in windows}
+        for f in range(frames):
+            t_end = 1.0 + 0.5 * f
+            longest = max(windows)
+            maps = maps_over(renderer, t_end, longest, dt_s, texel, collector)
+            inst.append(maps[-1])
+            per = len(maps) - 1
+            for w in windows:  # shorter windows from the same maps: the last w/longest of them
+                integ[w].append(trapezoid_mean(maps[per - round(per * w / longest):]))
+        inst = np.array(inst)
+        row = {"sun_zenith_deg": zenith, "dt_s": dt_s, "frames": frames,
+               "cv_instant": float(inst.std() / inst.mean())}
+        for w in windows:
+            a = np.array(integ[w])
+            row[f"cv_integrated_{w:.4f}s"] = float(a.std() / a.mean())
+        row["seconds"] = time.perf_counter() - start
+        rows.append(row)
+        print("  ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()),
+              flush=True)
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="a tiny surface, one zenith, one frame")
+    parser.add_argument("--frames", type=int, default=2, help="frames 0.5 s apart, pooled (default 2)")
+    parser.add_argument("--zeniths", default="20,50,80", help="sun zeniths [deg], comma-separated")
+    parser.add_argument("--dt", type=float, default=1.0 / 120.0, help="spacing of the averaged maps [s]")
+    args = parser.parse_args(argv)
+    if args.quick:
+        measure([20.0], [1.0 / 6.0], 1.0 / 24.0, 1, True)
+        return 0
+    measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
