@@ -111,6 +111,8 @@ def test_bad_input_is_one_line(tmp_path, capsys):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", series=("tide",), quick=True)
     with pytest.raises(ConfigError, match="--zeniths: 21 is not a measured point"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", zeniths=(20.0, 21.0), quick=True)
+    with pytest.raises(ConfigError, match="chose no point"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", zeniths=(), sqrt_winds=(), quick=True)
     with pytest.raises(ConfigError, match="--set sun.elevation_deg"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sun.elevation_deg": 30.0},
                              quick=True)

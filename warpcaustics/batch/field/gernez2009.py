@@ -170,8 +170,10 @@ def run_gernez2009(
     _check_scene(base.config)
     pyplot(PLOT_NEEDS)  # before the sweep, not after it
     points = select_points(gernez2009_points(series), zeniths, sqrt_winds)
+    if not points:
+        raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
     if quick:  # the first and last zenith, the first wind
-        ends = {"zenith": lambda ps: [ps[0], ps[-1]], "wind": lambda ps: ps[:1]}
+        ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
     overrides, variants = point_variants(points, base.config)
     times = tuple(i * frame_interval_s for i in range(frames))
