@@ -2,9 +2,10 @@
 
 Each row is ``warpcaustics field gernez2009 configs/field/gernez2009.toml`` at three of the paper's
 sun zeniths (20°, 50°, 80°) and three of its wind classes (√U = 1.2, 2.4, 3.6, at a 40° sun), with
-one change to the set-up (``--set``), so that each row's change to the model's CV against the
-baseline's is that change's share of the gap. The command each row runs is printed with it and
-written to the table. Rows are resumable sweeps under ``--out`` (default ``out/field_budget``);
+one change (``--set``) to the set-up before issue 27 (``BEFORE``: a JONSWAP sea, a uniform sky), so
+that each row's change to the model's CV against the baseline's is that change's share of the gap;
+the last row, ``configured``, is the config as it is now. The command each row runs is printed and
+written to the CSV. Rows are resumable sweeps under ``--out`` (default ``out/field_budget``);
 ``--rows`` picks some. The table goes to ``benchmarks/results/field_budget.csv`` and is printed as
 markdown (docs/validation.md holds the figures). No parameter here is fitted to a CV: each row is
 a source's value or a resolution, named beside it.
@@ -27,8 +28,12 @@ SCENE = ROOT / "configs/field/gernez2009.toml"
 ZENITHS = (20.0, 50.0, 80.0)
 SQRT_WINDS = (1.2, 2.4, 3.6)
 
-ROWS: dict[str, tuple[dict, str]] = {
-    "baseline": ({}, "configs/field/gernez2009.toml as it is (small-angle scattering, Petzold)"),
+BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform"}
+"""The set-up the budget starts from: configs/field/gernez2009.toml as it was before issue 27 (a
+JONSWAP sea, a uniform sky); every row but the last changes one thing on top of it."""
+
+ROWS: dict[str, tuple[dict | None, str]] = {
+    "baseline": ({}, "the set-up before issue 27: JONSWAP, uniform sky, small-angle scattering (Petzold)"),
     "single_scattering": ({"optics.scattering": "single"}, "scattered light dropped (c = a + b)"),
     "cells_1.6cm": ({"water.extent_m": 16.0}, "1024² over 16 m: 1.6 cm cells (waves > 16 m dropped)"),
     "cells_0.8cm": ({"water.extent_m": 8.0}, "1024² over 8 m: 7.8 mm cells (waves > 8 m dropped)"),
@@ -40,9 +45,10 @@ ROWS: dict[str, tuple[dict, str]] = {
     "choppy": ({"water.choppiness": 1.0}, "Lagrangian (choppy) displacement, λ = 1"),
     "spreading_s2": ({"water.spreading_s": 2.0}, "broad cos-2s spreading, s = 2 (default 10)"),
     "fetch_200km": ({"water.fetch_m": 200000.0}, "fetch 200 km (near fully developed; default 20 km)"),
+    "configured": (None, "configs/field/gernez2009.toml as it is now: Elfouhaily's sea, the CIE clear sky"),
 }
-"""name → (overrides, what it changes). The field command sets the sun, the sky's share and the
-wind at each point."""
+"""name → (overrides on top of ``BEFORE``, or None: the config as it is; what it changes). The field
+command sets the sun, the sky's share and the wind at each point."""
 
 
 def command(name: str, out: Path, workers: int, quick: bool) -> list[str]:
@@ -51,7 +57,8 @@ def command(name: str, out: Path, workers: int, quick: bool) -> list[str]:
             "--zeniths", ",".join(f"{z:g}" for z in ZENITHS),
             "--sqrt-winds", ",".join(f"{w:g}" for w in SQRT_WINDS),
             "--workers", str(workers), "--quiet"]
-    for key, value in ROWS[name][0].items():
+    changes = ROWS[name][0]
+    for key, value in ({} if changes is None else {**BEFORE, **changes}).items():
         args += ["--set", f"{key}={value!r}" if isinstance(value, str) else f"{key}={value}"]
     return args + (["--quick"] if quick else [])
 
@@ -67,7 +74,8 @@ def run_row(name: str, out: Path, workers: int, quick: bool) -> list[dict]:
     seconds = time.perf_counter() - start
     with (out / name / "gernez2009.csv").open() as fh:
         rows = list(csv.DictReader(fh))
-    return [{"row": name, "seconds": round(seconds, 1), **r} for r in rows]
+    return [{"row": name, "seconds": round(seconds, 1), **r, "command": "warpcaustics " + " ".join(args)}
+            for r in rows]
 
 
 def table(results: list[dict]) -> str:
