@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.field_budget import BEFORE  # the field set-up as these figures were measured
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -85,7 +87,8 @@ def profile(quick: bool, frames: int, modes: tuple[str, ...], extra: dict | None
         row = {"depth_m": float(depth), "measured": record.cv[d_index].tolist()}
         for mode in modes:
             scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml",
-                                  {**base, "floor.depth_m": float(depth), "optics.scattering": mode})
+                                  {**BEFORE, **base, "floor.depth_m": float(depth),
+                                   "optics.scattering": mode})
             renderer = wc.Renderer(scene, device="cpu")
             sums = np.zeros((3, 2))
             start = time.perf_counter()

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.field_budget import BEFORE  # the field set-up as these figures were measured
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -34,7 +36,8 @@ def measure(zeniths, depths, counts, frames: int) -> list[dict]:
         for depth in depths:
             for count in counts:
                 scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {
-                    "water.resolution": 256, "water.extent_m": 8.0, "sun.elevation_deg": 90.0 - zenith,
+                    **BEFORE, "water.resolution": 256, "water.extent_m": 8.0,
+                    "sun.elevation_deg": 90.0 - zenith,
                     "sky.diffuse_fraction": share, "sky.directions": count, "floor.depth_m": depth})
                 cfg = scene.config
                 texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
