@@ -12,6 +12,10 @@ the spatial CV of the instantaneous map against that of the map averaged over th
 average is the trapezoid rule over maps ``dt`` apart (``stats.integrate_series``'s piecewise-linear
 series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 0.5 s apart, pooled.
 ``--quick``: 64² surface, one zenith, one frame, T = 1/6 s at dt = 1/24 s (keeps the script running).
+
+``--series SECONDS``: the buoy's own statistic instead — E(t) sampled at 6 Hz for SECONDS at 8 × 8
+points of the window, its CV per point (median, 10th and 90th percentiles, and all samples pooled)
+beside the spatial CV of the same maps: when do the two agree?
 """
 
 from __future__ import annotations
@@ -30,12 +34,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def maps_over(renderer, t_end: float, window_s: float, dt_s: float, texel: float, collector: float):
     """The collector-averaged maps at times ``t_end − window_s … t_end``, about ``dt_s`` apart."""
-    from warpcaustics.batch.stats import collector_average
-
     steps = max(1, round(window_s / dt_s))
     times = t_end - window_s + np.arange(steps + 1) * (window_s / steps)
-    return [collector_average(renderer.render(float(t)).floor_irradiance[0], texel, collector, periodic=False)
-            for t in times]
+    return [collector_map(renderer, float(t), texel, collector) for t in times]
 
 
 def trapezoid_mean(maps: list[np.ndarray]) -> np.ndarray:
@@ -78,9 +79,56 @@ def measure(zeniths, windows, dt_s: float, frames: int, quick: bool) -> list[dic
             row[f"cv_integrated_{w:.4f}s"] = float(a.std() / a.mean())
         row["seconds"] = time.perf_counter() - start
         rows.append(row)
-        print("  ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()),
-              flush=True)
+        _print(row)
     return rows
+
+
+def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quick: bool) -> dict:
+    """The buoy's statistic beside the model's: the CV of E(t) at ``probes``² points of the window
+    (the collector-averaged map sampled at ``rate_hz`` for ``seconds``; the median over points and
+    the CV of all samples pooled) against the spatial CV of the same maps pooled — equal for a
+    stationary, homogeneous sea once the record is long against the pattern's correlation time."""
+    import warpcaustics as wc
+    from warpcaustics.batch.field import diffuse_fraction
+
+    overrides = {"water.resolution": 64 if quick else 256, "water.extent_m": 2.0 if quick else 8.0,
+                 "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
+    if quick:
+        overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
+    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**BEFORE, **overrides})
+    cfg = scene.config
+    texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
+    renderer = wc.Renderer(scene, device="cpu")
+    m = cfg.caustics.map_resolution
+    at = ((np.arange(probes) + 0.5) * m / probes).astype(int)  # probes spread evenly over the window
+    start = time.perf_counter()
+    samples, spatial = [], []
+    for k in range(max(2, round(seconds * rate_hz))):
+        e = collector_map(renderer, 1.0 + k / rate_hz, texel, cfg.stats.collector_mm * 1e-3)
+        samples.append(e[np.ix_(at, at)].ravel())
+        spatial.append((e.mean(), e.std() / e.mean()))
+    from warpcaustics.batch.field.common import pooled_statistics
+
+    series = np.array(samples)  # (time, point)
+    per_point = series.std(axis=0) / series.mean(axis=0)
+    p10, p50, p90 = np.percentile(per_point, [10, 50, 90])
+    row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
+           "cv_time_median": float(p50), "cv_time_p10": float(p10), "cv_time_p90": float(p90),
+           "cv_time_pooled": float(series.std() / series.mean()),
+           "cv_spatial": float(pooled_statistics(spatial)[1]), "wall_s": time.perf_counter() - start}
+    _print(row)
+    return row
+
+
+def _print(row: dict) -> None:
+    text = (f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items())
+    print("  ".join(text), flush=True)
+
+
+def collector_map(renderer, t: float, texel: float, collector: float) -> np.ndarray:
+    from warpcaustics.batch.stats import collector_average
+
+    return collector_average(renderer.render(float(t)).floor_irradiance[0], texel, collector, periodic=False)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -89,9 +137,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=2, help="frames 0.5 s apart, pooled (default 2)")
     parser.add_argument("--zeniths", default="20,50,80", help="sun zeniths [deg], comma-separated")
     parser.add_argument("--dt", type=float, default=1.0 / 120.0, help="spacing of the averaged maps [s]")
+    parser.add_argument("--series", type=float, default=0.0, metavar="SECONDS",
+                        help="instead: point time series at 6 Hz over SECONDS against the spatial CV")
     args = parser.parse_args(argv)
     if args.quick:
         measure([20.0], [1.0 / 6.0], 1.0 / 24.0, 1, True)
+        time_series(20.0, 1.0, 6.0, 4, True)
+        return 0
+    if args.series > 0.0:
+        for zenith in args.zeniths.split(","):
+            time_series(float(zenith), args.series, 6.0, 8, False)
         return 0
     measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False)
     return 0
