@@ -11,6 +11,7 @@ alone: Elfouhaily's mean square slope of a fully developed sea against Cox & Mun
 clean-surface fits at six winds, and the slope variance each spectrum puts on the field set-up's
 1024² grid as its cells shrink (the grid's k-box summed, Σ k² P Δk²), and what the same cells
 would hold as a window of an unbounded ocean (all waves down to the cell's Nyquist): does it converge?
+And where each spectrum puts its slope: by band of wavelengths, with its share along the wind.
 """
 
 from __future__ import annotations
@@ -89,6 +90,36 @@ def window_slope_variance(cfg, k_max: float) -> float:
     return float(np.trapezoid(per_ln_k, np.log(k)))
 
 
+BANDS_M = ((0.0625, 0.2), (0.2, 1.0), (1.0, 5.0), (5.0, 32.0))
+BAND_WINDS = (1.44, 5.0, 12.96)
+
+
+def band_table() -> list[dict]:
+    """Where each spectrum puts its slope (the field set-up, 20 km fetch): the slope variance of the
+    waves in each band of wavelengths (``BANDS_M``, the grid's 6 cm to its 32 m) and the share of it
+    along the wind (1/2 for an isotropic sea, 1 for long-crested waves), at three of the field
+    comparison's winds."""
+    import warpcaustics as wc
+    from warpcaustics.water import ocean_spectrum
+
+    field = ROOT / "configs/field/gernez2009.toml"
+    phi = np.linspace(-np.pi, np.pi, 721)[:-1]
+    rows = []
+    for wind in BAND_WINDS:
+        for spectrum in ("jonswap", "elfouhaily"):
+            cfg = wc.load_scene(field, {"water.spectrum": spectrum, "water.wind_speed_m_s": wind}).config
+            row = {"wind_m_s": wind, "spectrum": spectrum}
+            for shortest, longest in BANDS_M:
+                k = np.geomspace(2.0 * np.pi / longest, 2.0 * np.pi / shortest, 2000)
+                kk, pp = np.meshgrid(k, phi)
+                slope = kk**4 * ocean_spectrum(cfg, kk * np.cos(pp), kk * np.sin(pp))
+                total = np.trapezoid(slope.sum(axis=0), np.log(k))
+                along = np.trapezoid((slope * np.cos(pp) ** 2).sum(axis=0), np.log(k))
+                row[f"{shortest:g}-{longest:g}m"] = (float(total * (phi[1] - phi[0])), float(along / total))
+            rows.append(row)
+    return rows
+
+
 def run(quick: bool, device: str) -> dict:
     import warpcaustics as wc
     from warpcaustics.water import FFTOcean
@@ -136,8 +167,14 @@ def run(quick: bool, device: str) -> dict:
               f"{r['jonswap_window']:.4f} {r['elfouhaily_window']:.4f}")
     r = resolution[-1]
     print(f"  waves down to 1 mm, unbounded ocean: {r['jonswap_window']:.4f} {r['elfouhaily_window']:.4f}")
+    bands = band_table()
+    print("slope variance by wavelength [m] (its share along the wind), 20 km fetch: "
+          + ", ".join(f"{a:g}-{b:g}" for a, b in BANDS_M))
+    for r in bands:
+        cells = (f"{v[0]:.4f} ({v[1]:.2f})" for k, v in r.items() if k.endswith("m"))
+        print(f"  {r['wind_m_s']:5.2f} m/s {r['spectrum']:10s} " + "  ".join(cells))
     return {"benchmark": "wave_spectra", **device_record(device), "repeats": repeats, "results": rows,
-            "cox_munk": cox_munk, "resolution": resolution}
+            "cox_munk": cox_munk, "resolution": resolution, "bands": bands}
 
 
 def main(argv: list[str] | None = None) -> int:
