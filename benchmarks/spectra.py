@@ -171,7 +171,7 @@ def run(quick: bool, device: str) -> dict:
     print("slope variance by wavelength [m] (its share along the wind), 20 km fetch: "
           + ", ".join(f"{a:g}-{b:g}" for a, b in BANDS_M))
     for r in bands:
-        cells = (f"{v[0]:.4f} ({v[1]:.2f})" for k, v in r.items() if k.endswith("m"))
+        cells = (f"{v[0]:.4f} ({v[1]:.2f})" for v in r.values() if isinstance(v, tuple))
         print(f"  {r['wind_m_s']:5.2f} m/s {r['spectrum']:10s} " + "  ".join(cells))
     return {"benchmark": "wave_spectra", **device_record(device), "repeats": repeats, "results": rows,
             "cox_munk": cox_munk, "resolution": resolution, "bands": bands}
