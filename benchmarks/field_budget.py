@@ -42,6 +42,7 @@ ROWS: dict[str, tuple[dict | None, str]] = {
     "elfouhaily_0.8cm": ({"water.spectrum": "elfouhaily", "water.extent_m": 8.0},
                          "Elfouhaily et al. 1997 on 7.8 mm cells"),
     "cie_clear": ({"sky.model": "cie_clear"}, "CIE clear sky (type 12) at the paper's diffuse share"),
+    "point_sun": ({"sun.angular_diameter_deg": 0.0}, "a point sun instead of the 0.53° disk"),
     "choppy": ({"water.choppiness": 1.0}, "Lagrangian (choppy) displacement, λ = 1"),
     "spreading_s2": ({"water.spreading_s": 2.0}, "broad cos-2s spreading, s = 2 (default 10)"),
     "fetch_200km": ({"water.fetch_m": 200000.0}, "fetch 200 km (near fully developed; default 20 km)"),
