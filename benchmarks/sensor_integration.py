@@ -15,7 +15,9 @@ series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 
 
 ``--series SECONDS``: the buoy's own statistic instead — E(t) sampled at 6 Hz for SECONDS at 8 × 8
 points of the window, its CV per point (median, 10th and 90th percentiles, and all samples pooled)
-beside the spatial CV of the same maps: when do the two agree?
+beside the spatial CV of the same maps: when do the two agree? Also the period of the strongest
+fluctuation (the points' mean periodogram's peak; the paper's T_max, in the `jerlov` record) and
+the CV left after running means of 0.5, 1 and 2 s of the samples (what a slow sensor would read).
 """
 
 from __future__ import annotations
@@ -112,10 +114,22 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
     series = np.array(samples)  # (time, point)
     per_point = series.std(axis=0) / series.mean(axis=0)
     p10, p50, p90 = np.percentile(per_point, [10, 50, 90])
+    # the period of the strongest fluctuation (Gernez & Antoine's T_max): the peak of the points'
+    # mean periodogram, the mean removed
+    power = np.mean(np.abs(np.fft.rfft(series - series.mean(axis=0), axis=0)) ** 2, axis=1)
+    freq = np.fft.rfftfreq(series.shape[0], 1.0 / rate_hz)
     row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
            "cv_time_median": float(p50), "cv_time_p10": float(p10), "cv_time_p90": float(p90),
            "cv_time_pooled": float(series.std() / series.mean()),
-           "cv_spatial": float(pooled_statistics(spatial)[1]), "wall_s": time.perf_counter() - start}
+           "cv_spatial": float(pooled_statistics(spatial)[1]),
+           "peak_period_s": float(1.0 / freq[1 + np.argmax(power[1:])])}
+    # the CV left after a running mean of the 6 Hz samples over n of them (a sensor's response of
+    # n/rate seconds, sampled as the buoy sampled: a coarse stand-in for a continuous average)
+    for n in (3, 6, 12):
+        kernel = np.ones(n) / n
+        smooth = np.apply_along_axis(lambda x, k=kernel: np.convolve(x, k, mode="valid"), 0, series)
+        row[f"cv_time_mean_{n / rate_hz:g}s"] = float(np.median(smooth.std(axis=0) / smooth.mean(axis=0)))
+    row["wall_s"] = time.perf_counter() - start
     _print(row)
     return row
 
