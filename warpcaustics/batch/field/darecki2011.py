@@ -164,6 +164,7 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
         ax.errorbar([r["model_cv"] for r in rs], z, xerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
                     color="tab:blue", capsize=3, label="model as rendered")
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())  # the minor ticks' labels overlap
         ax.set_title(f"{nm:g} nm")
         ax.set_xlabel("CV of Ed")
         ax.grid(alpha=0.3, which="both")
