@@ -48,21 +48,26 @@ def trapezoid_mean(maps: list[np.ndarray]) -> np.ndarray:
     return sum(w * m for w, m in zip(weights, maps)) / weights.sum()
 
 
-def measure(zeniths, windows, dt_s: float, frames: int, quick: bool) -> list[dict]:
+def field_window(zenith: float, quick: bool):
+    """The renderer of the field set-up's 256² × 8 m window (``BEFORE``) at a sun zenith with the
+    paper's diffuse share, its config, its texel and its collector [m]."""
     import warpcaustics as wc
     from warpcaustics.batch.field import diffuse_fraction
 
+    overrides = {"water.resolution": 64 if quick else 256, "water.extent_m": 2.0 if quick else 8.0,
+                 "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
+    if quick:
+        overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
+    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**BEFORE, **overrides})
+    cfg = scene.config
+    texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
+    return wc.Renderer(scene, device="cpu"), cfg, texel, cfg.stats.collector_mm * 1e-3
+
+
+def measure(zeniths, windows, dt_s: float, frames: int, quick: bool) -> list[dict]:
     rows = []
     for zenith in zeniths:
-        overrides = {"water.resolution": 64 if quick else 256, "water.extent_m": 2.0 if quick else 8.0,
-                     "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
-        if quick:
-            overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
-        scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**BEFORE, **overrides})
-        cfg = scene.config
-        texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
-        collector = cfg.stats.collector_mm * 1e-3
-        renderer = wc.Renderer(scene, device="cpu")
+        renderer, cfg, texel, collector = field_window(zenith, quick)
         start = time.perf_counter()
         inst, integ = [], {w: [] for w in windows}
         for f in range(frames):
@@ -90,23 +95,13 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
     (the collector-averaged map sampled at ``rate_hz`` for ``seconds``; the median over points and
     the CV of all samples pooled) against the spatial CV of the same maps pooled — equal for a
     stationary, homogeneous sea once the record is long against the pattern's correlation time."""
-    import warpcaustics as wc
-    from warpcaustics.batch.field import diffuse_fraction
-
-    overrides = {"water.resolution": 64 if quick else 256, "water.extent_m": 2.0 if quick else 8.0,
-                 "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
-    if quick:
-        overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
-    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**BEFORE, **overrides})
-    cfg = scene.config
-    texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
-    renderer = wc.Renderer(scene, device="cpu")
+    renderer, cfg, texel, collector = field_window(zenith, quick)
     m = cfg.caustics.map_resolution
     at = ((np.arange(probes) + 0.5) * m / probes).astype(int)  # probes spread evenly over the window
     start = time.perf_counter()
     samples, spatial = [], []
     for k in range(max(2, round(seconds * rate_hz))):
-        e = collector_map(renderer, 1.0 + k / rate_hz, texel, cfg.stats.collector_mm * 1e-3)
+        e = collector_map(renderer, 1.0 + k / rate_hz, texel, collector)
         samples.append(e[np.ix_(at, at)].ravel())
         spatial.append((e.mean(), e.std() / e.mean()))
     from warpcaustics.batch.field.common import pooled_statistics
