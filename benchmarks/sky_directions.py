@@ -8,7 +8,9 @@ cells; the 32 m patch only adds longer waves) at the paper's diffuse share for e
 against the number of sky directions, 16 → 64 → 256, at 3.2 m and 9 m, a sun 20° and 85° from the
 zenith, pooled over ``--frames`` frames; with the CV of the sun's part alone (the sky as a uniform
 background) beside it. Directions are enough where the CV stops changing. ``--quick``: 16 and 64
-directions, 3.2 m, one frame.
+directions, 3.2 m, one frame. ``--halves``: each count also with ``sky.sampling = "halves"``, whose
+two independently drawn halves give the CV with the sky's continuum (``cv_continuous_sky``), free of
+the directions' own noise, to compare with the stratified sky's CV as its directions grow.
 """
 
 from __future__ import annotations
@@ -25,25 +27,25 @@ from benchmarks.field_budget import BEFORE  # the field set-up as these figures 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def measure(zeniths, depths, counts, frames: int) -> list[dict]:
+def measure(zeniths, depths, counts, frames: int, samplings=("stratified",)) -> list[dict]:
     import warpcaustics as wc
     from warpcaustics.batch.field import diffuse_fraction
-    from warpcaustics.batch.stats import collector_average
+    from warpcaustics.batch.stats import collector_average, continuous_sky_cv
 
     rows = []
     for zenith in zeniths:
         share = diffuse_fraction(zenith)
         for depth in depths:
-            for count in counts:
+            for count, sampling in ((c, s) for c in counts for s in samplings):
                 scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {
                     **BEFORE, "water.resolution": 256, "water.extent_m": 8.0,
-                    "sun.elevation_deg": 90.0 - zenith,
+                    "sun.elevation_deg": 90.0 - zenith, "sky.sampling": sampling,
                     "sky.diffuse_fraction": share, "sky.directions": count, "floor.depth_m": depth})
                 cfg = scene.config
                 texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
                 collector = cfg.stats.collector_mm * 1e-3
                 renderer = wc.Renderer(scene, device="cpu")
-                total, sun = [], []
+                total, sun, second = [], [], []
                 start = time.perf_counter()
                 for f in range(frames):
                     r = renderer.render(0.5 * f)
@@ -51,15 +53,24 @@ def measure(zeniths, depths, counts, frames: int) -> list[dict]:
                     sky = collector_average(r.sky_floor_irradiance[0], texel, collector, periodic=False)
                     total.append(e)
                     sun.append(e - sky + sky.mean())  # the sky as a uniform background
+                    if r.sky_floor_irradiance_even is not None:  # the sky's continuum from its halves
+                        even = collector_average(r.sky_floor_irradiance_even[0], texel, collector,
+                                                 periodic=False)
+                        # E[E_A E_B] = μ² (1 + CV²), pooled over the frames as the rest
+                        second.append(e.mean() ** 2 * (1.0 + continuous_sky_cv(e, sky, even) ** 2))
                 seconds = (time.perf_counter() - start) / frames
                 total, sun = np.array(total), np.array(sun)
                 row = {"sun_zenith_deg": zenith, "diffuse_share": share, "depth_m": depth,
-                       "directions": count, "cv": float(total.std() / total.mean()),
+                       "directions": count, "sampling": sampling, "cv": float(total.std() / total.mean()),
                        "cv_uniform_sky": float(sun.std() / sun.mean()), "s_per_frame": seconds}
+                text = ""
+                if second:
+                    row["cv_continuous_sky"] = float(np.sqrt(max(np.mean(second) / total.mean() ** 2 - 1, 0)))
+                    text = f", the sky's continuum from its halves {row['cv_continuous_sky']:.4f}"
                 rows.append(row)
-                print(f"sun {zenith:4.0f}°  diffuse {share:.2f}  {depth:4.1f} m  {count:4d} directions: CV "
-                      f"{row['cv']:.4f}  (uniform sky {row['cv_uniform_sky']:.4f})  {seconds:.0f} s/frame",
-                      flush=True)
+                print(f"sun {zenith:4.0f}°  diffuse {share:.2f}  {depth:4.1f} m  {count:4d} directions, "
+                      f"{sampling:10s}: CV {row['cv']:.4f}  (uniform sky {row['cv_uniform_sky']:.4f}{text})  "
+                      f"{seconds:.0f} s/frame", flush=True)
     return rows
 
 
@@ -67,9 +78,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="16 and 64 directions, 3.2 m, one frame")
     parser.add_argument("--frames", type=int, default=2)
+    parser.add_argument("--halves", action="store_true",
+                        help="also each count with sky.sampling = 'halves' (the CV with the sky's continuum, "
+                             "issue 32), at an 85° sun, 3.2 and 9 m, 16 and 64 directions")
     args = parser.parse_args(argv)
     if args.quick:
         measure((85.0,), (3.2,), (16, 64), 1)
+    elif args.halves:
+        measure((85.0,), (3.2, 9.0), (16, 64), args.frames, ("stratified", "halves"))
     else:
         measure((20.0, 85.0), (3.2, 9.0), (16, 64, 256), args.frames)
     return 0

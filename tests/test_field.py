@@ -183,14 +183,16 @@ def test_darecki_config_holds_the_records_conditions():
 
 def test_darecki_command_on_still_water_measures_no_fluctuation(tmp_path):
     """The depth-profile command end to end (--quick): under still water the CV is 0 in every band
-    at every depth, beside the record's values; a plot is written."""
+    at every depth, and so is the CV with the sky's continuum (``sky.sampling = "halves"``), beside
+    the record's values; a plot is written."""
     pytest.importorskip("matplotlib")
     flat = tmp_path / "flat.toml"
     flat.write_text(DARECKI.read_text().replace('model = "fft"', 'model = "flat"'))
     out = tmp_path / "o"
     assert main(["field", "darecki2011", str(flat), "--out", str(out), "--quick", "--frames", "1",
-                 "--depths", "0.86,9.58", "--device", "cpu", "--quiet"]) == 0
+                 "--depths", "0.86,9.58", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves"]) == 0
     rows = list(csv.DictReader((out / "darecki2011.csv").open()))
+    assert all(float(r["model_cv_continuous_sky"]) < 1e-5 for r in rows)  # the sky drawn in halves
     rec = jerlov.darecki2011_irradiance_cv()
     assert [(float(r["depth_m"]), float(r["wavelength_nm"])) for r in rows] == [
         (d, float(w)) for d in (0.86, 9.58) for w in rec.wavelengths_nm]
@@ -211,3 +213,37 @@ def test_darecki_bad_input_is_one_line(tmp_path, capsys):
     assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"), "--zeniths", "20"]) == 2
     assert "--zeniths is not a flag of darecki2011" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_frames_are_the_interval_apart(monkeypatch, capsys, tmp_path):
+    """--frame-interval sets the seconds between a point's frames (each data set's default without
+    it); zero, negative or not finite is a one-line error before anything renders."""
+    from warpcaustics.batch.field import darecki2011, gernez2009
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def capture(scene_path, fixed, variants, times, out, **kw):
+        seen["times"] = times
+        raise Stop
+
+    for module in (darecki2011, gernez2009):
+        monkeypatch.setattr(module, "render_points", capture)
+    pytest.importorskip("matplotlib")
+    for dataset, scene, flags, want in (
+            ("darecki2011", DARECKI, [], (0.0, 0.5, 1.0)),
+            ("darecki2011", DARECKI, ["--frame-interval", "4"], (0.0, 4.0, 8.0)),
+            ("gernez2009", _scene(tmp_path), [], (0.0, 2.0, 4.0)),
+            ("gernez2009", _scene(tmp_path), ["--frame-interval", "0.25"], (0.0, 0.25, 0.5))):
+        with pytest.raises(Stop):
+            main(["field", dataset, str(scene), "--out", str(tmp_path / "o"), "--quick", "--quiet", *flags])
+        assert seen.pop("times") == pytest.approx(want)
+    for bad in ("0", "-1", "nan", "inf"):
+        assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"),
+                     "--frame-interval", bad]) == 2
+        err = capsys.readouterr().err
+        assert f"--frame-interval = {float(bad)} must be a positive number of seconds" in err
+        assert len(err.strip().splitlines()) == 1
+    assert "times" not in seen and not (tmp_path / "o").exists()

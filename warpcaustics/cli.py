@@ -120,6 +120,9 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--depths", metavar="LIST",
                     help="darecki2011: only these measured depths [m], comma-separated (default all)")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
+    fd.add_argument("--frame-interval", type=float, metavar="S",
+                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 0.5); "
+                         "frames further apart than the waves' periods are independent samples")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)
     _set_arg(fd, ", on every point (a row of the error budget)")
@@ -166,6 +169,8 @@ def _field(args: argparse.Namespace) -> int:
                               f"(its point flags: {', '.join('--' + n.replace('_', '-') for n in own)})")
     common = dict(frames=args.frames, workers=args.workers, device=args.device, quick=args.quick,
                   quiet=args.quiet, force=args.force, overrides=_overrides(args))
+    if args.frame_interval is not None:  # else each data set's own default
+        common["frame_interval_s"] = args.frame_interval
     if args.dataset == "gernez2009":
         paths = run_gernez2009(args.scene, args.out, series=tuple((args.series or "zenith,wind").split(",")),
                                zeniths=_floats(args.zeniths, "--zeniths"),

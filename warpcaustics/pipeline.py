@@ -16,7 +16,7 @@ import warp as wp
 from warpcaustics import device as devices
 from warpcaustics.caustics.registry import METHODS
 from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch, sky_bytes
-from warpcaustics.config import Scattering
+from warpcaustics.config import Scattering, SkySampling
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.optics import spectra
 from warpcaustics.optics.refraction import height_range, sun_visibility
@@ -134,6 +134,8 @@ class Renderer:
                 "make the floor deeper or the waves lower")
         with watch.stage("shading"):
             visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible)
+        if cfg.sky.sampling is SkySampling.HALVES:
+            self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
                       watch=watch)
         self.method.check_frame(frame)

@@ -92,6 +92,11 @@ class RenderResult:
     sky_floor_irradiance: np.ndarray | None = None
     """With a sky (``sky.model``): (K, M, M) the sky's part of :attr:`floor_irradiance`
     [W m⁻² nm⁻¹]; the direct sun's is the rest."""
+    sky_floor_irradiance_even: np.ndarray | None = None
+    """``sky.sampling = "halves"``: (K, M, M) the part of :attr:`sky_floor_irradiance` from the
+    first half of the sky's directions (the even-numbered; the rest is the second half's): two
+    independent estimates of the sky's continuum, for statistics without the directions' own
+    caustic noise (:func:`warpcaustics.batch.stats.continuous_sky_cv`)."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None

@@ -123,28 +123,37 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
     band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``), after the
-    collector."""
-    fields = {"irradiance_w_m2": band_integrated(result.floor_irradiance, result.bin_widths_nm)}
-    sky = result.sky_floor_irradiance
-    if sky is not None:  # the direct sun's part and the sky's, each alone
-        fields["sky_irradiance_w_m2"] = band_integrated(sky, result.bin_widths_nm)
-        fields["direct_irradiance_w_m2"] = fields["irradiance_w_m2"] - fields["sky_irradiance_w_m2"]
+    collector. Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each
+    of these but the direct sun's also has ``cv_continuous_sky`` (:func:`continuous_sky_cv`)."""
+    widths = result.bin_widths_nm
+    views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
     covered = None
     if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0]:
-        fields["par_umol_m2_s"] = par_map(result.floor_irradiance, edges)
+        views["par_umol_m2_s"] = lambda m: par_map(m, edges)
         # PAR counts only what the bins hold: say so when they cover less than 400-700 nm
         covered = [max(float(edges[0]), PAR_BAND_NM[0]), min(float(edges[-1]), PAR_BAND_NM[1])]
     band = band_index(result.wavelengths_nm, edges, cfg.wavelength_nm)
     if band is not None:
-        fields[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = np.asarray(
-            result.floor_irradiance[band], np.float64
-        )
+        views[f"band_{result.wavelengths_nm[band]:g}nm_w_m2_nm"] = lambda m: np.asarray(m[band], np.float64)
     if cfg.per_band:
         for k, nm in enumerate(result.wavelengths_nm):
-            fields[f"bands/{nm:g}nm_w_m2_nm"] = np.asarray(result.floor_irradiance[k], np.float64)
+            views[f"bands/{nm:g}nm_w_m2_nm"] = lambda m, k=k: np.asarray(m[k], np.float64)
+    fields = {name: view(result.floor_irradiance) for name, view in views.items()}
+    sky = result.sky_floor_irradiance
+    halves = {}  # field → (its sky part, the sky's even half)
+    if sky is not None:  # the direct sun's part and the sky's, each alone
+        fields["sky_irradiance_w_m2"] = band_integrated(sky, widths)
+        fields["direct_irradiance_w_m2"] = fields["irradiance_w_m2"] - fields["sky_irradiance_w_m2"]
+        even = result.sky_floor_irradiance_even
+        if even is not None:
+            halves = {name: (view(sky), view(even)) for name, view in views.items()}
+            halves["sky_irradiance_w_m2"] = (fields["sky_irradiance_w_m2"], band_integrated(even, widths))
     texel = result.map_extent_m / result.floor_irradiance.shape[-1]
-    periodic = result.map_periodic
+
+    def collector(f: np.ndarray) -> np.ndarray:
+        return collector_average(f, texel, cfg.collector_mm * 1e-3, periodic=result.map_periodic)
+
     out = {
         "collector_mm": cfg.collector_mm,
         "flash_threshold": cfg.flash_threshold,
@@ -152,12 +161,38 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "par_band_nm": covered,
     }
     for name, f in fields.items():
-        stats = field_statistics(
-            collector_average(f, texel, cfg.collector_mm * 1e-3, periodic=periodic), cfg.flash_threshold
-        )
+        averaged = collector(f)
+        stats = field_statistics(averaged, cfg.flash_threshold)
+        if name in halves:
+            sky_part, even_part = (collector(h) for h in halves[name])
+            stats["cv_continuous_sky"] = continuous_sky_cv(averaged, sky_part, even_part)
         group, _, band_name = name.rpartition("/")
         (out.setdefault(group, {}) if group else out)[band_name] = stats
     return out
+
+
+def continuous_sky_cv(total: np.ndarray, sky: np.ndarray, even: np.ndarray) -> float | None:
+    """The CV of ``total`` with the sky's part taken as its continuum (issue 32). A sky of D
+    directions adds D caustic patterns, whose sum fluctuates more than a real sky's continuum of
+    directions does (docs/validation.md: the excess falls with D). With ``sky.sampling = "halves"``
+    the directions are two independently drawn halves, each an unbiased estimate of the continuum:
+    A = direct + even·s̄/ē and B = direct + odd·s̄/ō (each half scaled to the sky's mean s̄). Their
+    errors are independent, so the covariance of A and B is, in expectation, the variance of the
+    direct light plus the continuum's, without the directions' own noise: CV = √max(Cov(A, B), 0) /
+    mean (a frame's covariance can come out below 0 by chance; pool many texels or frames).
+    ``total``, ``sky`` (its sky part) and ``even`` (the first half's part) are maps of one field;
+    None where a half holds no light."""
+    total, sky, even = (np.asarray(x, np.float64) for x in (total, sky, even))
+    odd = sky - even
+    s, e, o = sky.mean(), even.mean(), odd.mean()
+    mean = total.mean()
+    if e <= 0.0 or o <= 0.0 or mean <= 0.0:
+        return None
+    direct = total - sky
+    a = direct + even * (s / e)
+    b = direct + odd * (s / o)
+    cov = float(np.mean((a - a.mean()) * (b - b.mean())))
+    return math.sqrt(max(cov, 0.0)) / float(mean)
 
 
 def band_index(

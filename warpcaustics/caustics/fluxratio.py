@@ -11,11 +11,15 @@ import warp as wp
 from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
-from warpcaustics.config import Scattering
+from warpcaustics.config import Scattering, SkySampling
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
 from warpcaustics.scene.receivers import albedo_spectrum
 from warpcaustics.water import Surface
+
+SKY_GROUPS = ("sky_even", "sky")
+"""The small-angle transfer's groups of the sky's even- and odd-numbered directions
+(``sky.sampling = "halves"``; else all are ``sky``)."""
 
 
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
@@ -188,8 +192,9 @@ class FluxRatioStage(CausticStage):
                 self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1])
         single_sky = None
         if self.light.sky_directions is not None:
-            sky_np, sky_flux = self._sky(frame)
+            sky_np, sky_flux, even = self._sky(frame)
             extra["sky_floor_irradiance"] = single_sky = sky_np
+            extra["sky_floor_irradiance_even"] = single_even = even
             floor_np, flux = floor_np + sky_np, flux + sky_flux
         transmitted = flux[0]
         extra["delivered_flux_w_nm"] = flux[1]
@@ -204,6 +209,7 @@ class FluxRatioStage(CausticStage):
             with watch.stage("sky"):
                 sky_np, walk["sky"] = self.multiple.run_sky(frame.surface, self.light.sky_visible)
             extra["sky_floor_irradiance"] = sky_np
+            extra["sky_floor_irradiance_even"] = None  # the walk's sky is one estimate
             floor_np = floor_np + sky_np
             transmitted = transmitted + np.asarray(walk["sky"]["transmitted"])
         extra["multiple_scattering_stats"] = walk
@@ -214,31 +220,43 @@ class FluxRatioStage(CausticStage):
             with watch.stage("small_angle"):
                 scattered, walk["small_angle"] = self.small_angle.finish(floor_flux)
             floor_np = single[0] + sum(scattered.values())
-            if "sky" in scattered:
-                extra["sky_floor_irradiance"] = single_sky + scattered["sky"]
+            if single_sky is not None:
+                sky_scattered = [scattered[g] for g in SKY_GROUPS if g in scattered]
+                extra["sky_floor_irradiance"] = single_sky + sum(sky_scattered)
+                if single_even is not None:
+                    extra["sky_floor_irradiance_even"] = single_even + scattered[SKY_GROUPS[0]]
         return floor_np, transmitted, extra, single
 
-    def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
-        """The sky's floor map and (2, K) flux (entering, delivered): one shaded refraction and
-        deposit per sky direction, each with its share of the sky's irradiance. With the small-angle
-        transfer each direction's map is read back and given its own transfer (its own path)."""
+    def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """The sky's floor map, (2, K) flux (entering, delivered) and, with ``sky.sampling =
+        "halves"``, the map of its even-numbered directions alone (else None): one shaded refraction
+        and deposit per sky direction, each with its share of the sky's irradiance (with halves,
+        the even-numbered ones first). With the small-angle transfer each direction's map is read
+        back and given its own transfer (its own path), its scattered light reported by half."""
         light = self.light
         transmitted = 0.0
-        total = None
+        total = even = None
         separate = self.small_angle is not None
-        for i, (direction, irradiance) in enumerate(zip(light.sky_directions, light.sky_irradiance_per_dir)):
+        count = len(light.sky_directions)
+        halves = self.scene.config.sky.sampling is SkySampling.HALVES
+        order = [*range(0, count, 2), *range(1, count, 2)] if halves else range(count)
+        for n, i in enumerate(order):
+            direction, irradiance = light.sky_directions[i], light.sky_irradiance_per_dir[i]
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
                 visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out)
-            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=i == 0 or separate,
+            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
                                         irradiance=irradiance)
             transmitted = transmitted + flux
             if separate:
                 one = floor.numpy().copy()
                 total = one if total is None else total + one
                 with frame.watch.stage("small_angle"):
-                    self.small_angle.add(one, direction, flux[1], group="sky")
-        return (floor.numpy().copy() if total is None else total), transmitted
+                    group = SKY_GROUPS[i % 2] if halves else "sky"
+                    self.small_angle.add(one, direction, flux[1], group=group)
+            if halves and n == count // 2 - 1:  # the last of the even-numbered directions
+                even = total.copy() if separate else floor.numpy().copy()
+        return (floor.numpy().copy() if total is None else total), transmitted, even
 
     def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
                  irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:

@@ -72,9 +72,10 @@ class SmallAngleScattering:
             group: str = "sun") -> None:
         """One pass: its single-scattering map (K, M, M) [W m⁻² nm⁻¹], the direction of its light
         (towards it), the flux its map holds over the whole patch (K,) [W nm⁻¹], and the group its
-        scattered light is reported in (``sun``, ``sky``). The light each texel's ray lost to
-        scattering on its own path, S (e^{b s(x)} − 1), is what the transfer spreads, normalised
-        to the mean path's e^{b s̄} − 1 that the transfer's own k = 0 term carries."""
+        scattered light is reported in (``sun``; ``sky_even`` and ``sky``, the sky's two halves). The
+        light each texel's ray lost to scattering on its own path, S (e^{b s(x)} − 1), is what the
+        transfer spreads, normalised to the mean path's e^{b s̄} − 1 that the transfer's own k = 0
+        term carries."""
         down, path = self.beam(direction)
         local = self.local_paths(down)
         lost = np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]

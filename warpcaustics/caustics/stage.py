@@ -57,6 +57,8 @@ class Lighting:
     """(D, 3) unit vectors towards the points of the sun's disk (the centre alone for a point sun)."""
     sky_directions: np.ndarray | None = None
     """(S, 3) unit vectors towards the sky's directions; None without a sky."""
+    sky_irradiance_horizontal: np.ndarray | None = None
+    """(K,) the sky's horizontal spectral irradiance [W m⁻² nm⁻¹]."""
     sky_irradiance_np: list[np.ndarray] = field(default_factory=list)
     """Per sky direction: its irradiance on a plane perpendicular to it (K,)."""
     sky_irradiance_per_dir: list = field(default_factory=list)
@@ -80,15 +82,26 @@ class Lighting:
                     group_ior=ior if cfg.optics.dispersion else ior[:1],
                     sun_directions=scene.sun_disk_directions())
         if cfg.sky.model is not SkyModel.NONE:
-            light.sky_directions, shares = scene.sky_directions()
-            sky = scene.sky_irradiance(sun)
-            light.sky_irradiance_np = [sky * w for w in shares]
-            light.sky_irradiance_per_dir = [wp.array(e.astype(np.float32), dtype=wp.float32, device=device)
-                                            for e in light.sky_irradiance_np]
+            light.sky_irradiance_horizontal = scene.sky_irradiance(sun)
+            light.set_sky(*scene.sky_directions(), device)
             n = scene.water_resolution
             shape = (len(light.sky_directions), n, n) if keep_sky_shading else (n, n)
             light.sky_visible = wp.empty(shape, dtype=wp.float32, device=device)
         return light
+
+    def set_sky(self, directions: np.ndarray, shares: np.ndarray, device: str) -> None:
+        """The sky's directions (S, 3) and each one's share of its horizontal irradiance (S,)."""
+        self.sky_directions = directions
+        self.sky_irradiance_np = [self.sky_irradiance_horizontal * w for w in shares]
+        self.sky_irradiance_per_dir = [wp.array(e.astype(np.float32), dtype=wp.float32, device=device)
+                                       for e in self.sky_irradiance_np]
+
+    def draw_sky(self, scene, time_s: float, device: str) -> None:
+        """``sky.sampling = "halves"``: this frame's directions, two randomly turned and offset
+        halves (:meth:`~warpcaustics.scene.Scene.sky_directions`), drawn from ``water.seed`` and the
+        frame's time, so a frame's directions are the same in every run."""
+        rng = np.random.default_rng([scene.config.water.seed, int(round(time_s * 1e6)) % 2**63])
+        self.set_sky(*scene.sky_directions(rng), device)
 
     def passes(self) -> list[tuple[np.ndarray, np.ndarray, bool]]:
         """Light passes: (direction (3,), irradiance (K,) on a plane perpendicular to it, from the

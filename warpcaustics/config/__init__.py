@@ -24,7 +24,7 @@ from warpcaustics.config.caustics import (
     SunMapVariant,
 )
 from warpcaustics.config.fields import PLANNED_VALUES
-from warpcaustics.config.light import SkyConfig, SkyModel, SkySpectrum, SunConfig, SunSpectrum
+from warpcaustics.config.light import SkyConfig, SkyModel, SkySampling, SkySpectrum, SunConfig, SunSpectrum
 from warpcaustics.config.loading import all_keys, config_from_dict, config_to_dict, parse_override, read_toml
 from warpcaustics.config.optics import (
     JerlovSource,
@@ -67,6 +67,7 @@ __all__ = [
     "Scattering",
     "SkyConfig",
     "SkyModel",
+    "SkySampling",
     "SkySpectrum",
     "StatsConfig",
     "SunConfig",

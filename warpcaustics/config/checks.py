@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from warpcaustics.config.caustics import GREY_METHODS, BeamInterpolation, CausticsMethod, Intersection
-from warpcaustics.config.light import SkyModel, SunSpectrum
+from warpcaustics.config.light import SkyModel, SkySampling, SunSpectrum
 from warpcaustics.config.optics import Scattering
 from warpcaustics.config.scene import FloorShape
 from warpcaustics.config.schema import Config
@@ -139,6 +139,14 @@ def _check_sky(cfg: Config) -> None:
     if sky.diffuse_fraction <= 0.0:
         raise ConfigError(f"sky.model = {sky.model.value!r} with sky.diffuse_fraction = 0 has no light; set "
                           "sky.diffuse_fraction (e.g. 0.15) or sky.model = \"none\"")
+    if sky.sampling is SkySampling.HALVES:
+        if sky.directions < 2 or sky.directions % 2:
+            raise ConfigError(f"sky.sampling = \"halves\" splits the directions in two: set sky.directions "
+                              f"to an even number of at least 2 (not {sky.directions})")
+        if method is not CausticsMethod.FLUXRATIO or cfg.optics.scattering is Scattering.MULTIPLE:
+            raise ConfigError("sky.sampling = \"halves\" keeps the halves' maps apart in caustics.method = "
+                              "\"fluxratio\" with optics.scattering = \"single\" or \"small_angle\"; set "
+                              "those or sky.sampling = \"stratified\"")
 
 
 def _check_scattering(cfg: Config) -> None:

@@ -22,6 +22,11 @@ class SkyModel(str, enum.Enum):
     CIE_CLEAR = "cie_clear"
 
 
+class SkySampling(str, enum.Enum):
+    STRATIFIED = "stratified"
+    HALVES = "halves"
+
+
 class SkySpectrum(str, enum.Enum):
     ASTM_G173_DIFFUSE = "astm_g173_diffuse"
     SUN = "sun"
@@ -79,3 +84,9 @@ class SkyConfig:
     the global horizontal irradiance over the render's bins is ``diffuse_fraction``."""
     directions: int = field(default=64, metadata=_range(1, 4096))
     """Directions the sky is integrated over (cosine-weighted, stratified) [-]."""
+    sampling: SkySampling = SkySampling.STRATIFIED
+    """How the directions are drawn: ``stratified``, one fixed stratified set (the best mean);
+    ``halves``, two stratified halves of ``directions``/2, each turned and offset at random anew
+    every frame, so that each half is an unbiased estimate of the sky's continuum with an error of
+    its own: the frame statistics then also give the CV without the directions' own caustic noise
+    (``cv_continuous_sky``, issue 32; ``fluxratio`` with single or small-angle scattering)."""

@@ -65,20 +65,28 @@ class Scene:
         d = np.cos(r)[:, None] * s + np.sin(r)[:, None] * around
         return d / np.linalg.norm(d, axis=1, keepdims=True)
 
-    def sky_directions(self) -> tuple[np.ndarray, np.ndarray]:
+    def sky_directions(self, rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(K, 3) unit directions towards the sky and (K,) the share of the sky's horizontal
         irradiance each carries on a plane perpendicular to it: cosine-weighted stratified samples
         (sinθ = √((j + ½)/K), turns of the golden angle), each standing for an equal part of the
         horizontal irradiance of a uniform sky, so it brings L_j / Σ L of it, L_j the sky's relative
         radiance there (1 for ``uniform``: 1/(K cosθ) on its perpendicular plane; the CIE type's
-        L/L_zenith around the sun for ``cie``, ``cie_clear``). The shares' horizontal parts sum to 1."""
+        L/L_zenith around the sun for ``cie``, ``cie_clear``). The shares' horizontal parts sum to 1.
+
+        With ``rng`` (``sky.sampling = "halves"``): two such patterns of K/2 directions, each with its
+        own random offset u in its strata (sinθ = √((j + u)/(K/2))) and turn φ₀ about the zenith,
+        interleaved (the even-numbered directions are the first). Every direction is then
+        cosine-distributed over the hemisphere, so each half is an unbiased estimate of the sky's
+        continuum, and the two halves' errors are independent."""
         sky = self.config.sky
         count = sky.directions
-        j = np.arange(count) + 0.5
-        sin_t = np.sqrt(j / count)
-        cos_t = np.sqrt(1.0 - sin_t * sin_t)
-        phi = j * math.pi * (3.0 - math.sqrt(5.0))
-        d = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
+        if rng is None:
+            d = _stratified_hemisphere(count, 0.5, 0.0)
+        else:
+            d = np.empty((count, 3))
+            for half in range(2):
+                d[half::2] = _stratified_hemisphere(count // 2, rng.random(), 2.0 * math.pi * rng.random())
+        cos_t = d[:, 2]
         if sky.model in (SkyModel.CIE, SkyModel.CIE_CLEAR):
             from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance
 
@@ -157,3 +165,13 @@ def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None 
     cfg = config_from_dict(table, overrides)
     base = Path(path).resolve().parent if path is not None else Path.cwd()
     return scene_from_config(cfg, base, str(path) if path is not None else None)
+
+
+def _stratified_hemisphere(count: int, offset: float, turn: float) -> np.ndarray:
+    """(count, 3) cosine-weighted stratified directions: sinθ_j = √((j + offset)/count), φ_j = turn +
+    (j + offset) × the golden angle, j < count."""
+    j = np.arange(count) + offset
+    sin_t = np.sqrt(j / count)
+    cos_t = np.sqrt(1.0 - sin_t * sin_t)
+    phi = turn + j * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)

@@ -13,9 +13,14 @@ import numpy as np
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 
-def check_frames(frames: int) -> None:
+def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
+    """The frame times ``i · frame_interval_s``, i < ``frames``, once both flags are sane."""
     if frames < 1:
         raise ConfigError(f"--frames = {frames} must be at least 1")
+    if not (math.isfinite(frame_interval_s) and frame_interval_s > 0):
+        raise ConfigError(f"--frame-interval = {frame_interval_s} must be a positive number of seconds, "
+                          "e.g. 2 (frames further apart than the waves' periods are independent)")
+    return tuple(i * frame_interval_s for i in range(frames))
 
 
 def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose: str) -> None:
@@ -73,3 +78,11 @@ def pooled_statistics(
     mean = float(mu.mean())
     second = float(np.mean(mu**2 + sd**2))
     return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0
+
+
+def continuous_sky(frames: list[tuple[float, float | None]]) -> float | None:
+    """The frames' (mean, ``cv_continuous_sky``) pooled, rounded (None: the sky was not drawn in
+    halves, ``sky.sampling``)."""
+    if any(cv is None for _, cv in frames):
+        return None
+    return round(pooled_statistics(frames)[1], 4)

@@ -24,6 +24,7 @@ import numpy as np
 from warpcaustics.batch.field.common import (
     check_frames,
     check_overrides,
+    continuous_sky,
     frame_statistics_of,
     pooled_statistics,
     render_points,
@@ -110,7 +111,7 @@ def run_darecki2011(
     ``darecki2011.png``. ``overrides``: config keys set at every depth (``--set``)."""
     from warpcaustics.scene import load_scene
 
-    check_frames(frames)
+    times = check_frames(frames, frame_interval_s)
     check_overrides(overrides, POINT_KEYS, "--depths")
     rec = record()
     scene_path = Path(scene).resolve()
@@ -122,7 +123,6 @@ def run_darecki2011(
     if quick:
         chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
     variants = [{"floor.depth_m": d} for d in chosen]
-    times = tuple(i * frame_interval_s for i in range(frames))
     sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
                           quiet=quiet, force=force)
     c555 = beam_attenuation(base.config, 555.0)
@@ -133,6 +133,7 @@ def run_darecki2011(
         for j, nm in enumerate(rec.wavelengths_nm):
             band = [s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats]
             _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
+            continuum = continuous_sky([(b["mean"], b.get("cv_continuous_sky")) for b in band])
             measured = float(rec.cv[k, j])
             rows.append({
                 "depth_m": depth,
@@ -141,6 +142,7 @@ def run_darecki2011(
                 "model_cv": round(cv, 4),
                 "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
                 "model_over_measured": round(cv / measured, 3),
+                "model_cv_continuous_sky": continuum,
                 "frames": len(band),
                 "model_c555_per_m": round(c555, 4),
                 "measured_c555_per_m": float(rec.beam_attenuation_555),
@@ -163,6 +165,9 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
         ax.plot([r["measured_cv"] for r in rs], z, "ko-", label="Darecki et al. 2011 (Fig. 13a)")
         ax.errorbar([r["model_cv"] for r in rs], z, xerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
                     color="tab:blue", capsize=3, label="model as rendered")
+        if all(r["model_cv_continuous_sky"] is not None for r in rs):
+            ax.plot([r["model_cv_continuous_sky"] for r in rs], z, "D-", color="tab:purple",
+                    label="model, the sky's continuum")
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(plt.NullFormatter())  # the minor ticks' labels overlap
         ax.set_title(f"{nm:g} nm")

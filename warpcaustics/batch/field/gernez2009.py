@@ -29,6 +29,7 @@ import numpy as np
 from warpcaustics.batch.field.common import (
     check_frames,
     check_overrides,
+    continuous_sky,
     frame_statistics_of,
     pooled_statistics,
     render_points,
@@ -162,7 +163,7 @@ def run_gernez2009(
     unknown = set(series) - set(SERIES)
     if not series or unknown:
         raise ConfigError(f"--series {','.join(series)!r} must name some of: {', '.join(SERIES)}")
-    check_frames(frames)
+    times = check_frames(frames, frame_interval_s)
     check_overrides(overrides, POINT_KEYS, "--zeniths / --sqrt-winds")
     scene_path = Path(scene).resolve()
     fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
@@ -176,7 +177,6 @@ def run_gernez2009(
         ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
     overrides, variants = point_variants(points, base.config)
-    times = tuple(i * frame_interval_s for i in range(frames))
     sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
                           quiet=quiet, force=force)
     rows = _rows(points, overrides, sweep, Path(out), base.config)
@@ -233,9 +233,10 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     b = float(water_optics(config.optics, bins).scattering_per_m[band])
     rows = []
     for point, o in zip(points, overrides):
-        total, direct, sky = [], [], []
+        total, direct, sky, continuum = [], [], [], []
         for s in frame_statistics_of(sweep, out, o):
             total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
+            continuum.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"].get("cv_continuous_sky")))
             direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
             sky.append(s["sky_irradiance_w_m2"]["mean"])
         mean, cv = pooled_statistics(total)
@@ -263,6 +264,7 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
                 "model_cv_frame_sd": round(float(np.std(per_frame)), 4),
                 "model_cv_uniform_sky": round(cv_uniform_sky, 4),
                 "model_cv_uniform_sky_scattered": round(cv_scattered, 4),
+                "model_cv_continuous_sky": continuous_sky(continuum),
                 "direct_transmission": round(t, 4),
                 "frames": len(total),
                 "model_mean_w_m2": mean,
@@ -313,6 +315,9 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
             color="tab:orange",
             label="… and the sun's scattered light too",
         )
+        if all(r["model_cv_continuous_sky"] is not None for r in rs):
+            ax.plot(x, [r["model_cv_continuous_sky"] for r in rs], "D-", color="tab:purple",
+                    label="model, the sky's continuum (sky.sampling = halves)")
         if s == "zenith":
             ax.set_xlabel("sun zenith angle [deg]")
             ax.set_title("CV at 510 nm, 3.2 m, 8 mm collector")

@@ -1,0 +1,142 @@
+"""sky.sampling = "halves" (issue 32 item 3): the sky's directions as two independently drawn
+halves, each an unbiased estimate of the sky's continuum, and the frame statistics' CV without the
+directions' own caustic noise (``cv_continuous_sky``)."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+import warpcaustics as wc
+from warpcaustics.batch.stats import continuous_sky_cv, frame_statistics
+from warpcaustics.errors import ConfigError
+
+from helpers import fresnel_t_angles
+
+SKY = {"sky.model": "uniform", "sky.diffuse_fraction": 0.3}
+FLAT = {"water.model": "flat", "water.extent_m": 4.0, "water.resolution": 8, "caustics.map_resolution": 8,
+        "optics.wavelengths": [500.0], "floor.depth_m": 2.0}
+
+
+def test_the_stratified_set_is_unchanged():
+    """Without a generator the directions are the fixed stratified set: sinθ_j = √((j + ½)/K),
+    φ_j = (j + ½) × the golden angle."""
+    scene = wc.load_scene(None, {**SKY, "sky.directions": 16})
+    d, shares = scene.sky_directions()
+    j = np.arange(16) + 0.5
+    np.testing.assert_allclose(np.hypot(d[:, 0], d[:, 1]), np.sqrt(j / 16), atol=1e-12)
+    phi = np.mod(j * math.pi * (3.0 - math.sqrt(5.0)), 2 * math.pi)
+    np.testing.assert_allclose(np.mod(np.arctan2(d[:, 1], d[:, 0]), 2 * math.pi), phi, atol=1e-9)
+    np.testing.assert_allclose(shares * d[:, 2], 1.0 / 16)
+
+
+def test_each_half_is_cosine_distributed():
+    """Every direction of either half is cosine-distributed over the hemisphere: over 4000 draws,
+    each half's share-weighted sums of cos²θ, cos⁴θ, sinθ cosφ and sin²θ cos2φ (twice each half's,
+    as it stands for the whole sky) average to the cosine-weighted integrals 1/2, 1/3, 0, 0 within
+    4 standard errors; the halves' horizontal shares are ½ each and the halves differ draw to draw."""
+    scene = wc.load_scene(None, {**SKY, "sky.directions": 8, "sky.sampling": "halves"})
+    rng = np.random.default_rng(7)
+    moments = {0: [], 1: []}
+    for _ in range(4000):
+        d, shares = scene.sky_directions(rng)
+        h = shares * d[:, 2]  # horizontal shares
+        phi = np.arctan2(d[:, 1], d[:, 0])
+        sin_t = np.hypot(d[:, 0], d[:, 1])
+        f = np.stack([d[:, 2] ** 2, d[:, 2] ** 4, sin_t * np.cos(phi), sin_t**2 * np.cos(2 * phi)])
+        for half in (0, 1):
+            assert h[half::2].sum() == pytest.approx(0.5, rel=1e-12)
+            moments[half].append(2.0 * (f[:, half::2] * h[half::2]).sum(axis=1))
+    for half in (0, 1):
+        m = np.array(moments[half])
+        se = m.std(axis=0) / math.sqrt(len(m))
+        assert np.all(np.abs(m.mean(axis=0) - [0.5, 1.0 / 3.0, 0.0, 0.0]) < 4 * se + 1e-12)
+    first, second = scene.sky_directions(np.random.default_rng(1))[0], scene.sky_directions(rng)[0]
+    assert not np.allclose(first, second)
+
+
+def test_halves_over_still_water_are_unbiased():
+    """A uniform sky over still water through 8 directions drawn anew each frame: each half alone
+    (twice its map) is a poor estimate of ∫ L cosθ T(θ) e^{−cD/cosθt} dΩ (float64 quadrature,
+    Fresnel in angle form) in one frame, but over 120 frames its mean is that integral within 4
+    standard errors, and the frame's whole sky is the halves' sum; the map is uniform, so the CV
+    with the sky's continuum is 0."""
+    scene = wc.load_scene(None, {**FLAT, **SKY, "sky.directions": 8, "sky.sampling": "halves"})
+    renderer = wc.Renderer(scene, device="cpu")
+    halves = []
+    for frame in range(120):
+        r = renderer.render(0.01 * frame)
+        sky, even = r.sky_floor_irradiance[0].astype(np.float64), r.sky_floor_irradiance_even[0]
+        np.testing.assert_allclose(sky.std(), 0.0, atol=1e-6 * sky.mean())
+        halves.append((2.0 * even.mean(), 2.0 * (sky - even).mean()))
+        stats = frame_statistics(r, scene.config.stats)
+        assert stats["irradiance_w_m2"]["cv_continuous_sky"] == pytest.approx(0.0, abs=1e-5)
+    c = float(r.attenuation_per_m[0])
+
+    def integrand(theta):
+        t = fresnel_t_angles(np.array([theta]), 1.0, float(r.ior[0]))[0]
+        theta_t = math.asin(math.sin(theta) / float(r.ior[0]))
+        return math.cos(theta) * math.sin(theta) * t * math.exp(-c * 2.0 / math.cos(theta_t))
+
+    e_sky = scene.sky_irradiance(r.sun_irradiance)[0]
+    expected = e_sky / math.pi * 2 * math.pi * integrate.quad(integrand, 0.0, math.pi / 2, limit=200)[0]
+    halves = np.array(halves)
+    se = halves.std(axis=0) / math.sqrt(len(halves))
+    assert np.all(se > 1e-4 * expected)  # each frame's halves do differ
+    assert np.all(np.abs(halves.mean(axis=0) - expected) < 4 * se)
+
+
+def test_the_covariance_of_the_halves_takes_out_their_noise():
+    """On fields made up here (float64): a direct part, a sky continuum and two halves, each (twice
+    its map, as it stands for the whole sky) with independent noise of 4× the continuum's variance.
+    The plain CV is 1.6× too high; the halves' covariance gives the CV of direct + continuum to 2 %;
+    with noiseless halves it is that CV exactly (1e-12); a half with no light gives None."""
+    rng = np.random.default_rng(3)
+    m = 512
+    x = np.linspace(0, 2 * math.pi, m, endpoint=False)
+    direct = 1.0 + 0.3 * np.sin(3 * x)[:, None] * np.cos(2 * x)[None, :]
+    continuum = 4.0 + 0.4 * np.cos(5 * x)[None, :] + 0.2 * np.sin(7 * x)[:, None]
+    noise = 2.0 * continuum.std()
+    even = 0.5 * continuum + 0.5 * noise * rng.standard_normal((m, m))
+    odd = 0.5 * continuum + 0.5 * noise * rng.standard_normal((m, m))
+    truth = direct + continuum
+    cv_truth = truth.std() / truth.mean()
+    total = direct + even + odd
+    assert total.std() / total.mean() > 1.5 * cv_truth
+    assert continuous_sky_cv(total, even + odd, even) == pytest.approx(cv_truth, rel=0.02)
+    assert continuous_sky_cv(truth, continuum, 0.5 * continuum) == pytest.approx(cv_truth, rel=1e-12)
+    assert continuous_sky_cv(truth, continuum, np.zeros_like(continuum)) is None
+
+
+@pytest.mark.parametrize("scattering", ["single", "small_angle"])
+def test_a_sea_under_halves_reports_the_continuum_cv(scattering):
+    """On a small FFT sea, with single and small-angle scattering: the halves' maps add up to the
+    sky's (its even half holds about half the sky, scattered light included), and the total, each
+    band and the sky alone report ``cv_continuous_sky``, the direct sun's part does not (it has no
+    sky), nor does a stratified sky."""
+    sea = {"water.model": "fft", "water.resolution": 32, "water.extent_m": 2.0, "water.depth_m": 50.0,
+           "caustics.map_resolution": 32, "optics.wavelengths": [450.0, 550.0], "floor.depth_m": 1.5,
+           "stats.per_band": True, "optics.scattering": scattering, **SKY}
+    scene = wc.load_scene(None, {**sea, "sky.directions": 8, "sky.sampling": "halves"})
+    r = wc.render(scene, device="cpu")
+    even, sky = r.sky_floor_irradiance_even, r.sky_floor_irradiance
+    assert np.all(even.mean(axis=(1, 2)) > 0.25 * sky.mean(axis=(1, 2)))
+    assert np.all((sky - even).mean(axis=(1, 2)) > 0.25 * sky.mean(axis=(1, 2)))
+    stats = frame_statistics(r, scene.config.stats)
+    for s in (stats["irradiance_w_m2"], stats["sky_irradiance_w_m2"], *stats["bands"].values()):
+        assert s["cv_continuous_sky"] is not None and s["cv_continuous_sky"] >= 0.0
+    assert "cv_continuous_sky" not in stats["direct_irradiance_w_m2"]
+    plain = wc.render(wc.load_scene(None, {**sea, "sky.directions": 8}), device="cpu")
+    assert plain.sky_floor_irradiance_even is None
+    assert "cv_continuous_sky" not in frame_statistics(plain, scene.config.stats)["irradiance_w_m2"]
+
+
+@pytest.mark.parametrize(("overrides", "needle"), [
+    ({"sky.directions": 7}, "even number of at least 2"),
+    ({"caustics.method": "photons"}, 'caustics.method = "fluxratio"'),
+    ({"optics.scattering": "multiple"}, '"single" or "small_angle"'),
+])
+def test_halves_errors_are_one_line(overrides, needle):
+    with pytest.raises(ConfigError, match=needle):
+        wc.load_scene(None, {**FLAT, **SKY, "sky.directions": 8, "sky.sampling": "halves", **overrides})
