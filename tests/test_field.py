@@ -233,7 +233,7 @@ def test_frames_are_the_interval_apart(monkeypatch, capsys, tmp_path):
         monkeypatch.setattr(module, "render_points", capture)
     pytest.importorskip("matplotlib")
     for dataset, scene, flags, want in (
-            ("darecki2011", DARECKI, [], (0.0, 0.5, 1.0)),
+            ("darecki2011", DARECKI, [], (0.0, 5.0, 10.0)),
             ("darecki2011", DARECKI, ["--frame-interval", "4"], (0.0, 4.0, 8.0)),
             ("gernez2009", _scene(tmp_path), [], (0.0, 2.0, 4.0)),
             ("gernez2009", _scene(tmp_path), ["--frame-interval", "0.25"], (0.0, 0.25, 0.5))):

@@ -121,7 +121,7 @@ def _parser() -> argparse.ArgumentParser:
                     help="darecki2011: only these measured depths [m], comma-separated (default all)")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
-                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 0.5); "
+                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 5); "
                          "frames further apart than the waves' periods are independent samples")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)

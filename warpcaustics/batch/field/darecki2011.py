@@ -98,7 +98,7 @@ def run_darecki2011(
     *,
     depths: tuple[float, ...] | None = None,
     frames: int = 3,
-    frame_interval_s: float = 0.5,
+    frame_interval_s: float = 5.0,
     workers: int = 1,
     device: str | None = None,
     quick: bool = False,
@@ -108,7 +108,10 @@ def run_darecki2011(
 ) -> dict[str, Path]:
     """Render SCENE at each of the record's depths (or ``depths`` of them) as one resumable sweep
     into ``out``, pool each depth's frames per band and write ``darecki2011.csv`` and
-    ``darecki2011.png``. ``overrides``: config keys set at every depth (``--set``)."""
+    ``darecki2011.png``. ``overrides``: config keys set at every depth (``--set``). The frames are
+    ``frame_interval_s`` apart, by default 5 s, longer than the peak waves' period (2.6 s at the
+    record's wind): each frame is a new realisation of the largest scales, which decide the CV at
+    depth (docs/validation.md)."""
     from warpcaustics.scene import load_scene
 
     times = check_frames(frames, frame_interval_s)
