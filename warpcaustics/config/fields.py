@@ -61,7 +61,8 @@ DESCRIBE_CHARS = 80
 
 
 def _describe(value: Any) -> str:
-    """A value as an error quotes it (TOML-like), cut to DESCRIBE_CHARS characters."""
+    """A value as an error quotes it (TOML-like); past DESCRIBE_CHARS characters, its first and last
+    DESCRIBE_CHARS/4 with the length."""
     if isinstance(value, bool):
         return str(value).lower()
     try:
@@ -71,7 +72,11 @@ def _describe(value: Any) -> str:
     if text and len(text) <= DESCRIBE_CHARS:
         return text
     kind = "a table" if isinstance(value, dict) else "a list" if isinstance(value, list) else "a value"
-    return f"{text[:DESCRIBE_CHARS // 2]}… ({len(text)} characters)" if text else kind
+    if not text:
+        return kind
+    # its start and its end: a long path keeps its file name
+    keep = DESCRIBE_CHARS // 4
+    return f"{text[:keep]}…{text[-keep:]} ({len(text)} characters)"
 
 
 def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
