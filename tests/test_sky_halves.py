@@ -9,7 +9,7 @@ import pytest
 from scipy import integrate
 
 import warpcaustics as wc
-from warpcaustics.batch.stats import continuous_sky_cv, frame_statistics
+from warpcaustics.batch.stats import continuous_sky_cv, continuous_sky_moments, frame_statistics
 from warpcaustics.errors import ConfigError
 
 from helpers import fresnel_t_angles
@@ -31,27 +31,40 @@ def test_the_stratified_set_is_unchanged():
     np.testing.assert_allclose(shares * d[:, 2], 1.0 / 16)
 
 
-def test_each_half_is_cosine_distributed():
-    """Every direction of either half is cosine-distributed over the hemisphere: over 4000 draws,
-    each half's share-weighted sums of cos²θ, cos⁴θ, sinθ cosφ and sin²θ cos2φ (twice each half's,
-    as it stands for the whole sky) average to the cosine-weighted integrals 1/2, 1/3, 0, 0 within
-    4 standard errors; the halves' horizontal shares are ½ each and the halves differ draw to draw."""
-    scene = wc.load_scene(None, {**SKY, "sky.directions": 8, "sky.sampling": "halves"})
+@pytest.mark.parametrize("model", ["uniform", "cie_clear"])
+def test_each_half_is_an_unbiased_estimate_of_the_sky(model):
+    """Every direction of either half is cosine-distributed, and a CIE sky's shares are over its
+    fixed mean radiance: over 4000 draws, each half's share-weighted sums (twice each half's, as it
+    stands for the whole sky) of 1, cos²θ, cos⁴θ, sinθ cosφ and sin²θ cos2φ average to the same sums
+    over 4096 fixed stratified directions within 4 standard errors (for the uniform sky the
+    cosine-weighted integrals 1, 1/2, 1/3, 0, 0, and each half's horizontal share is ½ exactly);
+    the halves differ draw to draw."""
+
+    def sums(d, shares):
+        h = shares * d[:, 2]  # horizontal shares
+        phi = np.arctan2(d[:, 1], d[:, 0])
+        sin_t = np.hypot(d[:, 0], d[:, 1])
+        f = np.stack([np.ones(len(d)), d[:, 2] ** 2, d[:, 2] ** 4, sin_t * np.cos(phi),
+                      sin_t**2 * np.cos(2 * phi)])
+        return (f * h).sum(axis=1)
+
+    sky = {"sky.model": model, "sky.diffuse_fraction": 0.3}
+    reference = sums(*wc.load_scene(None, {**sky, "sky.directions": 4096}).sky_directions())
+    if model == "uniform":
+        np.testing.assert_allclose(reference, [1.0, 0.5, 1.0 / 3.0, 0.0, 0.0], atol=1e-4)
+    scene = wc.load_scene(None, {**sky, "sky.directions": 8, "sky.sampling": "halves"})
     rng = np.random.default_rng(7)
     moments = {0: [], 1: []}
     for _ in range(4000):
         d, shares = scene.sky_directions(rng)
-        h = shares * d[:, 2]  # horizontal shares
-        phi = np.arctan2(d[:, 1], d[:, 0])
-        sin_t = np.hypot(d[:, 0], d[:, 1])
-        f = np.stack([d[:, 2] ** 2, d[:, 2] ** 4, sin_t * np.cos(phi), sin_t**2 * np.cos(2 * phi)])
         for half in (0, 1):
-            assert h[half::2].sum() == pytest.approx(0.5, rel=1e-12)
-            moments[half].append(2.0 * (f[:, half::2] * h[half::2]).sum(axis=1))
+            moments[half].append(2.0 * sums(d[half::2], shares[half::2]))
+            if model == "uniform":
+                assert (shares * d[:, 2])[half::2].sum() == pytest.approx(0.5, rel=1e-12)
     for half in (0, 1):
         m = np.array(moments[half])
         se = m.std(axis=0) / math.sqrt(len(m))
-        assert np.all(np.abs(m.mean(axis=0) - [0.5, 1.0 / 3.0, 0.0, 0.0]) < 4 * se + 1e-12)
+        assert np.all(np.abs(m.mean(axis=0) - reference) < 4 * se + 1e-6)
     first, second = scene.sky_directions(np.random.default_rng(1))[0], scene.sky_directions(rng)[0]
     assert not np.allclose(first, second)
 
@@ -91,7 +104,7 @@ def test_the_covariance_of_the_halves_takes_out_their_noise():
     """On fields made up here (float64): a direct part, a sky continuum and two halves, each (twice
     its map, as it stands for the whole sky) with independent noise of 4× the continuum's variance.
     The plain CV is 1.6× too high; the halves' covariance gives the CV of direct + continuum to 2 %;
-    with noiseless halves it is that CV exactly (1e-12); a half with no light gives None."""
+    with noiseless halves it is that CV exactly (1e-12)."""
     rng = np.random.default_rng(3)
     m = 512
     x = np.linspace(0, 2 * math.pi, m, endpoint=False)
@@ -104,22 +117,54 @@ def test_the_covariance_of_the_halves_takes_out_their_noise():
     cv_truth = truth.std() / truth.mean()
     total = direct + even + odd
     assert total.std() / total.mean() > 1.5 * cv_truth
-    assert continuous_sky_cv(total, even + odd, even) == pytest.approx(cv_truth, rel=0.02)
-    assert continuous_sky_cv(truth, continuum, 0.5 * continuum) == pytest.approx(cv_truth, rel=1e-12)
-    assert continuous_sky_cv(truth, continuum, np.zeros_like(continuum)) is None
+    assert continuous_sky_cv([continuous_sky_moments(total, even + odd, even)]) == pytest.approx(cv_truth,
+                                                                                                rel=0.02)
+    exact = continuous_sky_moments(truth, continuum, 0.5 * continuum)
+    assert continuous_sky_cv([exact]) == pytest.approx(cv_truth, rel=1e-12)
+    assert continuous_sky_cv([]) is None
+
+
+def test_pooled_over_frames_the_halves_noise_in_the_means_drops_out():
+    """Frames whose halves' means are off by independent noise (a few random directions misjudge
+    the sky's mean) and whose true means differ (the sea's largest scales): pooled over 400 frames
+    the covariance gives the pooled CV of direct + continuum to 3 %, while pooling each half's own
+    CV (or the map's) keeps the means' noise."""
+    rng = np.random.default_rng(5)
+    m = 64
+    x = np.linspace(0, 2 * math.pi, m, endpoint=False)
+    frames, truth, plain = [], [], []
+    for _ in range(400):
+        level = 1.0 + 0.1 * rng.standard_normal()  # the true mean moves from frame to frame
+        direct = level * (1.0 + 0.2 * np.sin(x + rng.uniform(0, 6))[:, None])
+        continuum = 3.0 * level * (1.0 + 0.05 * np.cos(2 * x)[None, :])
+        bias_even, bias_odd = 0.3 * rng.standard_normal(2)  # each half's error in the mean
+        even = 0.5 * continuum * (1.0 + bias_even) + 0.2 * rng.standard_normal((m, m))
+        odd = 0.5 * continuum * (1.0 + bias_odd) + 0.2 * rng.standard_normal((m, m))
+        frames.append(continuous_sky_moments(direct + even + odd, even + odd, even))
+        truth.append(direct + continuum)
+        plain.append(direct + even + odd)
+    truth, plain = np.array(truth), np.array(plain)
+    cv_truth = truth.std() / truth.mean()
+    assert plain.std() / plain.mean() > 1.3 * cv_truth
+    assert continuous_sky_cv(frames) == pytest.approx(cv_truth, rel=0.03)
 
 
 @pytest.mark.parametrize("scattering", ["single", "small_angle"])
 def test_a_sea_under_halves_reports_the_continuum_cv(scattering):
     """On a small FFT sea, with single and small-angle scattering: the halves' maps add up to the
-    sky's (its even half holds about half the sky, scattered light included), and the total, each
+    sky's (its even half holds about half the sky, scattered light included), the walk of the
+    small-angle mode lights from this frame's directions, and the total, each
     band and the sky alone report ``cv_continuous_sky``, the direct sun's part does not (it has no
     sky), nor does a stratified sky."""
     sea = {"water.model": "fft", "water.resolution": 32, "water.extent_m": 2.0, "water.depth_m": 50.0,
            "caustics.map_resolution": 32, "optics.wavelengths": [450.0, 550.0], "floor.depth_m": 1.5,
            "stats.per_band": True, "optics.scattering": scattering, **SKY}
     scene = wc.load_scene(None, {**sea, "sky.directions": 8, "sky.sampling": "halves"})
-    r = wc.render(scene, device="cpu")
+    renderer = wc.Renderer(scene, device="cpu")
+    r = renderer.render(0.0)
+    walk = renderer.method.multiple
+    if walk is not None:  # the walk that sets the scattered light's mean takes this frame's directions
+        np.testing.assert_allclose(walk.sky_dirs.numpy(), renderer.light.sky_directions, atol=1e-7)
     even, sky = r.sky_floor_irradiance_even, r.sky_floor_irradiance
     assert np.all(even.mean(axis=(1, 2)) > 0.25 * sky.mean(axis=(1, 2)))
     assert np.all((sky - even).mean(axis=(1, 2)) > 0.25 * sky.mean(axis=(1, 2)))
@@ -136,6 +181,7 @@ def test_a_sea_under_halves_reports_the_continuum_cv(scattering):
     ({"sky.directions": 7}, "even number of at least 2"),
     ({"caustics.method": "photons"}, 'caustics.method = "fluxratio"'),
     ({"optics.scattering": "multiple"}, '"single" or "small_angle"'),
+    ({"sky.model": "none", "sky.diffuse_fraction": 0.0}, "set sky.model"),
 ])
 def test_halves_errors_are_one_line(overrides, needle):
     with pytest.raises(ConfigError, match=needle):

@@ -134,7 +134,7 @@ class Renderer:
                 "make the floor deeper or the waves lower")
         with watch.stage("shading"):
             visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible)
-        if cfg.sky.sampling is SkySampling.HALVES:
+        if cfg.sky.sampling is SkySampling.HALVES and self.light.sky_directions is not None:
             self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
                       watch=watch)
@@ -160,7 +160,8 @@ class Renderer:
         return result(out)
 
 
-FINITE_FIELDS = ("floor", "transmitted", "camera_radiance", "sky_floor_irradiance", "face_flux_w_nm")
+FINITE_FIELDS = ("floor", "transmitted", "camera_radiance", "sky_floor_irradiance",
+                 "sky_floor_irradiance_even", "face_flux_w_nm")
 """What a frame must hold as finite numbers: its floor map, flux, camera image, sky map, face flux."""
 
 

@@ -124,7 +124,8 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
     band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``), after the
     collector. Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each
-    of these but the direct sun's also has ``cv_continuous_sky`` (:func:`continuous_sky_cv`)."""
+    of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`) and
+    the frame's ``cv_continuous_sky`` (:func:`continuous_sky_cv`)."""
     widths = result.bin_widths_nm
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
@@ -165,34 +166,46 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         stats = field_statistics(averaged, cfg.flash_threshold)
         if name in halves:
             sky_part, even_part = (collector(h) for h in halves[name])
-            stats["cv_continuous_sky"] = continuous_sky_cv(averaged, sky_part, even_part)
+            stats["continuous_sky"] = continuous_sky_moments(averaged, sky_part, even_part)
+            stats["cv_continuous_sky"] = continuous_sky_cv([stats["continuous_sky"]])
         group, _, band_name = name.rpartition("/")
         (out.setdefault(group, {}) if group else out)[band_name] = stats
     return out
 
 
-def continuous_sky_cv(total: np.ndarray, sky: np.ndarray, even: np.ndarray) -> float | None:
-    """The CV of ``total`` with the sky's part taken as its continuum (issue 32). A sky of D
-    directions adds D caustic patterns, whose sum fluctuates more than a real sky's continuum of
-    directions does (docs/validation.md: the excess falls with D). With ``sky.sampling = "halves"``
-    the directions are two independently drawn halves, each an unbiased estimate of the continuum:
-    A = direct + even·s̄/ē and B = direct + odd·s̄/ō (each half scaled to the sky's mean s̄). Their
-    errors are independent, so the covariance of A and B is, in expectation, the variance of the
-    direct light plus the continuum's, without the directions' own noise: CV = √max(Cov(A, B), 0) /
-    mean (a frame's covariance can come out below 0 by chance; pool many texels or frames).
-    ``total``, ``sky`` (its sky part) and ``even`` (the first half's part) are maps of one field;
-    None where a half holds no light."""
+def continuous_sky_moments(total: np.ndarray, sky: np.ndarray, even: np.ndarray) -> dict:
+    """What one frame gives towards the CV with the sky's part taken as its continuum (issue 32).
+    A sky of D directions adds D caustic patterns, whose sum fluctuates more than a real sky's
+    continuum of directions does (docs/validation.md: the excess falls with D). With
+    ``sky.sampling = "halves"`` the directions are two independently drawn halves, each (twice its
+    map) an unbiased estimate of the continuum: A = direct + 2·even, B = direct + 2·odd, whose
+    errors are independent given the surface. ``total``, ``sky`` (its sky part) and ``even`` (the
+    first half's part) are maps of one field. Returns the means of A and B and their covariance
+    over the texels (signed: pooled by :func:`continuous_sky_cv`)."""
     total, sky, even = (np.asarray(x, np.float64) for x in (total, sky, even))
-    odd = sky - even
-    s, e, o = sky.mean(), even.mean(), odd.mean()
-    mean = total.mean()
-    if e <= 0.0 or o <= 0.0 or mean <= 0.0:
-        return None
     direct = total - sky
-    a = direct + even * (s / e)
-    b = direct + odd * (s / o)
-    cov = float(np.mean((a - a.mean()) * (b - b.mean())))
-    return math.sqrt(max(cov, 0.0)) / float(mean)
+    a = direct + 2.0 * even
+    b = direct + 2.0 * (sky - even)
+    mean_a, mean_b = float(a.mean()), float(b.mean())
+    return {"mean_a": mean_a, "mean_b": mean_b, "cov": float(np.mean((a - mean_a) * (b - mean_b)))}
+
+
+def continuous_sky_cv(frames: list[dict]) -> float | None:
+    """The CV with the sky's continuum over one frame or several (each :func:`continuous_sky_moments`):
+    the halves' errors being independent, E[E_A E_B] = E[E²] of the continuum's field and
+    E[Ē_A] E[Ē_B] = Ē², so Var = mean(μ_A μ_B + Cov) − mean(μ_A)·mean(μ_B), and CV = √max(Var, 0)/Ē
+    with Ē = mean((μ_A + μ_B)/2) — free of the directions' own noise in expectation (a few frames or
+    a small map can come out below 0 by chance, hence the max). None without frames or light."""
+    if not frames:
+        return None
+    mean_a = np.array([f["mean_a"] for f in frames])
+    mean_b = np.array([f["mean_b"] for f in frames])
+    cov = np.array([f["cov"] for f in frames])
+    mean = float(np.mean(0.5 * (mean_a + mean_b)))
+    if mean <= 0.0:
+        return None
+    var = float(np.mean(mean_a * mean_b + cov) - mean_a.mean() * mean_b.mean())
+    return math.sqrt(max(var, 0.0)) / mean
 
 
 def band_index(

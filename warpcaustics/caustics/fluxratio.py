@@ -206,6 +206,8 @@ class FluxRatioStage(CausticStage):
             floor_np, walk = self.multiple.run(frame.surface, frame.visible)
             transmitted = np.asarray(walk["transmitted"])
         if self.light.sky_directions is not None:
+            if self.scene.config.sky.sampling is SkySampling.HALVES:  # this frame's directions
+                self.multiple.set_sky(self.light.sky_directions, np.stack(self.light.sky_irradiance_np))
             with watch.stage("sky"):
                 sky_np, walk["sky"] = self.multiple.run_sky(frame.surface, self.light.sky_visible)
             extra["sky_floor_irradiance"] = sky_np

@@ -81,10 +81,7 @@ class MultipleScattering:
                                        device=device)
         self.sky_dirs = self.sky_irradiance = None
         if sky_dirs is not None:
-            sky_dirs = np.asarray(sky_dirs, np.float32).reshape(-1, 3)
-            self.sky_dirs = wp.array(sky_dirs, dtype=wp.vec3, device=device)
-            self.sky_irradiance = wp.array(np.asarray(sky_irradiance, np.float32).reshape(len(sky_dirs), k),
-                                           dtype=wp.float32, device=device)
+            self.set_sky(sky_dirs, sky_irradiance)
         m = cfg.caustics.map_resolution
         side, centre = cfg.map_window  # a window, or the patch
 
@@ -117,6 +114,14 @@ class MultipleScattering:
         self.floor_albedo = arr(np.zeros(k) if floor_albedo is None else np.broadcast_to(floor_albedo, (k,)))
         self.texels = wp.zeros((m, m, k), dtype=wp.float32, device=device)
         self.tallies = wp.zeros((k, mc_kernels.TALLIES), dtype=wp.float64, device=device)
+
+    def set_sky(self, sky_dirs: np.ndarray, sky_irradiance: np.ndarray) -> None:
+        """The sky's directions (D, 3) and each one's irradiance (D, K) for :meth:`run_sky` (again
+        each frame with ``sky.sampling = "halves"``, whose directions are drawn anew)."""
+        sky_dirs = np.asarray(sky_dirs, np.float32).reshape(-1, 3)
+        self.sky_dirs = wp.array(sky_dirs, dtype=wp.vec3, device=self.device)
+        self.sky_irradiance = wp.array(np.asarray(sky_irradiance, np.float32).reshape(len(sky_dirs), -1),
+                                       dtype=wp.float32, device=self.device)
 
     def run(self, surface: Surface, visible: wp.array2d) -> tuple[np.ndarray, dict]:
         """The sun's walk: (K, M, M) floor irradiance [W m⁻² nm⁻¹] and the tallies per band; the

@@ -124,6 +124,9 @@ def _check_map_window(cfg: Config) -> None:
 def _check_sky(cfg: Config) -> None:
     sky = cfg.sky
     if sky.model is SkyModel.NONE:
+        if sky.sampling is SkySampling.HALVES:
+            raise ConfigError("sky.sampling = \"halves\" draws the sky's directions: set sky.model "
+                              "(e.g. \"uniform\") or sky.sampling = \"stratified\"")
         if sky.diffuse_fraction:
             raise ConfigError(f"sky.diffuse_fraction = {sky.diffuse_fraction:g} needs a sky; set "
                               "sky.model = \"uniform\" (or sky.diffuse_fraction = 0)")

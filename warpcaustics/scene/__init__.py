@@ -76,8 +76,11 @@ class Scene:
         With ``rng`` (``sky.sampling = "halves"``): two such patterns of K/2 directions, each with its
         own random offset u in its strata (sinθ = √((j + u)/(K/2))) and turn φ₀ about the zenith,
         interleaved (the even-numbered directions are the first). Every direction is then
-        cosine-distributed over the hemisphere, so each half is an unbiased estimate of the sky's
-        continuum, and the two halves' errors are independent."""
+        cosine-distributed over the hemisphere and, for a CIE sky, brings L_j / (K L̄) with L̄ the
+        sky's cosine-weighted mean radiance (rather than over the drawn directions' sum, which
+        would tie the halves), so each half is an unbiased estimate of the sky's continuum and the
+        two halves' errors are independent (their shares' horizontal parts sum to ½ each in
+        expectation; exactly for ``uniform``)."""
         sky = self.config.sky
         count = sky.directions
         if rng is None:
@@ -92,7 +95,13 @@ class Scene:
 
             sky_type = CIE_CLEAR_TYPE if sky.model is SkyModel.CIE_CLEAR else sky.cie_type
             radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
-            return d, radiance / (radiance.sum() * cos_t)
+            if rng is None:
+                return d, radiance / (radiance.sum() * cos_t)
+            # each half on its own: L_j over the sky's cosine-weighted mean radiance (a fixed
+            # 4096-direction stratified sum), so that neither half's shares depend on the other's
+            dense = _stratified_hemisphere(4096, 0.5, 0.0)
+            mean = float(cie_relative_radiance(sky_type, dense, self.sun_direction).mean())
+            return d, radiance / (count * mean * cos_t)
         return d, 1.0 / (count * cos_t)
 
     def sky_irradiance(self, sun_irradiance: np.ndarray) -> np.ndarray:

@@ -80,9 +80,13 @@ def pooled_statistics(
     return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0
 
 
-def continuous_sky(frames: list[tuple[float, float | None]]) -> float | None:
-    """The frames' (mean, ``cv_continuous_sky``) pooled, rounded (None: the sky was not drawn in
-    halves, ``sky.sampling``)."""
-    if any(cv is None for _, cv in frames):
+def continuous_sky(stats: list[dict]) -> float | None:
+    """The CV with the sky's continuum pooled over the frames' statistics of one field (None: the
+    sky was not drawn in halves, ``sky.sampling``)."""
+    from warpcaustics.batch.stats import continuous_sky_cv
+
+    moments = [s.get("continuous_sky") for s in stats]
+    if not moments or any(m is None for m in moments):
         return None
-    return round(pooled_statistics(frames)[1], 4)
+    cv = continuous_sky_cv(moments)
+    return None if cv is None else round(cv, 4)

@@ -136,7 +136,7 @@ def run_darecki2011(
         for j, nm in enumerate(rec.wavelengths_nm):
             band = [s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats]
             _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
-            continuum = continuous_sky([(b["mean"], b.get("cv_continuous_sky")) for b in band])
+            continuum = continuous_sky(band)
             measured = float(rec.cv[k, j])
             rows.append({
                 "depth_m": depth,

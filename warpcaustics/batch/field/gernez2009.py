@@ -233,10 +233,10 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     b = float(water_optics(config.optics, bins).scattering_per_m[band])
     rows = []
     for point, o in zip(points, overrides):
-        total, direct, sky, continuum = [], [], [], []
+        total, direct, sky, whole = [], [], [], []
         for s in frame_statistics_of(sweep, out, o):
             total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
-            continuum.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"].get("cv_continuous_sky")))
+            whole.append(s["irradiance_w_m2"])
             direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
             sky.append(s["sky_irradiance_w_m2"]["mean"])
         mean, cv = pooled_statistics(total)
@@ -264,7 +264,7 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
                 "model_cv_frame_sd": round(float(np.std(per_frame)), 4),
                 "model_cv_uniform_sky": round(cv_uniform_sky, 4),
                 "model_cv_uniform_sky_scattered": round(cv_scattered, 4),
-                "model_cv_continuous_sky": continuous_sky(continuum),
+                "model_cv_continuous_sky": continuous_sky(whole),
                 "direct_transmission": round(t, 4),
                 "frames": len(total),
                 "model_mean_w_m2": mean,
