@@ -134,7 +134,7 @@ class Renderer:
                 "make the floor deeper or the waves lower")
         with watch.stage("shading"):
             visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible)
-        if cfg.sky.sampling is SkySampling.HALVES and self.light.sky_directions is not None:
+        if cfg.sky.sampling is SkySampling.HALVES:  # the config check ensures a sky
             self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
                       watch=watch)

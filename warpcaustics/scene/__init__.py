@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -97,10 +98,9 @@ class Scene:
             radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
             if rng is None:
                 return d, radiance / (radiance.sum() * cos_t)
-            # each half on its own: L_j over the sky's cosine-weighted mean radiance (a fixed
-            # 4096-direction stratified sum), so that neither half's shares depend on the other's
-            dense = _stratified_hemisphere(4096, 0.5, 0.0)
-            mean = float(cie_relative_radiance(sky_type, dense, self.sun_direction).mean())
+            # each half on its own: L_j over the sky's cosine-weighted mean radiance, so that
+            # neither half's shares depend on the other's
+            mean = _cie_mean_radiance(sky_type, tuple(float(x) for x in self.sun_direction))
             return d, radiance / (count * mean * cos_t)
         return d, 1.0 / (count * cos_t)
 
@@ -184,3 +184,13 @@ def _stratified_hemisphere(count: int, offset: float, turn: float) -> np.ndarray
     cos_t = np.sqrt(1.0 - sin_t * sin_t)
     phi = turn + j * math.pi * (3.0 - math.sqrt(5.0))
     return np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
+
+
+@functools.lru_cache(maxsize=64)
+def _cie_mean_radiance(sky_type: int, sun_direction: tuple[float, float, float]) -> float:
+    """A CIE sky's cosine-weighted mean relative radiance over the hemisphere (4096 stratified
+    directions), computed once per sky and sun rather than every frame."""
+    from warpcaustics.optics.sky import cie_relative_radiance
+
+    dense = _stratified_hemisphere(4096, 0.5, 0.0)
+    return float(cie_relative_radiance(sky_type, dense, np.asarray(sun_direction)).mean())

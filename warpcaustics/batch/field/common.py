@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.batch.stats import continuous_sky_cv
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 
@@ -83,8 +84,6 @@ def pooled_statistics(
 def continuous_sky(stats: list[dict]) -> float | None:
     """The CV with the sky's continuum pooled over the frames' statistics of one field (None: the
     sky was not drawn in halves, ``sky.sampling``)."""
-    from warpcaustics.batch.stats import continuous_sky_cv
-
     moments = [s.get("continuous_sky") for s in stats]
     if not moments or any(m is None for m in moments):
         return None

@@ -233,12 +233,12 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     b = float(water_optics(config.optics, bins).scattering_per_m[band])
     rows = []
     for point, o in zip(points, overrides):
-        total, direct, sky, whole = [], [], [], []
+        whole, direct, sky = [], [], []
         for s in frame_statistics_of(sweep, out, o):
-            total.append((s["irradiance_w_m2"]["mean"], s["irradiance_w_m2"]["cv"]))
             whole.append(s["irradiance_w_m2"])
             direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
             sky.append(s["sky_irradiance_w_m2"]["mean"])
+        total = [(w["mean"], w["cv"]) for w in whole]
         mean, cv = pooled_statistics(total)
         per_frame = [c for _, c in total]
         # the sky as a uniform background: its K directions' own caustics removed
