@@ -56,3 +56,31 @@ def test_footprints_agree_with_beams_better_than_texels():
     # patches against the beams' triangles, not noise (it hardly falls from 4 to 16 per texel)
     for s in (2, 4):
         assert l1["footprint", s] < 0.5 * l1["texel", s], l1
+
+
+def test_footprints_on_a_sphere_agree_with_beams_better_than_texels():
+    """configs/ocean.toml (64² surface) with a sphere (radius 1 m, 7,936 faces, centre 2.5 m down),
+    no absorption: the flux on each of the sphere's faces from footprint photons, spread over the
+    faces their cells cover, is closer to the beams' (another method) than the photons' face
+    deposits at the same count — by more than 5× at 4 and 16 photons per cell — and the flux on
+    floor and sphere together is what entered the water (float32 sums: 1e-5)."""
+    centre = [0.0, 0.0, -2.5]
+    base = {"water.resolution": 64, "caustics.map_resolution": 32, "optics.wavelengths": "rgb",
+            "optics.water_type": "none",
+            "receivers": [{"mesh": "sphere", "scale": 2.0, "translate_m": centre}]}
+    beams = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**base, "caustics.method": "beams"}),
+                      device="cpu")
+    sphere = beams.face_receiver == 2
+    reference = beams.face_flux_w_nm[sphere]
+    l1 = {}
+    for splat in ("texel", "footprint"):
+        for s in (2, 4):
+            result = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {
+                **base, "caustics.method": "photons", "caustics.photon_splat": splat,
+                "caustics.photon_subdivisions": s}), device="cpu")
+            l1[splat, s] = relative_l1(reference, result.face_flux_w_nm[sphere])
+            total = result.floor_flux_w_nm + result.face_flux_w_nm.sum(axis=0)
+            np.testing.assert_allclose(total, result.transmitted_flux_w_nm, rtol=1e-5)
+    # measured 0.177 / 0.094 against 1.73 / 1.09 (a face holds ~1 photon at 4 per cell)
+    for s in (2, 4):
+        assert l1["footprint", s] < 0.2 * l1["texel", s], l1

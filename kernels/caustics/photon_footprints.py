@@ -12,13 +12,19 @@ plane, so still water gives the analytic irradiance in every texel at any photon
 light has small cells and stays sharp; spread light has large ones and is smooth. A photon without
 a cell (a silhouette, the edge of the lit region, a neighbour on another receiver) keeps the texel
 deposit.
+
+On the other receivers (``[[receivers]]`` meshes, a pool's walls) the "texels" are the faces: the
+cell is spread over the faces of the photon's receiver that it covers, each face's share its
+overlap with the cell in the cell's plane (the face projected along the cell's normal, clipped to
+the cell), the shares normalised to one so that the flux is kept exactly.
 """
 
 import warp as wp
 
 from warpcaustics.kernels.caustics.fluxratio import FloorMap, TriangleDeposit, spread_triangle, wrap_coord
-from warpcaustics.kernels.caustics.photon_lattice import photon_lattice
+from warpcaustics.kernels.caustics.photon_lattice import MIN_CELL_ALIGNMENT, photon_lattice
 from warpcaustics.kernels.caustics.photons import Photons
+from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
 
 wp.set_module_options({"enable_backward": False})
 
@@ -93,3 +99,133 @@ def add_footprints(
     splats' irradiance per horizontal area onto the relief's true area, as the texel deposit has it."""
     ty, tx, k = wp.tid()
     texels[ty, tx, k] = texels[ty, tx, k] + footprint[ty, tx, k] * texel_area_m2 * floor_inv_area[ty, tx]
+
+
+MIN_CELL_COVER = 0.5
+"""A receiver photon's cell must be at least this much covered by its receiver's faces (in the
+cell's plane); less (the cell hangs over a silhouette or a gap in the mesh): the face deposit."""
+MAX_CELL_FACES = 16
+"""Faces a receiver photon's cell keeps in registers between finding its cover and depositing; a
+cell over more faces searches them again to deposit."""
+vec_faces_i = wp.types.vector(length=MAX_CELL_FACES, dtype=wp.int32)
+vec_faces_f = wp.types.vector(length=MAX_CELL_FACES, dtype=wp.float32)
+CELL_REACH = 0.5
+"""The faces searched for a receiver photon's cell: those whose boxes meet the cell's box grown by
+this many of its longest sides (a curved receiver bends away from the cell's plane)."""
+
+
+@wp.func
+def face_in_cell(points: wp.array[wp.vec3], indices: wp.array[wp.int32], g: int, c: wp.vec3, a_axis: wp.vec3,
+                 b_axis: wp.vec3) -> float:
+    """Area of face g's overlap with the cell [−½, ½]² in the cell's coordinates (a, b) =
+    ((x − c)·a_axis, (x − c)·b_axis) (the face projected along the cell's normal), in cell areas."""
+    px = vec8()
+    py = vec8()
+    for j in range(3):
+        x = points[indices[3 * g + j]] - c
+        px[j] = wp.dot(x, a_axis)
+        py[j] = wp.dot(x, b_axis)
+    cx, cy, cn = clip_to_slab(px, py, 3, 0, -0.5, 0.5)
+    if cn < 3:
+        return 0.0
+    rx, ry, rn = clip_to_slab(cx, cy, cn, 1, -0.5, 0.5)
+    if rn < 3:
+        return 0.0
+    return polygon_area(rx, ry, rn)
+
+
+@wp.func
+def cell_axes(eu: wp.vec3, ev: wp.vec3, normal: wp.vec3):
+    """(a_axis, b_axis): x ↦ ((x − c)·a_axis, (x − c)·b_axis) are x's coordinates in the basis
+    (e_u, e_v) after projection along ``normal`` onto the cell's plane."""
+    a_axis = wp.cross(ev, normal)
+    b_axis = wp.cross(normal, eu)
+    return a_axis / wp.dot(eu, a_axis), b_axis / wp.dot(ev, b_axis)
+
+
+@wp.func
+def cell_cover(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.int32],
+               face_receiver: wp.array[wp.int32], face_normal: wp.array[wp.vec3], r: int, normal: wp.vec3,
+               c: wp.vec3, a_axis: wp.vec3, b_axis: wp.vec3, lo: wp.vec3, hi: wp.vec3):
+    """(covered, faces, overlaps, count): how much of the cell (in cell areas) receiver r's faces
+    that face along ``normal`` cover, and the first MAX_CELL_FACES of them with their overlaps
+    (``count`` > MAX_CELL_FACES: more overlap the cell than are kept)."""
+    total = float(0.0)
+    faces = vec_faces_i()
+    overlaps = vec_faces_f()
+    count = int(0)
+    query = wp.mesh_query_aabb(mesh, lo, hi)
+    g = int(0)
+    while wp.mesh_query_next(query, g):
+        if face_receiver[g] == r and wp.dot(face_normal[g], normal) >= MIN_CELL_ALIGNMENT:
+            a = face_in_cell(points, indices, g, c, a_axis, b_axis)
+            if a > 0.0:
+                total += a
+                if count < MAX_CELL_FACES:
+                    faces[count] = g
+                    overlaps[count] = a
+                count += 1
+    return total, faces, overlaps, count
+
+
+@wp.func
+def add_face_flux(face_flux: wp.array2d[wp.float32], row: int, w: float, ph: Photons, k0: int, ell: float):
+    """face_flux[row, k] += w E(k) e^{−c(k) ℓ} for the photon's bands."""
+    for j in range(ph.wavelengths_per_group):
+        k = k0 + j
+        wp.atomic_add(face_flux, row, k, w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell))
+
+
+@wp.kernel
+def splat_receiver_footprints(
+    ph: Photons,
+    mesh: wp.uint64,
+    points: wp.array[wp.vec3],
+    indices: wp.array[wp.int32],
+    face_receiver: wp.array[wp.int32],
+    face_normal: wp.array[wp.vec3],
+    spacing_m: float,
+    face_flux: wp.array2d[wp.float32],
+    splatted: wp.array[wp.int32],
+):
+    """Photon p on a receiver other than the floor with a lattice cell: its flux spread over the
+    receiver's faces that the cell covers (``face_flux`` (F_other, K) [W nm^-1]), each its overlap
+    / the cell's covered area; ``splatted[p]`` = 1. Runs after :func:`splat_footprints`, which
+    clears ``splatted``; photons it leaves keep the face deposit."""
+    p = wp.tid()
+    f = ph.face[p]
+    if f < ph.floor_face_count:  # the floor's, or no receiver
+        return
+    eu, ev, ok = photon_lattice(ph.hit, ph.face, face_receiver, face_normal, p, ph.quads, ph.subdivisions,
+                                ph.periodic, ph.extent_m, spacing_m)
+    if ok == 0:
+        return
+    normal = wp.normalize(wp.cross(eu, ev))
+    if wp.dot(normal, face_normal[f]) < 0.0:
+        normal = -normal
+    c = ph.hit[p]
+    corner = 0.5 * (wp.abs(eu) + wp.abs(ev))  # half the cell's box
+    reach = CELL_REACH * wp.max(wp.length(eu), wp.length(ev))
+    lo = c - corner - wp.vec3(reach)
+    hi = c + corner + wp.vec3(reach)
+    r = face_receiver[f]
+    a_axis, b_axis = cell_axes(eu, ev, normal)
+    covered, faces, overlaps, count = cell_cover(mesh, points, indices, face_receiver, face_normal, r, normal,
+                                                 c, a_axis, b_axis, lo, hi)
+    if covered < MIN_CELL_COVER:
+        return
+    ell = ph.path_before[p] + wp.length(c - ph.origin[p])
+    k0 = (p / ph.photons_per_group) * ph.wavelengths_per_group
+    w = ph.weight[p] / covered
+    if count <= MAX_CELL_FACES:
+        for i in range(count):
+            add_face_flux(face_flux, faces[i] - ph.floor_face_count, w * overlaps[i], ph, k0, ell)
+    else:
+        query = wp.mesh_query_aabb(mesh, lo, hi)
+        h = int(0)
+        while wp.mesh_query_next(query, h):
+            if face_receiver[h] == r and wp.dot(face_normal[h], normal) >= MIN_CELL_ALIGNMENT:
+                a = face_in_cell(points, indices, h, c, a_axis, b_axis)
+                if a > 0.0:
+                    add_face_flux(face_flux, h - ph.floor_face_count, w * a, ph, k0, ell)
+    splatted[p] = 1

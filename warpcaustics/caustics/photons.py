@@ -167,7 +167,8 @@ class PhotonCaustics(PassCaustics):
             cfg.caustics.newton_iterations if cfg.caustics.intersection is Intersection.NEWTON else -1
         )
         self.splatted = wp.zeros(count, dtype=wp.int32, device=device)
-        """1 where a photon was spread over its footprint on the floor map (``photon_splat``)."""
+        """1 where a photon was spread over its footprint (``photon_splat``): on the floor map, or
+        over the faces of another receiver."""
         self.footprint = None
         if cfg.caustics.photon_splat is PhotonSplat.FOOTPRINT:
             self._footprint_buffers(cfg, count, k, m)
@@ -285,6 +286,12 @@ class PhotonCaustics(PassCaustics):
                       inputs=[traced, self.receivers.face_receiver, self.receivers.face_normal,
                               self.spacing_m, self.floor_map],
                       outputs=[self.splat_flux, self.footprint, self.coarse_count, self.splatted], device=dev)
+            if self.receivers.face_count > self.receivers.floor_face_count:
+                mesh = self.receivers.mesh
+                wp.launch(footprint_kernels.splat_receiver_footprints, dim=self.weight.shape[0],
+                          inputs=[traced, mesh.id, mesh.points, mesh.indices, self.receivers.face_receiver,
+                                  self.receivers.face_normal, self.spacing_m],
+                          outputs=[self.face_flux, self.splatted], device=dev)
         wp.launch(
             photon_kernels.deposit_photons,
             dim=self.weight.shape[0],
