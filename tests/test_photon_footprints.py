@@ -1,5 +1,6 @@
-"""Photon footprint splats on the floor map (``caustics.photon_splat = "footprint"``): still water
-at any photon density, the flux kept, and closer to the exact beams than texel photons."""
+"""Photon footprint splats (``caustics.photon_splat = "footprint"``): still water at any photon
+density, the flux kept, the exact answer of a sinusoid's facets, and closer to the exact beams than
+texel photons on the floor and on a sphere."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ import pytest
 import warpcaustics as wc
 from warpcaustics.reference import relative_l1
 
-from helpers import CONFIGS, flat_floor_irradiance, flat_water_scene
+from helpers import CONFIGS, flat_floor_irradiance, flat_water_scene, fresnel_t_angles
 
 
 @pytest.mark.parametrize(("subdivisions", "map_m"), [(3, 50), (2, 97), (5, 64)])
@@ -84,3 +85,72 @@ def test_footprints_on_a_sphere_agree_with_beams_better_than_texels():
     # measured 0.177 / 0.094 against 1.73 / 1.09 (a face holds ~1 photon at 4 per cell)
     for s in (2, 4):
         assert l1["footprint", s] < 0.2 * l1["texel", s], l1
+
+
+def _facet_profile(heights, extent_m, depth_m, sun, m, ior=1.333, steps=4000):
+    """float64 reference: the texel averages (m texels over the period) of the floor irradiance
+    / E_sun under a periodic 1-D height profile as the photons' surface model has it: heights
+    straight between the samples (at cell centres), normals linear between the samples' unit
+    normals (central differences), each normalised. Each facet is cut into ``steps`` pieces whose
+    flux (E_sun (−h′, 0, 1)·s per unit length, times Fresnel's T at the piece's normal) is spread
+    evenly between the landing points of its ends (Snell's law in vector form)."""
+    n = len(heights)
+    dx = extent_m / n
+    x = (np.arange(n) + 0.5) * dx - extent_m / 2
+    h = np.asarray(heights, np.float64)
+    slope = (np.roll(h, -1) - np.roll(h, 1)) / (2 * dx)
+    normals = np.stack([-slope, np.zeros(n), np.ones(n)], axis=1)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    s = np.asarray(sun, np.float64) / np.linalg.norm(sun)
+    t = np.linspace(0.0, 1.0, steps + 1)
+    mid = 0.5 * (t[1:] + t[:-1])
+    eta = 1.0 / ior
+    lo, hi, flux = [], [], []
+    for i in range(n):
+        j = (i + 1) % n
+        normal = (1 - t)[:, None] * normals[i] + t[:, None] * normals[j]
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        cos_i = normal @ s
+        d = -eta * s + (eta * cos_i - np.sqrt(1 - eta**2 * (1 - cos_i**2)))[:, None] * normal
+        land = x[i] + t * dx + (h[i] + t * (h[j] - h[i]) + depth_m) * d[:, 0] / -d[:, 2]
+        normal = (1 - mid)[:, None] * normals[i] + mid[:, None] * normals[j]
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        transmitted = fresnel_t_angles(np.arccos(np.clip(normal @ s, -1.0, 1.0)), 1.0, ior)
+        flux.append(np.array([-(h[j] - h[i]) / dx, 0.0, 1.0]) @ s * transmitted * dx / steps)
+        lo.append(np.minimum(land[:-1], land[1:]))
+        hi.append(np.maximum(land[:-1], land[1:]))
+    lo, hi, flux = np.concatenate(lo), np.concatenate(hi), np.concatenate(flux)
+    shift = np.floor((lo + extent_m / 2) / extent_m) * extent_m  # each piece's start into the period
+    lo, hi = lo - shift, hi - shift
+    periods = int(np.ceil((hi.max() + extent_m / 2) / extent_m))
+    edges = -extent_m / 2 + np.arange(m * periods + 1) * extent_m / m
+    width = np.maximum(hi - lo, 1e-300)
+    below = np.array([np.sum(flux * np.clip((e - lo) / width, 0.0, 1.0)) for e in edges])
+    return np.diff(below).reshape(periods, m).sum(axis=0) / (extent_m / m)
+
+
+@pytest.mark.parametrize(("elevation_deg", "depth_m"), [(90.0, 1.0), (55.0, 3.0)])
+def test_a_sinusoid_matches_the_exact_answer_of_its_facets(tmp_path, elevation_deg, depth_m):
+    """Three periods of a 0.1 m sinusoid on 32 samples over 4 m (focal depth ~1.8 m), a point sun
+    overhead over a floor 1 m down (before the focus) and 55° high over one 3 m down (past it,
+    folds), no absorption, 64² map: the photons' floor profile against the float64 answer of the
+    same facets (:func:`_facet_profile`). Relative L1 within the photon method's stated error:
+    3 % at the default 4×4 per cell, 1.5 % at 8×8 (measured 0.44 % / 1.64 %, 0.10 % / 0.59 %), and
+    falling towards the reference with the count (16×16: 0.013 % / 0.21 %)."""
+    extent, n, m = 4.0, 32, 64
+    x = (np.arange(n) + 0.5) * extent / n - extent / 2
+    heights = (0.1 * np.sin(2 * np.pi * 3 * x / extent)).astype(np.float32)
+    np.save(tmp_path / "sinusoid.npy", np.tile(heights, (n, 1)))
+    base = {"water.model": "heightfield", "water.file": str(tmp_path / "sinusoid.npy"),
+            "water.extent_m": extent,
+            "sun.elevation_deg": elevation_deg, "sun.azimuth_deg": 0.0, "sun.angular_diameter_deg": 0.0,
+            "floor.depth_m": depth_m, "optics.water_type": "none", "optics.wavelengths.bins": 1,
+            "caustics.method": "photons", "caustics.map_resolution": m}
+    l1 = {}
+    for s in (4, 8, 16):
+        scene = wc.load_scene(None, {**base, "caustics.photon_subdivisions": s})
+        result = wc.render(scene, device="cpu")
+        reference = _facet_profile(heights, extent, depth_m, scene.sun_direction, m)
+        l1[s] = relative_l1(reference, result.floor_irradiance[0].mean(axis=0) / result.sun_irradiance[0])
+    assert l1[4] <= 0.03 and l1[8] <= 0.015, l1
+    assert l1[16] < 0.5 * l1[8], l1
