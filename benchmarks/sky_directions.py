@@ -10,7 +10,10 @@ zenith, pooled over ``--frames`` frames; with the CV of the sun's part alone (th
 background) beside it. Directions are enough where the CV stops changing. ``--quick``: 16 and 64
 directions, 3.2 m, one frame. ``--halves``: each count also with ``sky.sampling = "halves"``, whose
 two independently drawn halves give the CV with the sky's continuum (``cv_continuous_sky``), free of
-the directions' own noise, to compare with the stratified sky's CV as its directions grow.
+the directions' own noise, to compare with the stratified sky's CV as its directions grow — and the
+power spectrum of E/Ē − 1 in octave bands of spatial frequency, the stratified sky's own (its 256
+directions from one frame) and the continuum's from the halves' cross-power
+(``continuous_sky_spectrum``).
 """
 
 from __future__ import annotations
@@ -27,10 +30,17 @@ from benchmarks.field_budget import BEFORE  # the field set-up as these figures 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def measure(zeniths, depths, counts, frames: int, samplings=("stratified",)) -> list[dict]:
+def measure(zeniths, depths, counts, frames: int, samplings=("stratified",),
+            spectra: bool = False) -> list[dict]:
     import warpcaustics as wc
     from warpcaustics.batch.field import diffuse_fraction
-    from warpcaustics.batch.stats import collector_average, continuous_sky_cv, continuous_sky_moments
+    from warpcaustics.batch.stats import (
+        collector_average,
+        continuous_sky_cv,
+        continuous_sky_moments,
+        continuous_sky_spectrum,
+        cross_band_power,
+    )
 
     rows = []
     for zenith in zeniths:
@@ -45,18 +55,20 @@ def measure(zeniths, depths, counts, frames: int, samplings=("stratified",)) -> 
                 texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
                 collector = cfg.stats.collector_mm * 1e-3
                 renderer = wc.Renderer(scene, device="cpu")
-                total, sun, halves = [], [], []
+                window = cfg.caustics.map_extent_m
+                total, sun, halves, power = [], [], [], []
                 start = time.perf_counter()
                 for f in range(frames):
                     r = renderer.render(0.5 * f)
                     e = collector_average(r.floor_irradiance[0], texel, collector, periodic=False)
                     sky = collector_average(r.sky_floor_irradiance[0], texel, collector, periodic=False)
                     total.append(e)
+                    power.append(cross_band_power(e, e, window, periodic=False) / float(e.mean()) ** 2)
                     sun.append(e - sky + sky.mean())  # the sky as a uniform background
                     if r.sky_floor_irradiance_even is not None:  # the sky's continuum from its halves
                         even = collector_average(r.sky_floor_irradiance_even[0], texel, collector,
                                                  periodic=False)
-                        halves.append(continuous_sky_moments(e, sky, even))
+                        halves.append(continuous_sky_moments(e, sky, even, extent_m=window, periodic=False))
                 seconds = (time.perf_counter() - start) / frames
                 total, sun = np.array(total), np.array(sun)
                 row = {"sun_zenith_deg": zenith, "diffuse_share": share, "depth_m": depth,
@@ -66,10 +78,20 @@ def measure(zeniths, depths, counts, frames: int, samplings=("stratified",)) -> 
                 if halves:  # pooled over the frames
                     row["cv_continuous_sky"] = continuous_sky_cv(halves)
                     text = f", the sky's continuum from its halves {row['cv_continuous_sky']:.4f}"
+                row["relative_power"] = np.mean(power, axis=0).tolist()
+                if halves:
+                    row["continuous_sky_relative_power"] = continuous_sky_spectrum(halves)["relative_power"]
                 rows.append(row)
                 print(f"sun {zenith:4.0f}°  diffuse {share:.2f}  {depth:4.1f} m  {count:4d} directions, "
                       f"{sampling:10s}: CV {row['cv']:.4f}  (uniform sky {row['cv_uniform_sky']:.4f}{text})  "
                       f"{seconds:.0f} s/frame", flush=True)
+                if spectra:
+                    print(f"    power of E/E-1 per octave band from {1 / window:g} cycles/m: "
+                          + " ".join(f"{x:.2e}" for x in row["relative_power"]), flush=True)
+                    if halves:
+                        print("    the sky's continuum from its halves:              "
+                              + " ".join(f"{x:.2e}" for x in row["continuous_sky_relative_power"]),
+                              flush=True)
     return rows
 
 
@@ -78,13 +100,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="16 and 64 directions, 3.2 m, one frame")
     parser.add_argument("--frames", type=int, default=2)
     parser.add_argument("--halves", action="store_true",
-                        help="also each count with sky.sampling = 'halves' (the CV with the sky's continuum, "
-                             "issue 32), at an 85° sun, 3.2 m, 16 and 64 directions")
+                        help="also each count with sky.sampling = 'halves' (the CV and power spectrum "
+                             "with the sky's continuum, issue 32), at an 85° sun, 3.2 m, 16 and 64 "
+                             "directions, and 256 stratified directions for one frame")
     args = parser.parse_args(argv)
     if args.quick:
         measure((85.0,), (3.2,), (16, 64), 1)
     elif args.halves:
-        measure((85.0,), (3.2,), (16, 64), args.frames, ("stratified", "halves"))
+        measure((85.0,), (3.2,), (16, 64), args.frames, ("stratified", "halves"), spectra=True)
+        measure((85.0,), (3.2,), (256,), 1, spectra=True)
     else:
         measure((20.0, 85.0), (3.2, 9.0), (16, 64, 256), args.frames)
     return 0

@@ -1,6 +1,6 @@
 """sky.sampling = "halves" (issue 32 item 3): the sky's directions as two independently drawn
-halves, each an unbiased estimate of the sky's continuum, and the frame statistics' CV without the
-directions' own caustic noise (``cv_continuous_sky``)."""
+halves, each an unbiased estimate of the sky's continuum, and the frame statistics' CV and spatial
+power spectrum without the directions' own caustic noise (``cv_continuous_sky``, ``band_cov``)."""
 
 import math
 
@@ -9,7 +9,14 @@ import pytest
 from scipy import integrate
 
 import warpcaustics as wc
-from warpcaustics.batch.stats import continuous_sky_cv, continuous_sky_moments, frame_statistics
+from warpcaustics.batch.stats import (
+    continuous_sky_cv,
+    continuous_sky_moments,
+    continuous_sky_spectrum,
+    cross_band_power,
+    frame_statistics,
+    octave_band_edges,
+)
 from warpcaustics.errors import ConfigError
 
 from helpers import fresnel_t_angles
@@ -147,6 +154,77 @@ def test_pooled_over_frames_the_halves_noise_in_the_means_drops_out():
     cv_truth = truth.std() / truth.mean()
     assert plain.std() / plain.mean() > 1.3 * cv_truth
     assert continuous_sky_cv(frames) == pytest.approx(cv_truth, rel=0.03)
+
+
+def test_band_powers_add_up_to_the_variance_and_the_halves_give_the_continuums():
+    """Fields made up here (float64), 128² over 4 m: the octave bands run from 1/4 to 32 cycles per
+    m (the Nyquist corner, 22.6, inside the last); a map's band powers add up to its variance
+    (1e-12; a Hann-tapered window of white noise to 2 %); cosines of known amplitude α put α²/2 in
+    their own band (1e-12). Halves with independent white noise of 4× the field's variance each:
+    pooled over 64 frames the bands of their cross-power are the noiseless field's (within 4
+    standard errors of the frames' spread), while one half's own spectrum carries the noise."""
+    rng = np.random.default_rng(11)
+    m, extent = 128, 4.0
+    edges = octave_band_edges(m, extent)
+    np.testing.assert_allclose(edges, 2.0 ** np.arange(8) / extent)
+    x = (np.arange(m) + 0.5) * extent / m
+    modes = [(0.5, 0.3), (1.5, 0.2), (6.0, 0.1)]  # (cycles per m, amplitude): bands 1, 2 and 4
+    field = np.tile(2.0 + sum(a * np.cos(2 * math.pi * f * x) for f, a in modes), (m, 1))
+    expected = np.zeros(len(edges) - 1)
+    for f, a in modes:
+        expected[np.searchsorted(edges, f, side="right") - 1] += 0.5 * a**2
+    np.testing.assert_allclose(cross_band_power(field, field, extent, periodic=True), expected, atol=1e-12)
+    noise = rng.standard_normal((m, m))
+    for periodic, rel in ((True, 1e-12), (False, 0.02)):
+        total = cross_band_power(noise, noise, extent, periodic=periodic).sum()
+        assert total == pytest.approx(noise.var(), rel=rel)
+    sigma = 2.0 * field.std()
+    frames, own = [], []
+    for _ in range(64):
+        even = 0.5 * field + 0.5 * sigma * rng.standard_normal((m, m))
+        odd = 0.5 * field + 0.5 * sigma * rng.standard_normal((m, m))
+        frames.append(continuous_sky_moments(even + odd, even + odd, even, extent_m=extent))
+        own.append(cross_band_power(2 * even, 2 * even, extent, periodic=True))
+    bands = np.array([f["band_cov"] for f in frames])
+    se = bands.std(axis=0) / math.sqrt(len(bands))
+    assert np.all(np.abs(bands.mean(axis=0) - expected) < 4 * se + 1e-12), (bands.mean(axis=0), expected, se)
+    assert np.mean(own, axis=0)[-1] > 100 * se[-1]  # white noise: most of its power in the top band
+    pooled = continuous_sky_spectrum(frames)
+    level = np.mean([0.5 * (f["mean_a"] + f["mean_b"]) for f in frames])
+    np.testing.assert_allclose(pooled["relative_power"], bands.mean(axis=0) / level**2, rtol=1e-12)
+    assert continuous_sky_spectrum([]) is None
+
+
+def test_a_seas_continuum_spectrum_from_halves_is_the_many_directions_sky():
+    """A 32² FFT sea over 2 m, the sun 5° high with 85 % sky, 3 m deep, no absorption: the power
+    spectrum of E/Ē − 1 in octave bands (0.5 to 32 cycles per m) from the cross-power of 64
+    directions in halves, 16 draws 1 µs apart (the same sea to float32, new directions each), within
+    3 standard errors of the stratified sky extrapolated to a continuum — (4 P₁₀₂₄ − P₂₅₆)/3, its
+    excess falling as 1/D — in every band (measured within 1.5), where 16 stratified directions
+    carry 4–37× too much power (measured) and more than 5× in the three finest bands."""
+    sea = {"water.model": "fft", "water.resolution": 32, "water.extent_m": 2.0, "water.depth_m": 50.0,
+           "caustics.map_resolution": 32, "optics.wavelengths.bins": 1, "floor.depth_m": 3.0,
+           "sky.model": "uniform", "sky.diffuse_fraction": 0.85, "sun.elevation_deg": 5.0,
+           "optics.water_type": "none"}
+
+    def spectrum(directions):
+        scene = wc.load_scene(None, {**sea, "sky.directions": directions})
+        f = wc.render(scene, device="cpu").floor_irradiance[0]
+        return cross_band_power(f, f, 2.0, periodic=True) / float(np.mean(f, dtype=np.float64)) ** 2
+
+    continuum = (4.0 * spectrum(1024) - spectrum(256)) / 3.0
+    renderer = wc.Renderer(wc.load_scene(None, {**sea, "sky.directions": 64, "sky.sampling": "halves"}),
+                           device="cpu")
+    frames = []
+    for j in range(16):
+        r = renderer.render(j * 1e-6)
+        frames.append(continuous_sky_moments(r.floor_irradiance[0], r.sky_floor_irradiance[0],
+                                             r.sky_floor_irradiance_even[0], extent_m=2.0))
+    halves = continuous_sky_spectrum(frames)["relative_power"]
+    mean = np.mean([0.5 * (f["mean_a"] + f["mean_b"]) for f in frames])
+    se = np.std([f["band_cov"] for f in frames], axis=0) / mean**2 / math.sqrt(len(frames))
+    assert np.all(np.abs(halves - continuum) < 3 * se), (halves, continuum, se)
+    assert np.all(spectrum(16)[-3:] > 5 * continuum[-3:])
 
 
 @pytest.mark.parametrize("scattering", ["single", "small_angle"])

@@ -124,8 +124,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
     band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``), after the
     collector. Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each
-    of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`) and
-    the frame's ``cv_continuous_sky`` (:func:`continuous_sky_cv`)."""
+    of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
+    its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
+    (:func:`continuous_sky_cv`)."""
     widths = result.bin_widths_nm
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
@@ -166,14 +167,48 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         stats = field_statistics(averaged, cfg.flash_threshold)
         if name in halves:
             sky_part, even_part = (collector(h) for h in halves[name])
-            stats["continuous_sky"] = continuous_sky_moments(averaged, sky_part, even_part)
+            stats["continuous_sky"] = continuous_sky_moments(
+                averaged, sky_part, even_part, extent_m=result.map_extent_m, periodic=result.map_periodic)
             stats["cv_continuous_sky"] = continuous_sky_cv([stats["continuous_sky"]])
         group, _, band_name = name.rpartition("/")
         (out.setdefault(group, {}) if group else out)[band_name] = stats
     return out
 
 
-def continuous_sky_moments(total: np.ndarray, sky: np.ndarray, even: np.ndarray) -> dict:
+def octave_band_edges(m: int, extent_m: float) -> np.ndarray:
+    """Edges [cycles per m] of octave bands of spatial frequency for an M × M map over ``extent_m``:
+    from the map's fundamental 1/extent (the lowest non-zero frequency) doubling until the last band
+    holds the Nyquist limit's corner, √2 M/(2 extent)."""
+    top = math.sqrt(2.0) * m / (2.0 * extent_m)
+    count = max(int(math.ceil(math.log2(top * extent_m))), 1)
+    return np.exp2(np.arange(count + 1)) / extent_m
+
+
+def cross_band_power(a: np.ndarray, b: np.ndarray, extent_m: float, *, periodic: bool) -> np.ndarray:
+    """The cross-power Re(Â B̂*) of two (M, M) maps, their means taken out, summed over
+    :func:`octave_band_edges` and scaled so that the bands add up to the maps' covariance over the
+    texels (Parseval); ``a`` = ``b`` gives the power spectrum, which adds up to the variance. A map
+    that does not repeat (a window) is tapered by a Hann window first (its edges would otherwise
+    leak power into every band), the power rescaled by the taper's mean square."""
+    a = np.asarray(a, np.float64) - np.mean(a)
+    b = np.asarray(b, np.float64) - np.mean(b)
+    m = a.shape[-1]
+    scale = 1.0 / a.size**2
+    if not periodic:
+        hann = np.sin(np.pi * (np.arange(m) + 0.5) / m) ** 2
+        taper = np.outer(hann, hann)
+        a, b = a * taper, b * taper
+        scale /= float(np.mean(taper**2))
+    cross = (np.fft.fft2(a) * np.conj(np.fft.fft2(b))).real * scale
+    k = np.fft.fftfreq(m, d=extent_m / m)
+    radius = np.hypot(*np.meshgrid(k, k))
+    edges = octave_band_edges(m, extent_m)
+    band = np.minimum(np.digitize(radius, edges) - 1, len(edges) - 2)  # k = 0 falls below: −1
+    return np.bincount(band[band >= 0], weights=cross[band >= 0], minlength=len(edges) - 1)
+
+
+def continuous_sky_moments(total: np.ndarray, sky: np.ndarray, even: np.ndarray, *,
+                           extent_m: float | None = None, periodic: bool = True) -> dict:
     """What one frame gives towards the CV with the sky's part taken as its continuum (issue 32).
     A sky of D directions adds D caustic patterns, whose sum fluctuates more than a real sky's
     continuum of directions does (docs/validation.md: the excess falls with D). With
@@ -181,13 +216,37 @@ def continuous_sky_moments(total: np.ndarray, sky: np.ndarray, even: np.ndarray)
     map) an unbiased estimate of the continuum: A = direct + 2·even, B = direct + 2·odd, whose
     errors are independent given the surface. ``total``, ``sky`` (its sky part) and ``even`` (the
     first half's part) are maps of one field. Returns the means of A and B and their covariance
-    over the texels (signed: pooled by :func:`continuous_sky_cv`)."""
+    over the texels (signed: pooled by :func:`continuous_sky_cv`) and, given the map's
+    ``extent_m``, the covariance split over octave bands of spatial frequency (``band_cov``, at
+    ``band_edges_cycles_per_m``; :func:`cross_band_power`): E[Â B̂*] = |Ŝ|² of the field with the
+    continuum's sky, so the bands are its power spectrum free of the directions' noise (pooled by
+    :func:`continuous_sky_spectrum`)."""
     total, sky, even = (np.asarray(x, np.float64) for x in (total, sky, even))
     direct = total - sky
     a = direct + 2.0 * even
     b = direct + 2.0 * (sky - even)
     mean_a, mean_b = float(a.mean()), float(b.mean())
-    return {"mean_a": mean_a, "mean_b": mean_b, "cov": float(np.mean((a - mean_a) * (b - mean_b)))}
+    out = {"mean_a": mean_a, "mean_b": mean_b, "cov": float(np.mean((a - mean_a) * (b - mean_b)))}
+    if extent_m is not None:
+        out["band_edges_cycles_per_m"] = octave_band_edges(a.shape[-1], extent_m).tolist()
+        out["band_cov"] = cross_band_power(a, b, extent_m, periodic=periodic).tolist()
+    return out
+
+
+def continuous_sky_spectrum(frames: list[dict]) -> dict | None:
+    """The power spectrum of E/Ē − 1 with the sky's continuum in octave bands, pooled over frames
+    (each :func:`continuous_sky_moments` with ``band_cov``): the mean of the frames' band
+    cross-powers over Ē² (Ē as in :func:`continuous_sky_cv`). The bands add up to the within-frame
+    part of CV² (the frames' means moving adds the rest). A band can come out below 0 by chance
+    (its noise); it is reported as it is. None without frames, bands or light."""
+    frames = [f for f in frames if "band_cov" in f]
+    if not frames:
+        return None
+    mean = float(np.mean([0.5 * (f["mean_a"] + f["mean_b"]) for f in frames]))
+    if mean <= 0.0:
+        return None
+    power = np.mean([f["band_cov"] for f in frames], axis=0) / mean**2
+    return {"band_edges_cycles_per_m": frames[0]["band_edges_cycles_per_m"], "relative_power": power.tolist()}
 
 
 def continuous_sky_cv(frames: list[dict]) -> float | None:
