@@ -5,7 +5,10 @@ pass is timed) with its camera above the water, and again with the camera of
 ``configs/pool_pots.toml`` under it, at the same image size: the median time of a frame's camera
 stage (above: the rays to the water and below it, the beams' gather at the points the refracted
 rays meet, ``camera.shaft_samples`` midpoint samples of the in-scattering per ray; under: the
-G-buffer gather and the scan-plane shafts), after a warm-up frame, device synchronised.
+G-buffer gather and the scan-plane shafts), after a warm-up frame, device synchronised. Then the
+camera above the water without shafts, lit by the beams' gather and by the photons' maps
+(``caustics.method = "photons"``, which draws no shafts from above): the camera stages and the
+frames, whose ratio is what lighting the view from the photons' maps costs against the beams.
 ``python -m benchmarks.above_water --help``.
 """
 
@@ -25,7 +28,9 @@ def measure(n: int, size: tuple[int, int], samples: int, device: str, repeats: i
     import warpcaustics as wc
 
     times = {}
-    for where, extra in (("above", {}), ("under", UNDER)):
+    for where, extra in (("above", {}), ("under", UNDER),
+                         ("above_beams_no_shafts", {"caustics.shafts": False}),
+                         ("above_photons", {"caustics.shafts": False, "caustics.method": "photons"})):
         scene = point_sun_scene(ROOT / "configs" / "above_water.toml", {
             "water.resolution": n, "camera.width": size[0], "camera.height": size[1],
             "camera.shaft_samples": samples, "sky.model": "none", "sky.diffuse_fraction": 0.0,
@@ -42,7 +47,10 @@ def measure(n: int, size: tuple[int, int], samples: int, device: str, repeats: i
     return {"water_n": n, "camera_px": list(size), "shaft_samples": samples,
             "above_frame_s": times["above"], "under_frame_s": times["under"],
             "above_camera_s": times["above_camera"], "under_camera_s": times["under_camera"],
-            "camera_above_vs_under": times["above_camera"] / times["under_camera"]}
+            "camera_above_vs_under": times["above_camera"] / times["under_camera"],
+            **{f"{where}_{what}_s": times[where if what == "frame" else f"{where}_camera"]
+               for where in ("above_beams_no_shafts", "above_photons") for what in ("frame", "camera")},
+            "frame_photons_vs_beams_no_shafts": times["above_photons"] / times["above_beams_no_shafts"]}
 
 
 def run(quick: bool, device: str) -> dict:
@@ -63,6 +71,11 @@ def run(quick: bool, device: str) -> dict:
               f"{r['camera_above_vs_under']:5.2f}x | frames {r['above_frame_s']:.2f} s / "
               f"{r['under_frame_s']:.2f} s",
               flush=True)
+        photons, beams = r["above_photons_camera_s"], r["above_beams_no_shafts_camera_s"]
+        print(f"above_water  N={n:4d} {size[0]}x{size[1]} no shafts | camera above, photons "
+              f"{photons * 1e3:9.1f} ms | beams {beams * 1e3:9.1f} ms | frames "
+              f"{r['above_photons_frame_s']:.2f} s / {r['above_beams_no_shafts_frame_s']:.2f} s | "
+              f"ratio {r['frame_photons_vs_beams_no_shafts']:5.2f}x", flush=True)
     return {"benchmark": "above_water_camera", **record, "repeats": repeats,
             "timing": "median of the camera stage of a frame (RenderResult.timings_s['camera']) after a "
                       "warm-up "

@@ -124,9 +124,64 @@ def test_the_reflection_of_a_uniform_sky_is_r_e_over_pi():
     np.testing.assert_allclose(camera.surface_radiance, expected, rtol=1e-5)
 
 
+def test_photons_from_above_light_what_the_refracted_rays_meet_from_their_maps(tmp_path):
+    """Photons seen from above (no shafts). Still water, as the test above: the image is
+    (1 − R)/n² ρ/π E_floor e^{−c d} (float64, written here; measured 7e-7). A rough FFT sea with a
+    sphere in it: each pixel that looks into the water is (1 − R)/n² ρ/π E e^{−c d} with E the
+    pass's floor map bilinear between texel centres at the point the refracted ray meets (periodic)
+    or the sphere's face flux over its area — recomputed here in float64 from the result's maps and
+    G-buffer (float32: 1e-5); the sphere and the floor are both in view."""
+    scene = _scene(**{"caustics.method": "photons", "caustics.shafts": False})
+    result = wc.render(scene, device="cpu")
+    cfg = scene.config
+    optics = spectra.water_optics(cfg.optics, spectra.bins_for(cfg.optics))
+    c = optics.attenuation_per_m[:, None, None]
+    sun = scene.sun_direction
+    theta_s = math.acos(sun[2])
+    cos_ts = math.sqrt(1 - (math.sin(theta_s) / IOR) ** 2)
+    e_floor = (result.sun_irradiance[:, None, None] * math.cos(theta_s)
+               * fresnel_t_angles(np.array([theta_s]), 1.0, IOR)[0] * np.exp(-c * DEPTH_M / cos_ts))
+    v = _pixel_rays(cfg)
+    cos_v = -v[..., 2]
+    t_view = fresnel_t_angles(np.arccos(cos_v), 1.0, IOR)
+    d = DEPTH_M / np.sqrt(1 - (1 - cos_v**2) / IOR**2)
+    expected = t_view / IOR**2 * 0.5 / math.pi * e_floor * np.exp(-c * d)
+    np.testing.assert_allclose(result.camera_radiance, expected, rtol=2e-4)
+
+    rough = _scene(**{"caustics.method": "photons", "caustics.shafts": False, "water.model": "fft",
+                      "water.wind_speed_m_s": 6.0, "camera.width": 48, "camera.height": 32,
+                      "camera.position_m": [0.3, -3.0, 2.0], "camera.look_at_m": [0.0, 0.5, -DEPTH_M],
+                      "camera.fov_deg": 50.0,
+                      "receivers": [{"mesh": "sphere", "scale": 1.0, "translate_m": [0.0, 0.5, -1.5]}]})
+    renderer = wc.Renderer(rough, "cpu")
+    r = renderer.render(0.0)
+    g = r.camera_gbuffer
+    seen = renderer.method.camera.water_receiver.numpy() >= 0
+    floor_faces = renderer.method.receivers.floor_face_count
+    on_sphere = seen & (g["face"] >= floor_faces)
+    assert on_sphere.sum() > 20 and (seen & ~on_sphere).sum() > 200
+    m = r.floor_irradiance.shape[-1]
+    u = (g["position"][..., 0] / 8.0 + 0.5) * m - 0.5
+    w = (g["position"][..., 1] / 8.0 + 0.5) * m - 0.5
+    x0, y0 = np.floor(u).astype(int), np.floor(w).astype(int)
+    tu, tv = u - x0, w - y0
+    f = r.floor_irradiance.astype(np.float64)
+    at = lambda y, x: f[:, y % m, x % m]  # noqa: E731
+    e = ((1 - tv) * ((1 - tu) * at(y0, x0) + tu * at(y0, x0 + 1))
+         + tv * ((1 - tu) * at(y0 + 1, x0) + tu * at(y0 + 1, x0 + 1)))
+    face = np.clip(g["face"] - floor_faces, 0, None)
+    e_face = (r.face_flux_w_nm[face] / r.face_area_m2[face][..., None]).transpose(2, 0, 1)
+    e = np.where(on_sphere, e_face, e)
+    albedo = renderer.method.receivers.albedo[np.maximum(g["receiver"], 0)].transpose(2, 0, 1)
+    through = renderer.method.camera.through.numpy().astype(np.float64)
+    expected = np.where(seen, through * albedo / math.pi * e * np.exp(-c * g["depth"]), 0.0)
+    surface = renderer.method.camera.surface_radiance
+    np.testing.assert_allclose(r.camera_radiance - surface, expected, rtol=1e-5, atol=1e-7 * expected.max())
+
+
 def test_above_water_errors():
-    """The view from above needs beams, and the camera above every crest."""
-    with pytest.raises(ConfigError, match="camera.position_m"):
+    """The view from above needs beams or photons (without shafts), and the camera above every crest."""
+    with pytest.raises(ConfigError, match="caustics.shafts = false"):
         _scene(**{"caustics.method": "photons"})
     scene = _scene(**{"water.model": "fft", "water.wind_speed_m_s": 8.0,
                       "camera.position_m": [0.3, -1.0, 0.01],

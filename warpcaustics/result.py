@@ -101,7 +101,9 @@ class RenderResult:
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None
     """Per camera pixel: ``position`` (H, W, 3) [m], ``normal`` (H, W, 3), ``depth`` (H, W) [m] along
-    the ray (inf: no receiver), ``receiver`` (H, W) id (−1: none)."""
+    the ray (inf: no receiver), ``receiver`` (H, W) id (−1: none); above the water the ray is the
+    refracted one (or the camera's, where it misses the water) and ``face`` (H, W) is the receivers'
+    face it meets (the floor's first, then the others in ``face_area_m2``'s order; −1: none)."""
 
     def water_iops(self) -> dict:
         """The water's absorption ``a``, scattering ``b`` and beam attenuation ``c`` [1/m] used by

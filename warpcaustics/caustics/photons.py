@@ -326,7 +326,11 @@ class PhotonCaustics(PassCaustics):
         return ph
 
     def _render_camera(self, camera, shafts: bool) -> None:
-        """Splat this pass's photons into ``camera``'s image, each over its lattice cell."""
+        """Splat this pass's photons into ``camera``'s image, each over its lattice cell; a camera
+        above the water looks the points its refracted rays meet up in the pass's maps."""
+        if getattr(camera, "above_water", False):
+            camera.render_photons(self)
+            return
         spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         camera.render(self, spacing, shafts)
 

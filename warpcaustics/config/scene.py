@@ -71,7 +71,7 @@ class ReceiverConfig:
 class CameraConfig:
     enabled: bool = False
     """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``; above the water,
-    ``"beams"``)."""
+    photons draw no shafts, so they need ``caustics.shafts = false``)."""
     position_m: tuple[float, ...] = field(default=(0.0, -6.0, -1.0), metadata=_coordinate())
     """Pinhole position (x, y, z) [m]: below the water surface (z < 0), or above every crest (z > 0:
     the view from above the water, through the refracting surface)."""

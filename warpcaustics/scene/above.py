@@ -8,8 +8,9 @@ R(θ, λ) splits it: the reflected ray sees the sky (``sky.model``'s radiance) a
 what the refracted rays see from the beams (:meth:`render_beams`): the receiver's Lambertian
 radiance ``ρ E / π``, attenuated over the path, plus the single scattering into the ray along it,
 by midpoint samples of :func:`point_inscatter`; that radiance leaves the water multiplied by
-(1 − R)/n² (the radiance invariant L/n² across the surface). The reflection is added once, after
-the passes (:meth:`finish`). A ray that misses the water sees the sky, or a receiver in the air lit
+(1 − R)/n² (the radiance invariant L/n² across the surface). Photons light them through their
+maps instead (:meth:`render_photons`, no shafts). The reflection is added once, after the passes
+(:meth:`finish`). A ray that misses the water sees the sky, or a receiver in the air lit
 by the sun and the sky without shadows.
 """
 
@@ -89,6 +90,12 @@ class AboveWaterCamera:
         self.kind = wp.empty((h, w), dtype=wp.int32, device=device)
         self.depth = wp.empty((h, w), dtype=wp.float32, device=device)
         self.receiver = wp.empty((h, w), dtype=wp.int32, device=device)
+        self.face = wp.empty((h, w), dtype=wp.int32, device=device)
+        """The receivers' face each ray meets (−1: none)."""
+        other = receivers.face_area_m2[receivers.floor_face_count:]
+        self.face_area_m2 = wp.array(np.append(other, 1.0).astype(np.float32), dtype=wp.float32,
+                                     device=device)
+        """Area of each non-floor face [m²] (one more entry, so that the array is never empty)."""
         self.water_receiver = wp.empty((h, w), dtype=wp.int32, device=device)
         """The receiver each refracted ray meets; −1 where the pixel does not look into the water."""
         self.length = wp.empty((h, w), dtype=wp.float32, device=device)
@@ -169,7 +176,7 @@ class AboveWaterCamera:
         rec = self.receivers
         wp.launch(above_kernels.first_receiver, dim=(h, w),
                   inputs=[rec.mesh.id, rec.face_receiver, self.origin, self.direction],
-                  outputs=[self.position, self.normal, self.depth, self.receiver], device=dev)
+                  outputs=[self.position, self.normal, self.depth, self.receiver, self.face], device=dev)
         receiver = self.receiver.numpy()
         depth = self.depth.numpy().astype(np.float64)
         self.water_receiver.assign(np.where(wet, receiver, -1).astype(np.int32))
@@ -247,6 +254,28 @@ class AboveWaterCamera:
                   device=dev)
         return self.radiance
 
+    def render_photons(self, photons) -> wp.array3d:
+        """What the refracted rays see of ``photons``' pass, as it leaves the water: (K, H, W). The
+        photons light the points the refracted rays meet through their maps (the floor map
+        bilinear, a face's flux over its area); they draw no shafts here (the config refuses them:
+        a photon's shaft is splatted as an under-water pinhole sees its path)."""
+        dev = self.device
+        h, w = self.cfg.height, self.cfg.width
+        k = self.caustic.shape[0]
+        wp.launch(above_kernels.photon_point_irradiance, dim=(k, h, w),
+                  inputs=[self.water_receiver, self.position, self.face, self.receivers.floor_face_count,
+                          photons.irradiance, float(self.config.water.extent_m), int(photons.periodic),
+                          photons.face_flux, self.face_area_m2],
+                  outputs=[self.caustic], device=dev)
+        self.shafts.zero_()
+        wp.launch(camera_kernels.shade, dim=(k, h, w),
+                  inputs=[self.water_receiver, self.depth, self.caustic, self.shafts,
+                          self.receivers.albedo_wp, photons.attenuation_per_m],
+                  outputs=[self.radiance], device=dev)
+        wp.launch(above_kernels.scale_by, dim=(k, h, w), inputs=[self.through], outputs=[self.radiance],
+                  device=dev)
+        return self.radiance
+
     def finish(self, radiance: np.ndarray) -> np.ndarray:
         """The frame's image: the passes' ``radiance`` (K, H, W) plus the reflection and the dry rays."""
         return radiance + self.surface_radiance
@@ -258,5 +287,6 @@ class AboveWaterCamera:
             depth = self.depth.numpy().copy()
             depth[depth >= 1.0e29] = np.inf
             self._gbuffer = {"position": self.position.numpy().copy(), "normal": self.normal.numpy().copy(),
-                             "depth": depth, "receiver": self.receiver.numpy().copy()}
+                             "depth": depth, "receiver": self.receiver.numpy().copy(),
+                             "face": self.face.numpy().copy()}
         return self._gbuffer

@@ -121,10 +121,11 @@ def first_receiver(
     normal: wp.array2d[wp.vec3],
     depth: wp.array2d[wp.float32],
     receiver: wp.array2d[wp.int32],
+    face: wp.array2d[wp.int32],
 ):
     """The first receiver along each pixel's ray from ``origins`` along the unit ``directions``
     (below the surface: the refracted ray; in the air: the camera's): position, normal facing the
-    ray, distance and receiver id (−1 and depth 1e30 for none)."""
+    ray, distance, receiver id and face (−1 and depth 1e30 for none)."""
     j, i = wp.tid()
     o = origins[j, i]
     d = directions[j, i]
@@ -137,11 +138,13 @@ def first_receiver(
         normal[j, i] = n
         depth[j, i] = q.t
         receiver[j, i] = face_receiver[q.face]
+        face[j, i] = q.face
     else:
         position[j, i] = o + 1.0e5 * d
         normal[j, i] = -d
         depth[j, i] = 1.0e30
         receiver[j, i] = -1
+        face[j, i] = -1
 
 
 @wp.kernel
@@ -176,3 +179,54 @@ def scale_by(factor: wp.array3d[wp.float32], values: wp.array3d[wp.float32]):
     """values *= factor, element by element (the water's radiance leaving through the surface)."""
     k, j, i = wp.tid()
     values[k, j, i] = values[k, j, i] * factor[k, j, i]
+
+
+@wp.func
+def map_texel(coord: float, m: int, periodic: int) -> int:
+    """Texel index of a map coordinate [texels]: wrapped on a periodic sea, clamped in a pool."""
+    t = int(wp.floor(coord))
+    if periodic != 0:
+        return ((t % m) + m) % m
+    return wp.clamp(t, 0, m - 1)
+
+
+@wp.kernel
+def photon_point_irradiance(
+    water_receiver: wp.array2d[wp.int32],
+    position: wp.array2d[wp.vec3],
+    face: wp.array2d[wp.int32],
+    floor_face_count: int,
+    floor_irradiance: wp.array3d[wp.float32],
+    extent_m: float,
+    periodic: int,
+    face_flux: wp.array2d[wp.float32],
+    face_area_m2: wp.array[wp.float32],
+    caustic: wp.array3d[wp.float32],
+):
+    """Irradiance (K, H, W) from a photon pass where each refracted ray meets a receiver: on the
+    floor, the photons' floor map (K, M, M) bilinear between texel centres at the point's (x, y)
+    (over the patch ±extent/2; wrapped on a periodic sea, clamped at a pool's walls); on another
+    receiver, its face's flux over the face's area. 0 where the pixel sees no receiver in the water."""
+    k, j, i = wp.tid()
+    caustic[k, j, i] = 0.0
+    if water_receiver[j, i] < 0:
+        return
+    f = face[j, i]
+    if f >= floor_face_count:
+        caustic[k, j, i] = face_flux[f - floor_face_count, k] / face_area_m2[f - floor_face_count]
+        return
+    m = floor_irradiance.shape[1]
+    p = position[j, i]
+    u = (p[0] / extent_m + 0.5) * float(m) - 0.5
+    v = (p[1] / extent_m + 0.5) * float(m) - 0.5
+    tu = u - wp.floor(u)
+    tv = v - wp.floor(v)
+    x0 = map_texel(u, m, periodic)
+    x1 = map_texel(u + 1.0, m, periodic)
+    y0 = map_texel(v, m, periodic)
+    y1 = map_texel(v + 1.0, m, periodic)
+    a = floor_irradiance[k, y0, x0]
+    b = floor_irradiance[k, y0, x1]
+    c = floor_irradiance[k, y1, x0]
+    d = floor_irradiance[k, y1, x1]
+    caustic[k, j, i] = (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)
