@@ -45,9 +45,10 @@ def above_camera_bytes(cfg: Config, k: int, water_n: int) -> int:
     cam = cfg.camera
     pixels = cam.width * cam.height
     side = water_n + 1
-    # per pixel: 7 vec3 images, 5 scalar images, 4 (K, H, W) images, the samples' points, views,
+    # per pixel: 7 vec3 images, 6 scalar images, 4 (K, H, W) images, the samples' points, views,
     # distances and pieces; per surface vertex: its point and normal, two triangles' indices and BVH
-    return (pixels * (7 * 12 + 5 * 4 + 4 * 4 * k) + pixels * (2 * 12 + 2 * 4)
+    # (the meshes' face areas, 4 bytes a face, are left to the receivers' own estimate)
+    return (pixels * (7 * 12 + 6 * 4 + 4 * 4 * k) + pixels * (2 * 12 + 2 * 4)
             + side * side * (2 * 12 + 6 * 4 + 64))
 
 
