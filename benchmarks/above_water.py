@@ -6,9 +6,10 @@ pass is timed) with its camera above the water, and again with the camera of
 stage (above: the rays to the water and below it, the beams' gather at the points the refracted
 rays meet, ``camera.shaft_samples`` midpoint samples of the in-scattering per ray; under: the
 G-buffer gather and the scan-plane shafts), after a warm-up frame, device synchronised. Then the
-camera above the water without shafts, lit by the beams' gather and by the photons' maps
-(``caustics.method = "photons"``, which draws no shafts from above): the camera stages and the
-frames, whose ratio is what lighting the view from the photons' maps costs against the beams.
+camera above the water lit by the photons (``caustics.method = "photons"``: their maps, and their
+shafts from E⊥ on ``camera.shaft_samples`` horizontal slices of the water) against the beams, with
+shafts and without: the camera stages and the frames, whose ratio is what the photons cost
+against the beams for the same view.
 ``python -m benchmarks.above_water --help``.
 """
 
@@ -28,9 +29,10 @@ def measure(n: int, size: tuple[int, int], samples: int, device: str, repeats: i
     import warpcaustics as wc
 
     times = {}
-    for where, extra in (("above", {}), ("under", UNDER),
-                         ("above_beams_no_shafts", {"caustics.shafts": False}),
-                         ("above_photons", {"caustics.shafts": False, "caustics.method": "photons"})):
+    photons, no_shafts = {"caustics.method": "photons"}, {"caustics.shafts": False}
+    for where, extra in (("above", {}), ("under", UNDER), ("above_photons", photons),
+                         ("above_beams_no_shafts", no_shafts),
+                         ("above_photons_no_shafts", {**no_shafts, **photons})):
         scene = point_sun_scene(ROOT / "configs" / "above_water.toml", {
             "water.resolution": n, "camera.width": size[0], "camera.height": size[1],
             "camera.shaft_samples": samples, "sky.model": "none", "sky.diffuse_fraction": 0.0,
@@ -49,8 +51,11 @@ def measure(n: int, size: tuple[int, int], samples: int, device: str, repeats: i
             "above_camera_s": times["above_camera"], "under_camera_s": times["under_camera"],
             "camera_above_vs_under": times["above_camera"] / times["under_camera"],
             **{f"{where}_{what}_s": times[where if what == "frame" else f"{where}_camera"]
-               for where in ("above_beams_no_shafts", "above_photons") for what in ("frame", "camera")},
-            "frame_photons_vs_beams_no_shafts": times["above_photons"] / times["above_beams_no_shafts"]}
+               for where in ("above_photons", "above_beams_no_shafts", "above_photons_no_shafts")
+               for what in ("frame", "camera")},
+            "frame_photons_vs_beams": times["above_photons"] / times["above"],
+            "frame_photons_vs_beams_no_shafts":
+                times["above_photons_no_shafts"] / times["above_beams_no_shafts"]}
 
 
 def run(quick: bool, device: str) -> dict:
@@ -71,11 +76,15 @@ def run(quick: bool, device: str) -> dict:
               f"{r['camera_above_vs_under']:5.2f}x | frames {r['above_frame_s']:.2f} s / "
               f"{r['under_frame_s']:.2f} s",
               flush=True)
-        photons, beams = r["above_photons_camera_s"], r["above_beams_no_shafts_camera_s"]
-        print(f"above_water  N={n:4d} {size[0]}x{size[1]} no shafts | camera above, photons "
-              f"{photons * 1e3:9.1f} ms | beams {beams * 1e3:9.1f} ms | frames "
-              f"{r['above_photons_frame_s']:.2f} s / {r['above_beams_no_shafts_frame_s']:.2f} s | "
-              f"ratio {r['frame_photons_vs_beams_no_shafts']:5.2f}x", flush=True)
+        for tag, photons, beams, ratio in (
+                ("shafts", "above_photons", "above", "frame_photons_vs_beams"),
+                ("no shafts", "above_photons_no_shafts", "above_beams_no_shafts",
+                 "frame_photons_vs_beams_no_shafts")):
+            beams_camera = r[f"{beams}_camera_s"]
+            print(f"above_water  N={n:4d} {size[0]}x{size[1]} {tag:9s} | camera above, photons "
+                  f"{r[f'{photons}_camera_s'] * 1e3:9.1f} ms | beams {beams_camera * 1e3:9.1f} ms | frames "
+                  f"{r[f'{photons}_frame_s']:.2f} s / {r[f'{beams}_frame_s']:.2f} s | ratio {r[ratio]:5.2f}x",
+                  flush=True)
     return {"benchmark": "above_water_camera", **record, "repeats": repeats,
             "timing": "median of the camera stage of a frame (RenderResult.timings_s['camera']) after a "
                       "warm-up "

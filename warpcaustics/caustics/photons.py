@@ -15,6 +15,7 @@ from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, Re
 from warpcaustics.config import Config, Intersection, PhotonSplat
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photon_footprints as footprint_kernels
+from warpcaustics.kernels.caustics import photon_slices as slice_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
 from warpcaustics.optics.refraction import still_water_refraction
 from warpcaustics.scene.receivers import FIRST_MESH_ID, WALLS_ID
@@ -313,6 +314,31 @@ class PhotonCaustics(PassCaustics):
         )
         return self.irradiance
 
+    def slices(self, planes_z: np.ndarray, resolution: int) -> wp.array4d:
+        """(S, R, R, K) the pass's E⊥ [W m^-2 nm^-1] on the horizontal planes ``planes_z`` over the
+        patch (R² texels; wrapping on a periodic sea): where each photon's last segment crosses a
+        plane, spread over its lattice cell there (``kernels/caustics/photon_slices.py``)."""
+        dev = self.device
+        k = self.sun_irradiance.shape[0]
+        out = wp.zeros((len(planes_z), resolution, resolution, k), dtype=wp.float32, device=dev)
+        flux = getattr(self, "splat_flux", None)
+        if flux is None:
+            flux = self.splat_flux = wp.empty((self.weight.shape[0], 1, 1, k), dtype=wp.float32, device=dev)
+        extent = self.cfg.water.extent_m
+        sm = floor_kernels.FloorMap()
+        sm.origin = wp.vec2(-0.5 * extent, -0.5 * extent)
+        sm.centre = wp.vec2(0.0, 0.0)
+        sm.scale = resolution / extent
+        sm.wrap = int(self.periodic)
+        sm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS
+        coarse = wp.zeros(1, dtype=wp.int32, device=dev)
+        traced = self.traced()
+        spacing = extent / self.n / self.subdivisions
+        for s, z in enumerate(planes_z):
+            wp.launch(slice_kernels.splat_slice, dim=self.weight.shape[0],
+                      inputs=[traced, float(z), spacing, sm], outputs=[flux, out[s], coarse], device=dev)
+        return out
+
     def traced(self) -> photon_kernels.Photons:
         """The photons of the pass being traced as the deposit and the camera read them."""
         ph = photon_kernels.Photons()
@@ -327,9 +353,10 @@ class PhotonCaustics(PassCaustics):
 
     def _render_camera(self, camera, shafts: bool) -> None:
         """Splat this pass's photons into ``camera``'s image, each over its lattice cell; a camera
-        above the water looks the points its refracted rays meet up in the pass's maps."""
+        above the water looks the points its refracted rays meet up in the pass's maps, and its
+        shafts in the pass's slices of the water (:meth:`slices`)."""
         if getattr(camera, "above_water", False):
-            camera.render_photons(self)
+            camera.render_photons(self, shafts)
             return
         spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         camera.render(self, spacing, shafts)

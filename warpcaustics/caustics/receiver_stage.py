@@ -246,7 +246,7 @@ class ReceiverStage(CausticStage):
         above = getattr(self.camera, "above_water", False)
         if above:
             with watch.stage(camera_stage):
-                self.camera.begin_frame(frame.surface, frame.highest)
+                self.camera.begin_frame(frame.surface, frame.highest, frame.lowest)
         for direction, irradiance, from_sky in self.light.passes():
             if from_sky:
                 with watch.stage("sky"):

@@ -314,9 +314,3 @@ def _check_photon_scene(cfg: Config) -> None:
     if math.hypot(*cross) <= 1e-9 * math.hypot(*view) * max(math.hypot(*up), 1e-300):
         raise ConfigError(f"camera.up = {list(up)} is parallel to the view direction; choose another up")
     _check_bounces(cfg)
-    above = cam.enabled and cam.position_m[2] > 0.0  # the methods a camera takes: checked above
-    if above and cfg.caustics.method is CausticsMethod.PHOTONS and cfg.caustics.shafts:
-        raise ConfigError(f"camera.position_m z = {cam.position_m[2]:g} puts the camera above the water, "
-                          "where photons draw no light shafts (they are splatted along each photon's path "
-                          "as a camera under the water sees it): set caustics.shafts = false, or use "
-                          "caustics.method = \"beams\"")

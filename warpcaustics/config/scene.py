@@ -70,8 +70,7 @@ class ReceiverConfig:
 @dataclass(frozen=True)
 class CameraConfig:
     enabled: bool = False
-    """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``; above the water,
-    photons draw no shafts, so they need ``caustics.shafts = false``)."""
+    """Render a camera image (needs ``caustics.method = "photons"`` or ``"beams"``)."""
     position_m: tuple[float, ...] = field(default=(0.0, -6.0, -1.0), metadata=_coordinate())
     """Pinhole position (x, y, z) [m]: below the water surface (z < 0), or above every crest (z > 0:
     the view from above the water, through the refracting surface)."""
@@ -87,4 +86,5 @@ class CameraConfig:
     """Image height [pixels]."""
     shaft_samples: int = field(default=32, metadata=_range(1, 1024))
     """Above the water: midpoint samples of the single scattering along each refracted view ray,
-    from the surface to the receiver it meets [-]."""
+    from the surface to the receiver it meets, and with photons the horizontal slices of the water
+    their light is gathered on [-]."""

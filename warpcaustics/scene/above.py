@@ -9,9 +9,9 @@ what the refracted rays see from the beams (:meth:`render_beams`): the receiver'
 radiance ``ρ E / π``, attenuated over the path, plus the single scattering into the ray along it,
 by midpoint samples of :func:`point_inscatter`; that radiance leaves the water multiplied by
 (1 − R)/n² (the radiance invariant L/n² across the surface). Photons light them through their
-maps instead (:meth:`render_photons`, no shafts). The reflection is added once, after the passes
-(:meth:`finish`). A ray that misses the water sees the sky, or a receiver in the air lit
-by the sun and the sky without shadows.
+maps instead, and their shafts from E⊥ on horizontal slices of the water (:meth:`render_photons`).
+The reflection is added once, after the passes (:meth:`finish`). A ray that misses the water sees
+the sky, or a receiver in the air lit by the sun and the sky without shadows.
 """
 
 from __future__ import annotations
@@ -21,10 +21,11 @@ import math
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config, SkyModel
+from warpcaustics.config import CausticsMethod, Config, SkyModel
 from warpcaustics.kernels.scene import camera as camera_kernels
 from warpcaustics.kernels.scene.camera import above as above_kernels
 from warpcaustics.optics.phase import PhaseFunction
+from warpcaustics.optics.refraction import still_water_refraction
 from warpcaustics.reference.floor import fresnel_transmittance
 from warpcaustics.scene.camera import pinhole
 from warpcaustics.scene.receivers import Receivers
@@ -34,6 +35,14 @@ PERIODIC_IMAGES = 3
 
 ENTRY_OFFSET_M = 1.0e-4
 """The refracted ray starts this far below the surface point, off the surface's own triangles."""
+
+PHOTON_SLICE_TEXELS = 128
+"""The photons' slices of the water column (their shafts from above) have at most this many texels a
+side over the patch (the floor map's resolution if coarser): S × R² × K floats a pass."""
+
+SLICE_FLOOR_GAP = 1.0e-3
+"""The photons' last slice lies this share of the water column above the receivers' lowest point:
+photons that end on a floor there land on either side of it by float32 rounding."""
 
 OPEN_WATER_ATTENUATION_LENGTHS = 10.0
 """A refracted ray that meets no receiver is sampled over this many attenuation lengths of its
@@ -48,8 +57,11 @@ def above_camera_bytes(cfg: Config, k: int, water_n: int) -> int:
     # per pixel: 7 vec3 images, 6 scalar images, 4 (K, H, W) images, the samples' points, views,
     # distances and pieces; per surface vertex: its point and normal, two triangles' indices and BVH
     # (the meshes' face areas, 4 bytes a face, are left to the receivers' own estimate)
+    slices = 0  # photons' shafts: their E⊥ on camera.shaft_samples planes (render_photons)
+    if cfg.caustics.method is CausticsMethod.PHOTONS and cfg.caustics.shafts:
+        slices = cam.shaft_samples * min(cfg.caustics.map_resolution, PHOTON_SLICE_TEXELS) ** 2 * k * 4
     return (pixels * (7 * 12 + 6 * 4 + 4 * 4 * k) + pixels * (2 * 12 + 2 * 4)
-            + side * side * (2 * 12 + 6 * 4 + 64))
+            + side * side * (2 * 12 + 6 * 4 + 64) + slices)
 
 
 class AboveWaterCamera:
@@ -114,6 +126,7 @@ class AboveWaterCamera:
         """What the camera sees that the light passes do not give: the reflection, the sky, the
         receivers in the air (float64)."""
         self.top_z = 0.0
+        self.lowest_z = 0.0
         self._mesh = None
         self._gbuffer: dict[str, np.ndarray] | None = None
 
@@ -144,13 +157,14 @@ class AboveWaterCamera:
             self._mesh.refit()
         return self._mesh
 
-    def begin_frame(self, surface, highest_m: float) -> None:
+    def begin_frame(self, surface, highest_m: float, lowest_m: float = 0.0) -> None:
         """Trace the pixel rays to the water and below it for ``surface``; shade what the light
         passes do not (the reflection, the sky, the receivers in the air)."""
         dev = self.device
         h, w = self.cfg.height, self.cfg.width
         mesh = self._water_mesh(surface)
         self.top_z = float(highest_m)
+        self.lowest_z = float(lowest_m)
         wp.launch(above_kernels.surface_hits, dim=(h, w),
                   inputs=[self.cam, mesh.id, self._points, self._point_normals, self._indices,
                           float(surface.extent_m), int(surface.periodic),
@@ -255,11 +269,11 @@ class AboveWaterCamera:
                   device=dev)
         return self.radiance
 
-    def render_photons(self, photons) -> wp.array3d:
+    def render_photons(self, photons, shafts: bool) -> wp.array3d:
         """What the refracted rays see of ``photons``' pass, as it leaves the water: (K, H, W). The
         photons light the points the refracted rays meet through their maps (the floor map
-        bilinear, a face's flux over its area); they draw no shafts here (the config refuses them:
-        a photon's shaft is splatted as an under-water pinhole sees its path)."""
+        bilinear, a face's flux over its area), and the light scattered into the rays from their
+        E⊥ on horizontal slices of the water (:meth:`_photon_shafts`)."""
         dev = self.device
         h, w = self.cfg.height, self.cfg.width
         k = self.caustic.shape[0]
@@ -269,6 +283,8 @@ class AboveWaterCamera:
                           photons.face_flux, self.face_area_m2],
                   outputs=[self.caustic], device=dev)
         self.shafts.zero_()
+        if shafts:
+            self._photon_shafts(photons)
         wp.launch(camera_kernels.shade, dim=(k, h, w),
                   inputs=[self.water_receiver, self.depth, self.caustic, self.shafts,
                           self.receivers.albedo_wp, photons.attenuation_per_m],
@@ -276,6 +292,37 @@ class AboveWaterCamera:
         wp.launch(above_kernels.scale_by, dim=(k, h, w), inputs=[self.through], outputs=[self.radiance],
                   device=dev)
         return self.radiance
+
+    def _photon_shafts(self, photons) -> None:
+        """The single scattering into the refracted rays from a photon pass: its E⊥ on
+        ``camera.shaft_samples`` horizontal planes from the lowest trough down to just above the
+        receivers' lowest point (``PhotonCaustics.slices``, at most :data:`PHOTON_SLICE_TEXELS`² texels over
+        the patch), sampled at the rays' midpoints (linear between planes), with the phase
+        function at the pass's direction refracted by still water."""
+        dev = self.device
+        h, w = self.cfg.height, self.cfg.width
+        k = self.caustic.shape[0]
+        pixels = h * w
+        count = self.samples
+        top = min(self.lowest_z, 0.0)
+        lowest = float(self.receivers.points[:, 2].min())
+        bottom = lowest + SLICE_FLOOR_GAP * (top - lowest)  # photons end on the floor, rounded either way
+        step = (top - bottom) / max(count - 1, 1)
+        planes = top - step * np.arange(count)
+        resolution = min(self.config.caustics.map_resolution, PHOTON_SLICE_TEXELS)
+        slices = photons.slices(planes, resolution)
+        light = still_water_refraction(np.asarray(photons.light_dir, np.float64), self.ray_ior)
+        ph = self.phase
+        for n in range(self.samples):
+            wp.launch(above_kernels.segment_samples, dim=(h, w),
+                      inputs=[self.origin, self.direction, self.length, self.samples, n],
+                      outputs=[self.points, self.views, self.along, self.piece], device=dev)
+            wp.launch(above_kernels.slice_inscatter, dim=(pixels, k),
+                      inputs=[slices, float(top), float(step), float(self.config.water.extent_m),
+                              int(photons.periodic), wp.vec3(*light.astype(np.float32)), ph.kind, ph.g,
+                              ph.angles_rad, ph.log_phase, ph.cone_phase, self.scattering_per_m,
+                              photons.attenuation_per_m, self.points, self.views, self.along, self.piece],
+                      outputs=[self.shafts.reshape((k, pixels))], device=dev)
 
     def finish(self, radiance: np.ndarray) -> np.ndarray:
         """The frame's image: the passes' ``radiance`` (K, H, W) plus the reflection and the dry rays."""

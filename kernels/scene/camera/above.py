@@ -11,6 +11,7 @@ ratio's vertex normals)."""
 
 import warp as wp
 
+from warpcaustics.kernels.optics.phase import phase_value
 from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera, pixel_ray
 
 wp.set_module_options({"enable_backward": False})
@@ -230,3 +231,64 @@ def photon_point_irradiance(
     c = floor_irradiance[k, y1, x0]
     d = floor_irradiance[k, y1, x1]
     caustic[k, j, i] = (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)
+
+
+@wp.func
+def map_bilinear(maps: wp.array4d[wp.float32], s: int, x: wp.vec3, k: int, extent_m: float,
+                 periodic: int) -> float:
+    """Map s of ``maps`` (S, M, M, K) in band k, bilinear between texel centres at x's (x, y) over
+    the patch ±extent/2 (wrapped on a periodic sea, clamped in a pool)."""
+    m = maps.shape[1]
+    u = (x[0] / extent_m + 0.5) * float(m) - 0.5
+    v = (x[1] / extent_m + 0.5) * float(m) - 0.5
+    tu = u - wp.floor(u)
+    tv = v - wp.floor(v)
+    x0 = map_texel(u, m, periodic)
+    x1 = map_texel(u + 1.0, m, periodic)
+    y0 = map_texel(v, m, periodic)
+    y1 = map_texel(v + 1.0, m, periodic)
+    return (1.0 - tv) * ((1.0 - tu) * maps[s, y0, x0, k] + tu * maps[s, y0, x1, k]) + tv * (
+        (1.0 - tu) * maps[s, y1, x0, k] + tu * maps[s, y1, x1, k])
+
+
+@wp.kernel
+def slice_inscatter(
+    slices: wp.array4d[wp.float32],
+    top_z: float,
+    step_z: float,
+    extent_m: float,
+    periodic: int,
+    light_dir: wp.vec3,
+    phase_kind: int,
+    hg_g: float,
+    angles_rad: wp.array[wp.float32],
+    log_phase: wp.array[wp.float32],
+    cone_phase: float,
+    scattering_per_m: wp.array[wp.float32],
+    attenuation_per_m: wp.array[wp.float32],
+    points: wp.array[wp.vec3],
+    views: wp.array[wp.vec3],
+    along_m: wp.array[wp.float32],
+    piece_m: wp.array[wp.float32],
+    radiance: wp.array2d[wp.float32],
+):
+    """One midpoint piece of each refracted view ray's in-scattering from the photons' slices
+    (S, M, M, K) of E⊥ (already attenuated along the light's path), plane s at z = top_z − s step_z:
+    ``piece σ_s p(cos θ) E⊥(x) e^{−c s}``, E⊥ bilinear in (x, y) and linear in z between planes
+    (held at the first and last), cos θ = −light_dir·view with ``light_dir`` the pass's refracted
+    direction under still water, added to ``radiance`` (K, P)."""
+    p, k = wp.tid()
+    piece = piece_m[p]
+    if piece <= 0.0:
+        return
+    x = points[p]
+    count = slices.shape[0]
+    f = wp.clamp((top_z - x[2]) / step_z, 0.0, float(count - 1))
+    s0 = wp.min(int(f), count - 1)
+    s1 = wp.min(s0 + 1, count - 1)
+    t = f - float(s0)
+    e = (1.0 - t) * map_bilinear(slices, s0, x, k, extent_m, periodic) + t * map_bilinear(
+        slices, s1, x, k, extent_m, periodic)
+    phase = phase_value(phase_kind, hg_g, angles_rad, log_phase, cone_phase, -wp.dot(light_dir, views[p]))
+    radiance[k, p] = radiance[k, p] + piece * scattering_per_m[k] * phase * e * wp.exp(
+        -attenuation_per_m[k] * along_m[p])
