@@ -29,6 +29,22 @@ from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
 wp.set_module_options({"enable_backward": False})
 
 
+@wp.func
+def photon_deposit(texels: wp.array3d[wp.float32], flux: wp.array4d[wp.float32], k0: int, bands: int,
+                   p: int) -> TriangleDeposit:
+    """The flux-ratio map's deposit record for photon p: its flux ``flux[p, 0, 0, k]`` in bands k0 …
+    k0 + bands − 1 into ``texels`` (M, M, K)."""
+    dep = TriangleDeposit()
+    dep.floor_texels = texels
+    dep.flux_w_nm = flux
+    dep.k_begin = k0
+    dep.k_count = bands
+    dep.iy = p
+    dep.ix = 0
+    dep.half = 0
+    return dep
+
+
 @wp.kernel
 def splat_footprints(
     ph: Photons,
@@ -62,14 +78,7 @@ def splat_footprints(
     for j in range(ph.wavelengths_per_group):
         k = k0 + j
         flux[p, 0, 0, k] = 0.5 * ph.weight[p] * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
-    dep = TriangleDeposit()
-    dep.floor_texels = texels
-    dep.flux_w_nm = flux
-    dep.k_begin = k0
-    dep.k_count = ph.wavelengths_per_group
-    dep.iy = p
-    dep.ix = 0
-    dep.half = 0
+    dep = photon_deposit(texels, flux, k0, ph.wavelengths_per_group, p)
     m = texels.shape[0]
     scale = floor_map.scale
     u = wp.vec2(eu[0], eu[1]) * scale

@@ -15,13 +15,8 @@ slice_inscatter``).
 
 import warp as wp
 
-from warpcaustics.kernels.caustics.fluxratio import (
-    FloorMap,
-    TriangleDeposit,
-    spread_triangle,
-    texel_of,
-    wrap_coord,
-)
+from warpcaustics.kernels.caustics.fluxratio import FloorMap, spread_triangle, texel_of, wrap_coord
+from warpcaustics.kernels.caustics.photon_footprints import photon_deposit
 from warpcaustics.kernels.caustics.photon_lattice import MAX_CELL_SPACINGS, grid_neighbour, unwrap
 from warpcaustics.kernels.caustics.photons import Photons
 
@@ -113,13 +108,6 @@ def splat_slice(
                 k = k0 + j
                 wp.atomic_add(texels, ty, tx, k, 2.0 * flux[p, 0, 0, k] * inv_texel_area)
         return
-    dep = TriangleDeposit()
-    dep.floor_texels = texels
-    dep.flux_w_nm = flux
-    dep.k_begin = k0
-    dep.k_count = ph.wavelengths_per_group
-    dep.iy = p
-    dep.ix = 0
-    dep.half = 0
+    dep = photon_deposit(texels, flux, k0, ph.wavelengths_per_group, p)
     spread_triangle(dep, q0, u, u + v, m, slice_map.wrap, slice_map.max_clipped, inv_texel_area, coarse_count)
     spread_triangle(dep, q0, u + v, v, m, slice_map.wrap, slice_map.max_clipped, inv_texel_area, coarse_count)

@@ -190,15 +190,20 @@ class PhotonCaustics(PassCaustics):
         self.footprint = wp.empty((m, m, k), dtype=wp.float32, device=dev)
         self.splat_flux = wp.empty((count, 1, 1, k), dtype=wp.float32, device=dev)
         self.coarse_count = wp.zeros(1, dtype=wp.int32, device=dev)
-        extent = cfg.water.extent_m
+        self.floor_map = self._patch_map(m)
+        self.spacing_m = cfg.water.extent_m / self.n / self.subdivisions
+
+    def _patch_map(self, resolution: int) -> floor_kernels.FloorMap:
+        """The frame of a map of ``resolution``² texels over the whole patch (wrapping on a periodic
+        sea)."""
+        extent = self.cfg.water.extent_m
         fm = floor_kernels.FloorMap()
         fm.origin = wp.vec2(-0.5 * extent, -0.5 * extent)
         fm.centre = wp.vec2(0.0, 0.0)
-        fm.scale = m / extent
+        fm.scale = resolution / extent
         fm.wrap = int(self.periodic)
         fm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS
-        self.floor_map = fm
-        self.spacing_m = extent / self.n / self.subdivisions
+        return fm
 
     def _light_view(self, view_dir: np.ndarray, resolution: int) -> photon_kernels.LightView:
         # The view needs the receivers where photons land: on a periodic sea that is the patch
@@ -324,19 +329,13 @@ class PhotonCaustics(PassCaustics):
         flux = getattr(self, "splat_flux", None)
         if flux is None:
             flux = self.splat_flux = wp.empty((self.weight.shape[0], 1, 1, k), dtype=wp.float32, device=dev)
-        extent = self.cfg.water.extent_m
-        sm = floor_kernels.FloorMap()
-        sm.origin = wp.vec2(-0.5 * extent, -0.5 * extent)
-        sm.centre = wp.vec2(0.0, 0.0)
-        sm.scale = resolution / extent
-        sm.wrap = int(self.periodic)
-        sm.max_clipped = floor_kernels.MAX_CLIPPED_TEXELS
+        frame = self._patch_map(resolution)
         coarse = wp.zeros(1, dtype=wp.int32, device=dev)
         traced = self.traced()
-        spacing = extent / self.n / self.subdivisions
+        spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         for s, z in enumerate(planes_z):
             wp.launch(slice_kernels.splat_slice, dim=self.weight.shape[0],
-                      inputs=[traced, float(z), spacing, sm], outputs=[flux, out[s], coarse], device=dev)
+                      inputs=[traced, float(z), spacing, frame], outputs=[flux, out[s], coarse], device=dev)
         return out
 
     def traced(self) -> photon_kernels.Photons:

@@ -11,6 +11,7 @@ ratio's vertex normals)."""
 
 import warp as wp
 
+from warpcaustics.kernels.geometry import bilerp
 from warpcaustics.kernels.optics.phase import phase_value
 from warpcaustics.kernels.scene.camera.pinhole import PinholeCamera, pixel_ray
 
@@ -191,6 +192,17 @@ def map_texel(coord: float, m: int, periodic: int) -> int:
     return wp.clamp(t, 0, m - 1)
 
 
+@wp.func
+def map_cell(x: wp.vec3, m: int, extent_m: float, periodic: int):
+    """(x0, x1, y0, y1, tu, tv): the four texels of an M × M map over the patch ±extent/2 around
+    x's (x, y), between texel centres, and the bilinear weights (wrapped on a periodic sea, clamped
+    in a pool)."""
+    u = (x[0] / extent_m + 0.5) * float(m) - 0.5
+    v = (x[1] / extent_m + 0.5) * float(m) - 0.5
+    return (map_texel(u, m, periodic), map_texel(u + 1.0, m, periodic), map_texel(v, m, periodic),
+            map_texel(v + 1.0, m, periodic), u - wp.floor(u), v - wp.floor(v))
+
+
 @wp.kernel
 def photon_point_irradiance(
     water_receiver: wp.array2d[wp.int32],
@@ -216,39 +228,17 @@ def photon_point_irradiance(
     if f >= floor_face_count:
         caustic[k, j, i] = face_flux[f - floor_face_count, k] / face_area_m2[f - floor_face_count]
         return
-    m = floor_irradiance.shape[1]
-    p = position[j, i]
-    u = (p[0] / extent_m + 0.5) * float(m) - 0.5
-    v = (p[1] / extent_m + 0.5) * float(m) - 0.5
-    tu = u - wp.floor(u)
-    tv = v - wp.floor(v)
-    x0 = map_texel(u, m, periodic)
-    x1 = map_texel(u + 1.0, m, periodic)
-    y0 = map_texel(v, m, periodic)
-    y1 = map_texel(v + 1.0, m, periodic)
-    a = floor_irradiance[k, y0, x0]
-    b = floor_irradiance[k, y0, x1]
-    c = floor_irradiance[k, y1, x0]
-    d = floor_irradiance[k, y1, x1]
-    caustic[k, j, i] = (1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d)
+    x0, x1, y0, y1, tu, tv = map_cell(position[j, i], floor_irradiance.shape[1], extent_m, periodic)
+    e = floor_irradiance
+    caustic[k, j, i] = bilerp(e[k, y0, x0], e[k, y0, x1], e[k, y1, x0], e[k, y1, x1], tu, tv)
 
 
 @wp.func
 def map_bilinear(maps: wp.array4d[wp.float32], s: int, x: wp.vec3, k: int, extent_m: float,
                  periodic: int) -> float:
-    """Map s of ``maps`` (S, M, M, K) in band k, bilinear between texel centres at x's (x, y) over
-    the patch ±extent/2 (wrapped on a periodic sea, clamped in a pool)."""
-    m = maps.shape[1]
-    u = (x[0] / extent_m + 0.5) * float(m) - 0.5
-    v = (x[1] / extent_m + 0.5) * float(m) - 0.5
-    tu = u - wp.floor(u)
-    tv = v - wp.floor(v)
-    x0 = map_texel(u, m, periodic)
-    x1 = map_texel(u + 1.0, m, periodic)
-    y0 = map_texel(v, m, periodic)
-    y1 = map_texel(v + 1.0, m, periodic)
-    return (1.0 - tv) * ((1.0 - tu) * maps[s, y0, x0, k] + tu * maps[s, y0, x1, k]) + tv * (
-        (1.0 - tu) * maps[s, y1, x0, k] + tu * maps[s, y1, x1, k])
+    """Map s of ``maps`` (S, M, M, K) in band k at x (:func:`map_cell`)."""
+    x0, x1, y0, y1, tu, tv = map_cell(x, maps.shape[1], extent_m, periodic)
+    return bilerp(maps[s, y0, x0, k], maps[s, y0, x1, k], maps[s, y1, x0, k], maps[s, y1, x1, k], tu, tv)
 
 
 @wp.kernel
