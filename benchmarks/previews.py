@@ -7,8 +7,8 @@ the default 0.53° disk costs the flux-ratio map, photons and beams a pass per d
 - ``docs/images/{ocean_floor,pool_pots,buried_in_sand,above_water}.png``: the camera images of the
   photon configs and of the view from above (the pools stepped to 1 s, so that their drops have
   spread into waves);
-- ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots and ocean_floor by
-  photons (left) and by beams (right, ``caustics.method = "both"``);
+- ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots, ocean_floor and
+  above_water (seen from above) by photons (left) and by beams (right, ``caustics.method = "both"``);
 - ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
   an Ernst-style bounding prism projected on the screen;
 - ``docs/images/methods_ocean.png``, ``methods_mercier.png``: one frame of configs/ocean.toml
@@ -94,7 +94,7 @@ def _beam_pictures(images: Path) -> None:
     from warpcaustics.io.png import write_png
 
     rows = []
-    for name in ("pool_pots", "ocean_floor"):
+    for name in ("pool_pots", "ocean_floor", "above_water"):
         scene = wc.load_scene(ROOT / "configs" / f"{name}.toml", {"caustics.method": "both"})
         renderer = wc.Renderer(scene, device="cpu")
         result = renderer.render(CAMERA_SCENES[name])
@@ -103,8 +103,10 @@ def _beam_pictures(images: Path) -> None:
         rows.append(np.concatenate(pair, axis=1))
         if name == "ocean_floor":
             _bounds_plot(renderer, images / "beam_bounds.png")
-    gap = np.full((6, rows[0].shape[1], 3), 255, np.uint8)
-    write_png(images / "beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1]], axis=0))
+    width = max(r.shape[1] for r in rows)
+    rows = [np.pad(r, ((0, 0), (0, width - r.shape[1]), (0, 0)), constant_values=255) for r in rows]
+    gap = np.full((6, width, 3), 255, np.uint8)
+    write_png(images / "beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1], gap, rows[2]], axis=0))
     print(f"wrote {images / 'beams_vs_photons.png'} and {images / 'beam_bounds.png'}")
 
 
