@@ -58,7 +58,7 @@ def above_camera_bytes(cfg: Config, k: int, water_n: int) -> int:
     # distances and pieces; per surface vertex: its point and normal, two triangles' indices and BVH
     # (the meshes' face areas, 4 bytes a face, are left to the receivers' own estimate)
     slices = 0  # photons' shafts: their E⊥ on camera.shaft_samples planes (render_photons)
-    if cfg.caustics.method is CausticsMethod.PHOTONS and cfg.caustics.shafts:
+    if cfg.caustics.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH) and cfg.caustics.shafts:
         slices = cam.shaft_samples * min(cfg.caustics.map_resolution, PHOTON_SLICE_TEXELS) ** 2 * k * 4
     return (pixels * (7 * 12 + 6 * 4 + 4 * 4 * k) + pixels * (2 * 12 + 2 * 4)
             + side * side * (2 * 12 + 6 * 4 + 64) + slices)
