@@ -101,14 +101,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=2)
     parser.add_argument("--halves", action="store_true",
                         help="also each count with sky.sampling = 'halves' (the CV and power spectrum "
-                             "with the sky's continuum, issue 32), at an 85° sun, 3.2 m, 16 and 64 "
+                             "with the sky's continuum, issue 32), at an 85° sun, --depth (3.2 m), 16 and 64 "
                              "directions, and 256 stratified directions for one frame")
+    parser.add_argument("--depth", type=float, default=3.2,
+                        help="with --halves: the floor's depth [m] (default 3.2)")
     args = parser.parse_args(argv)
     if args.quick:
         measure((85.0,), (3.2,), (16, 64), 1)
     elif args.halves:
-        measure((85.0,), (3.2,), (16, 64), args.frames, ("stratified", "halves"), spectra=True)
-        measure((85.0,), (3.2,), (256,), 1, spectra=True)
+        measure((85.0,), (args.depth,), (16, 64), args.frames, ("stratified", "halves"), spectra=True)
+        measure((85.0,), (args.depth,), (256,), 1, spectra=True)
     else:
         measure((20.0, 85.0), (3.2, 9.0), (16, 64, 256), args.frames)
     return 0

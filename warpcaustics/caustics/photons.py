@@ -325,12 +325,19 @@ class PhotonCaustics(PassCaustics):
         plane, spread over its lattice cell there (``kernels/caustics/photon_slices.py``)."""
         dev = self.device
         k = self.sun_irradiance.shape[0]
-        out = wp.zeros((len(planes_z), resolution, resolution, k), dtype=wp.float32, device=dev)
+        shape = (len(planes_z), resolution, resolution, k)
+        out = getattr(self, "_slices", None)
+        if out is None or out.shape != shape:  # kept from pass to pass
+            out = self._slices = wp.zeros(shape, dtype=wp.float32, device=dev)
+        else:
+            out.zero_()
         flux = getattr(self, "splat_flux", None)
         if flux is None:
             flux = self.splat_flux = wp.empty((self.weight.shape[0], 1, 1, k), dtype=wp.float32, device=dev)
         frame = self._patch_map(resolution)
-        coarse = wp.zeros(1, dtype=wp.int32, device=dev)
+        coarse = getattr(self, "coarse_count", None)
+        if coarse is None:
+            coarse = self.coarse_count = wp.zeros(1, dtype=wp.int32, device=dev)
         traced = self.traced()
         spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         for s, z in enumerate(planes_z):
