@@ -113,11 +113,6 @@ def add_footprints(
 MIN_CELL_COVER = 0.5
 """A receiver photon's cell must be at least this much covered by its receiver's faces (in the
 cell's plane); less (the cell hangs over a silhouette or a gap in the mesh): the face deposit."""
-MAX_CELL_FACES = 16
-"""Faces a receiver photon's cell keeps in registers between finding its cover and depositing; a
-cell over more faces searches them again to deposit."""
-vec_faces_i = wp.types.vector(length=MAX_CELL_FACES, dtype=wp.int32)
-vec_faces_f = wp.types.vector(length=MAX_CELL_FACES, dtype=wp.float32)
 CELL_REACH = 0.5
 """The faces searched for a receiver photon's cell: those whose boxes meet the cell's box grown by
 this many of its longest sides (a curved receiver bends away from the cell's plane)."""
@@ -153,16 +148,21 @@ def cell_axes(eu: wp.vec3, ev: wp.vec3, normal: wp.vec3):
 
 
 @wp.func
-def cell_cover(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.int32],
+def add_face_flux(face_flux: wp.array2d[wp.float32], row: int, w: float, ph: Photons, k0: int, ell: float):
+    """face_flux[row, k] += w E(k) e^{−c(k) ℓ} for the photon's bands."""
+    for j in range(ph.wavelengths_per_group):
+        k = k0 + j
+        wp.atomic_add(face_flux, row, k, w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell))
+
+
+@wp.func
+def cell_faces(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.int32],
                face_receiver: wp.array[wp.int32], face_normal: wp.array[wp.vec3], r: int, normal: wp.vec3,
-               c: wp.vec3, a_axis: wp.vec3, b_axis: wp.vec3, lo: wp.vec3, hi: wp.vec3):
-    """(covered, faces, overlaps, count): how much of the cell (in cell areas) receiver r's faces
-    that face along ``normal`` cover, and the first MAX_CELL_FACES of them with their overlaps
-    (``count`` > MAX_CELL_FACES: more overlap the cell than are kept)."""
+               c: wp.vec3, a_axis: wp.vec3, b_axis: wp.vec3, lo: wp.vec3, hi: wp.vec3, w: float,
+               face_flux: wp.array2d[wp.float32], ph: Photons, k0: int, ell: float) -> float:
+    """How much of the cell (in cell areas) receiver r's faces that face along ``normal`` cover;
+    with ``w`` > 0 each such face also gets w × its overlap of the photon's flux (:func:`add_face_flux`)."""
     total = float(0.0)
-    faces = vec_faces_i()
-    overlaps = vec_faces_f()
-    count = int(0)
     query = wp.mesh_query_aabb(mesh, lo, hi)
     g = int(0)
     while wp.mesh_query_next(query, g):
@@ -170,19 +170,9 @@ def cell_cover(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.
             a = face_in_cell(points, indices, g, c, a_axis, b_axis)
             if a > 0.0:
                 total += a
-                if count < MAX_CELL_FACES:
-                    faces[count] = g
-                    overlaps[count] = a
-                count += 1
-    return total, faces, overlaps, count
-
-
-@wp.func
-def add_face_flux(face_flux: wp.array2d[wp.float32], row: int, w: float, ph: Photons, k0: int, ell: float):
-    """face_flux[row, k] += w E(k) e^{−c(k) ℓ} for the photon's bands."""
-    for j in range(ph.wavelengths_per_group):
-        k = k0 + j
-        wp.atomic_add(face_flux, row, k, w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell))
+                if w > 0.0:
+                    add_face_flux(face_flux, g - ph.floor_face_count, w * a, ph, k0, ell)
+    return total
 
 
 @wp.kernel
@@ -219,22 +209,12 @@ def splat_receiver_footprints(
     hi = c + corner + wp.vec3(reach)
     r = face_receiver[f]
     a_axis, b_axis = cell_axes(eu, ev, normal)
-    covered, faces, overlaps, count = cell_cover(mesh, points, indices, face_receiver, face_normal, r, normal,
-                                                 c, a_axis, b_axis, lo, hi)
-    if covered < MIN_CELL_COVER:
-        return
     ell = ph.path_before[p] + wp.length(c - ph.origin[p])
     k0 = (p / ph.photons_per_group) * ph.wavelengths_per_group
-    w = ph.weight[p] / covered
-    if count <= MAX_CELL_FACES:
-        for i in range(count):
-            add_face_flux(face_flux, faces[i] - ph.floor_face_count, w * overlaps[i], ph, k0, ell)
-    else:
-        query = wp.mesh_query_aabb(mesh, lo, hi)
-        h = int(0)
-        while wp.mesh_query_next(query, h):
-            if face_receiver[h] == r and wp.dot(face_normal[h], normal) >= MIN_CELL_ALIGNMENT:
-                a = face_in_cell(points, indices, h, c, a_axis, b_axis)
-                if a > 0.0:
-                    add_face_flux(face_flux, h - ph.floor_face_count, w * a, ph, k0, ell)
+    covered = cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis, lo,
+                         hi, 0.0, face_flux, ph, k0, ell)  # the cover alone
+    if covered < MIN_CELL_COVER:
+        return
+    cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis, lo, hi,
+               ph.weight[p] / covered, face_flux, ph, k0, ell)  # the deposit, over the same faces
     splatted[p] = 1

@@ -170,7 +170,7 @@ class PhotonCaustics(PassCaustics):
         self.splatted = wp.zeros(count, dtype=wp.int32, device=device)
         """1 where a photon was spread over its footprint (``photon_splat``): on the floor map, or
         over the faces of another receiver."""
-        self.footprint = None
+        self.footprint = self.splat_flux = self.coarse_count = self._slices = None
         if cfg.caustics.photon_splat is PhotonSplat.FOOTPRINT:
             self._footprint_buffers(cfg, count, k, m)
         self.path_before = wp.zeros(count, dtype=wp.float32, device=device)
@@ -326,23 +326,21 @@ class PhotonCaustics(PassCaustics):
         dev = self.device
         k = self.sun_irradiance.shape[0]
         shape = (len(planes_z), resolution, resolution, k)
-        out = getattr(self, "_slices", None)
-        if out is None or out.shape != shape:  # kept from pass to pass
-            out = self._slices = wp.zeros(shape, dtype=wp.float32, device=dev)
+        if self._slices is None or self._slices.shape != shape:  # kept from pass to pass
+            self._slices = wp.zeros(shape, dtype=wp.float32, device=dev)
         else:
-            out.zero_()
-        flux = getattr(self, "splat_flux", None)
-        if flux is None:
-            flux = self.splat_flux = wp.empty((self.weight.shape[0], 1, 1, k), dtype=wp.float32, device=dev)
+            self._slices.zero_()
+        if self.splat_flux is None:  # texel deposits on the floor: the slices' own
+            self.splat_flux = wp.empty((self.weight.shape[0], 1, 1, k), dtype=wp.float32, device=dev)
+            self.coarse_count = wp.zeros(1, dtype=wp.int32, device=dev)
+        out = self._slices
         frame = self._patch_map(resolution)
-        coarse = getattr(self, "coarse_count", None)
-        if coarse is None:
-            coarse = self.coarse_count = wp.zeros(1, dtype=wp.int32, device=dev)
         traced = self.traced()
         spacing = self.cfg.water.extent_m / self.n / self.subdivisions
         for s, z in enumerate(planes_z):
             wp.launch(slice_kernels.splat_slice, dim=self.weight.shape[0],
-                      inputs=[traced, float(z), spacing, frame], outputs=[flux, out[s], coarse], device=dev)
+                      inputs=[traced, float(z), spacing, frame],
+                      outputs=[self.splat_flux, out[s], self.coarse_count], device=dev)
         return out
 
     def traced(self) -> photon_kernels.Photons:

@@ -127,6 +127,8 @@ class AboveWaterCamera:
         receivers in the air (float64)."""
         self.top_z = 0.0
         self.lowest_z = 0.0
+        self.receivers_bottom_z = float(receivers.points[:, 2].min())
+        """The receivers' lowest point [m] (they are static): the photons' last slice is just above."""
         self._mesh = None
         self._gbuffer: dict[str, np.ndarray] | None = None
 
@@ -261,13 +263,7 @@ class AboveWaterCamera:
                           outputs=[self.points, self.views, self.along, self.piece], device=dev)
                 beams.inscatter(sb, self.points, self.views, self.along, self.piece,
                                 self.shafts.reshape((k, pixels)), self.top_z)
-        wp.launch(camera_kernels.shade, dim=(k, h, w),
-                  inputs=[self.water_receiver, self.depth, self.caustic, self.shafts,
-                          self.receivers.albedo_wp, beams.attenuation_per_m],
-                  outputs=[self.radiance], device=dev)
-        wp.launch(above_kernels.scale_by, dim=(k, h, w), inputs=[self.through], outputs=[self.radiance],
-                  device=dev)
-        return self.radiance
+        return self._leave_water(beams.attenuation_per_m)
 
     def render_photons(self, photons, shafts: bool) -> wp.array3d:
         """What the refracted rays see of ``photons``' pass, as it leaves the water: (K, H, W). The
@@ -285,12 +281,19 @@ class AboveWaterCamera:
         self.shafts.zero_()
         if shafts:
             self._photon_shafts(photons)
+        return self._leave_water(photons.attenuation_per_m)
+
+    def _leave_water(self, attenuation_per_m: wp.array) -> wp.array3d:
+        """The radiance the refracted rays bring back from this pass (:attr:`caustic` on the receiver
+        they meet, :attr:`shafts` along them), through the surface into the camera: (K, H, W)."""
+        h, w = self.cfg.height, self.cfg.width
+        k = self.caustic.shape[0]
         wp.launch(camera_kernels.shade, dim=(k, h, w),
                   inputs=[self.water_receiver, self.depth, self.caustic, self.shafts,
-                          self.receivers.albedo_wp, photons.attenuation_per_m],
-                  outputs=[self.radiance], device=dev)
+                          self.receivers.albedo_wp, attenuation_per_m],
+                  outputs=[self.radiance], device=self.device)
         wp.launch(above_kernels.scale_by, dim=(k, h, w), inputs=[self.through], outputs=[self.radiance],
-                  device=dev)
+                  device=self.device)
         return self.radiance
 
     def _photon_shafts(self, photons) -> None:
@@ -305,7 +308,7 @@ class AboveWaterCamera:
         pixels = h * w
         count = self.samples
         top = min(self.lowest_z, 0.0)
-        lowest = float(self.receivers.points[:, 2].min())
+        lowest = self.receivers_bottom_z
         bottom = lowest + SLICE_FLOOR_GAP * (top - lowest)  # photons end on the floor, rounded either way
         step = (top - bottom) / max(count - 1, 1)
         planes = top - step * np.arange(count)
