@@ -13,8 +13,17 @@ k is ``weight · E_sun(k) · exp(−c(k) ℓ)``, ℓ its path in water.
 
 import warp as wp
 
+from warpcaustics.kernels.caustics.bounces import (
+    BEYOND_LIMIT_END,
+    LANDED,
+    MAX_OBJECT_BOUNCES,
+    TRAPPED_END,
+    Optics,
+    follow_bounces,
+)
+from warpcaustics.kernels.caustics.bounces import MISSED as MISSED_END
 from warpcaustics.kernels.caustics.fluxratio import grid_corner, lift, texel_of
-from warpcaustics.kernels.geometry import bilerp, fresnel_transmittance, refract, sun_into_water
+from warpcaustics.kernels.geometry import bilerp, sun_into_water
 
 wp.set_module_options({"enable_backward": False})
 
@@ -350,11 +359,6 @@ MISSED = wp.constant(3)
 """and light that meets no receiver after a bounce."""
 TALLIES = 4
 
-MAX_INTERNAL_REFLECTIONS = 4
-"""Total internal reflections a photon may make inside a glass receiver before it is tallied."""
-BOUNCE_OFFSET_M = 1.0e-5
-"""How far from a surface a bounced photon starts again [m] (off the face it left)."""
-
 
 @wp.func
 def tally(tallies: wp.array2d[wp.float64], row: int, w: float, ph_e: wp.array[wp.float32],
@@ -363,17 +367,6 @@ def tally(tallies: wp.array2d[wp.float64], row: int, w: float, ph_e: wp.array[wp
     for j in range(bands):
         k = k0 + j
         wp.atomic_add(tallies, row, k, wp.float64(w * ph_e[k] * wp.exp(-attenuation[k] * path)))
-
-
-@wp.struct
-class Optics:
-    """The receivers' optics for the bounces: per receiver id, its refractive index (0: opaque and
-    diffuse) and whether it is a mirror; the water's index; bounces allowed after the surface's."""
-
-    ior: wp.array[wp.float32]
-    specular: wp.array[wp.int32]
-    water_ior: wp.array[wp.float32]
-    object_bounces: int
 
 
 @wp.kernel
@@ -398,13 +391,10 @@ def trace_bounces(
     tallies: wp.array2d[wp.float64],
 ):
     """Photon i followed through up to ``object_bounces`` interactions with glass or specular
-    receivers (Liktor & Dachsbacher 2011 §6's two-sided refraction and multiple bounces, traced
-    exactly on the BVH) to the diffuse receiver it lands on. A pass through a glass receiver (in,
-    any total internal reflections, out) is one bounce; its weight is multiplied by the exact
-    Fresnel transmittance at each face and the reflected parts are tallied; a mirror reflects it
-    all. On exit ``origin``/``direction`` are the last segment's, ``carried`` its weight and
-    ``path_before`` the water path before it (glass does not attenuate). What does not land is
-    tallied by reason (:data:`REFLECTED`, :data:`BEYOND_LIMIT`, :data:`TRAPPED`, :data:`MISSED`)."""
+    receivers (``kernels/caustics/bounces.py``) to the diffuse receiver it lands on. On exit
+    ``origin``/``direction`` are the last segment's, ``carried`` its weight and ``path_before`` the
+    water path before it (glass does not attenuate). What does not land is tallied by reason
+    (:data:`REFLECTED` at each bounce, :data:`BEYOND_LIMIT`, :data:`TRAPPED`, :data:`MISSED`)."""
     i = wp.tid()
     face[i] = -1
     carried[i] = 0.0
@@ -414,85 +404,28 @@ def trace_bounces(
         return
     g = i / photons_per_group
     k0 = g * bands_per_group
-    n_w = optics.water_ior[g]
     o = origin[i]
     d = direction[i]
     if periodic != 0:
         o = periodic_start(o, d, extent_m, plane_z)
-    path = float(0.0)
-    bounces = int(0)
-    for _event in range(8):
-        q = wp.mesh_query_ray(mesh, o, d, RAY_LENGTH_M)
-        if not q.result:
-            if bounces > 0:
-                tally(tallies, MISSED, w, sun_irradiance, attenuation, k0, bands_per_group, path)
-            origin[i] = o
-            direction[i] = d
-            carried[i] = w
-            path_before[i] = path
-            return
-        r = face_receiver[q.face]
-        n_g = optics.ior[r]
-        mirror = optics.specular[r]
-        p = o + q.t * d
-        if n_g <= 0.0 and mirror == 0:  # a diffuse receiver: the photon lands
-            origin[i] = o
-            direction[i] = d
-            carried[i] = w
-            path_before[i] = path
-            hit[i] = p
-            face[i] = q.face
-            return
-        path += q.t
-        if bounces >= optics.object_bounces:
-            tally(tallies, BEYOND_LIMIT, w, sun_irradiance, attenuation, k0, bands_per_group, path)
-            return
-        bounces += 1
-        n = q.normal
-        if wp.dot(n, d) > 0.0:
-            n = -n  # facing the photon
-        if mirror != 0:
-            d = d - 2.0 * wp.dot(d, n) * n
-            o = p + BOUNCE_OFFSET_M * d
-            continue
-        # into the glass
-        cos_in = -wp.dot(d, n)
-        t_in = fresnel_transmittance(cos_in, n_w / n_g)
-        tally(tallies, REFLECTED, w * (1.0 - t_in), sun_irradiance, attenuation, k0, bands_per_group, path)
-        w = w * t_in
-        d_water = d
-        d = wp.normalize(refract(d, n, n_w / n_g))
-        x = p
-        left = int(0)
-        for _inside in range(MAX_INTERNAL_REFLECTIONS + 1):
-            q2 = wp.mesh_query_ray(mesh, x + BOUNCE_OFFSET_M * d, d, RAY_LENGTH_M)
-            if not q2.result or face_receiver[q2.face] != r:
-                # a chord shorter than the offset (a grazing entry): the photon leaves where it
-                # entered, as through a thin parallel sheet, with the same transmittance
-                tally(tallies, REFLECTED, w * (1.0 - t_in), sun_irradiance, attenuation, k0, bands_per_group,
-                      path)
-                w = w * t_in
-                d = d_water
-                o = x + BOUNCE_OFFSET_M * d
-                left = 1
-                break
-            x = x + (q2.t + BOUNCE_OFFSET_M) * d
-            m = q2.normal
-            if wp.dot(m, d) > 0.0:
-                m = -m  # facing the photon, inside
-            out = refract(d, m, n_g / n_w)
-            if wp.length_sq(out) == 0.0:  # total internal reflection
-                d = d - 2.0 * wp.dot(d, m) * m
-                continue
-            t_out = fresnel_transmittance(-wp.dot(d, m), n_g / n_w)
-            tally(tallies, REFLECTED, w * (1.0 - t_out), sun_irradiance, attenuation, k0, bands_per_group,
-                  path)
-            w = w * t_out
-            d = wp.normalize(out)
-            o = x + BOUNCE_OFFSET_M * d
-            left = 1
-            break
-        if left == 0:
-            tally(tallies, TRAPPED, w, sun_irradiance, attenuation, k0, bands_per_group, path)
-            return
-    tally(tallies, TRAPPED, w, sun_irradiance, attenuation, k0, bands_per_group, path)
+    tr = follow_bounces(mesh, face_receiver, optics, optics.water_ior[g], o, d)
+    for j in range(MAX_OBJECT_BOUNCES):
+        if j < tr.bounces and tr.loss[j] > 0.0:
+            tally(tallies, REFLECTED, w * tr.loss[j], sun_irradiance, attenuation, k0, bands_per_group,
+                  tr.loss_path_m[j])
+    w = w * tr.transmit
+    if tr.end == BEYOND_LIMIT_END:
+        tally(tallies, BEYOND_LIMIT, w, sun_irradiance, attenuation, k0, bands_per_group, tr.path_m)
+        return
+    if tr.end == TRAPPED_END:
+        tally(tallies, TRAPPED, w, sun_irradiance, attenuation, k0, bands_per_group, tr.path_m)
+        return
+    if tr.end == MISSED_END and tr.bounces > 0:
+        tally(tallies, MISSED, w, sun_irradiance, attenuation, k0, bands_per_group, tr.path_m)
+    origin[i] = tr.origin
+    direction[i] = tr.direction
+    carried[i] = w
+    path_before[i] = tr.path_m
+    if tr.end == LANDED:
+        hit[i] = tr.hit
+        face[i] = tr.face
