@@ -106,7 +106,7 @@ def test_two_sided_config_renders_the_sphere_s_caustic():
 
 
 @pytest.mark.parametrize(("overrides", "match"), [
-    ({"caustics.method": "beams"}, "caustics.bounces = 2 is implemented for"),
+    ({"caustics.method": "fluxratio", "receivers": []}, "caustics.bounces = 2 is implemented for"),
     ({"caustics.intersection": "newton"}, "caustics.bounces = 2 is implemented for"),
     ({"receivers": [{"mesh": "sphere", "translate_m": [0.0, 0.0, -1.0]}]}, "has nothing to bounce off"),
     ({"caustics.bounces": 1}, r"receivers\[0\].ior needs caustics.bounces"),

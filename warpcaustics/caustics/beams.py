@@ -13,7 +13,13 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
+from warpcaustics.caustics.beam_bounces import BouncedBeams, bounced_capacity
+from warpcaustics.caustics.receiver_stage import (
+    CausticsSetup,
+    PassCaustics,
+    ReceiverStage,
+    unlit_receivers,
+)
 from warpcaustics.config import BeamInterpolation, Config, FloorShape
 from warpcaustics.kernels.caustics import beams as beam_kernels
 from warpcaustics.kernels.scene.camera import PinholeCamera
@@ -40,6 +46,10 @@ REFINE_MAX_PIXELS = 16.0
 """Side of a screen tile of the volume-caustics rasteriser [pixels]."""
 
 
+BEAM_ARRAYS = ("base", "direction", "transmit", "end_m", "ends", "weight", "area_coef")
+"""The per-beam buffers a primary beam fills."""
+
+
 def beam_count(n: int, groups: int, periodic: bool) -> int:
     quads = n if periodic else n + 1
     return groups * quads * quads * 2
@@ -64,11 +74,20 @@ def beams_bytes(
 ) -> int:
     """Device memory of the beam stage, receivers and floor map included (not the tile lists, whose
     length depends on the frame: about one entry per beam and tile it touches) [bytes].
-    ``face_count``: faces of the receivers' BVH; ``sampled_faces``: those that are not floor."""
+    ``face_count``: faces of the receivers' BVH; ``sampled_faces``: those that are not floor. With
+    ``caustics.bounces`` > 1, the bounced beams' first buffers (``bounced_capacity``; they grow by
+    BEAM_BYTES + 16 bytes a beam when a frame needs more) and the bounce pass's per-primary arrays."""
     m = cfg.caustics.map_resolution
-    beams = beam_count(n, groups, periodic)
+    primaries = beam_count(n, groups, periodic)
+    beams = primaries
+    bounce_bytes = 0
+    if cfg.caustics.bounces > 1:
+        beams += bounced_capacity(primaries)
+        # each beam's edges' paths before its base; each bounced slot's source; need, slots, offset
+        bounce_bytes = 12 * beams + 4 * (beams - primaries) + 12 * primaries
     return (
         beams * BEAM_BYTES
+        + bounce_bytes
         + 2 * k * m * m * 4
         + 2 * (m + 1) * (m + 1) * 4
         + face_count * 84
@@ -156,6 +175,13 @@ class BeamStats:
     """Beams dropped: facing away from the sun, total internal reflection or degenerate."""
     tile_entries: int
     """Entries of the floor's horizontal tile lists (beam × tile pairs)."""
+    bounced: int = 0
+    """``caustics.bounces`` > 1: bounced beams built (``kernels/caustics/beams/bounces.py``),"""
+    parted: int = 0
+    """beams whose light met a glass or specular receiver but whose edges then parted (their light
+    past it is not carried on),"""
+    rising: int = 0
+    """and bounced beams dropped because an edge leaves upwards."""
 
 
 def _horizontal_grid(extent_m: float, tiles: int, periodic: bool) -> beam_kernels.TileGrid:
@@ -202,6 +228,12 @@ class BeamCaustics(PassCaustics):
         self.ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
         count = beam_count(n, self.groups, periodic)
         self.beams_per_group = count // self.groups
+        self.primary_slots = count
+        """Slots of the primary beams; the bounced beams follow them."""
+        self.bounces = None
+        if cfg.caustics.bounces > 1:
+            self.bounces = BouncedBeams(cfg, receivers, group_ior, count, device)
+        """Light through glass and off mirrors (``caustics/beam_bounces.py``)."""
         k = len(setup.sun_irradiance)
         self.k = k
         m = cfg.caustics.map_resolution
@@ -218,25 +250,16 @@ class BeamCaustics(PassCaustics):
         """The current pass's light direction."""
         self.smooth = cfg.caustics.beam_interpolation is BeamInterpolation.SMOOTH
         self.plane_z = -cfg.floor.depth_m
-        self.base = wp.empty((count, 3), dtype=wp.vec3, device=device)
-        self.direction = wp.empty((count, 3), dtype=wp.vec3, device=device)
-        self.transmit = wp.empty((count, 3), dtype=wp.float32, device=device)
-        self.end_m = wp.empty((count, 3), dtype=wp.float32, device=device)
-        self.ends = wp.empty((count, 4), dtype=wp.vec3, device=device)
-        """Per beam: a point of its end plane, the plane's unit normal along the beam, the unit mean
-        edge direction, the base plane's unit normal (``kernels/caustics/beams/build.py fill_ends``)."""
-        self.weight = wp.empty(count, dtype=wp.float32, device=device)
-        """A⊥ per beam [m²] (0: dropped)."""
-        self.area_coef = wp.empty(count, dtype=wp.vec3, device=device)
+        self.unlit_receiver = wp.array(unlit_receivers(cfg, receivers), dtype=wp.int32, device=device)
+        self.no_source = wp.zeros(1, dtype=wp.int32, device=device)
+        """``Beams.source`` without bounces (never read: there are no bounced beams)."""
         self.dropped = wp.zeros(1, dtype=wp.int32, device=device)
         self.texels_per_tile = texels_per_tile(m, n)
-        floor_grid = _horizontal_grid(self.extent_m, m // self.texels_per_tile, periodic)
-        point_grid = _horizontal_grid(self.extent_m, max(n // TILE_CELLS, 1), periodic)
+        self.grids = (_horizontal_grid(self.extent_m, m // self.texels_per_tile, periodic),
+                      _horizontal_grid(self.extent_m, max(n // TILE_CELLS, 1), periodic))
+        """The floor's and the points' horizontal tile grids."""
         self.flat_floor = cfg.floor.shape is FloorShape.FLAT
-        self.floor_bins = TileBins(floor_grid, count, device)
-        """Bins of the sections over the floor's heights (the clipped-texel map)."""
-        self.point_bins = TileBins(point_grid, count, device)
-        """Bins of each beam's whole length (receiver points at any height)."""
+        self.allocate(count + (self.bounces.capacity if self.bounces else 0))
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1] on the floor's true area."""
         coords = np.arange(m + 1) * (self.extent_m / m) - 0.5 * self.extent_m
@@ -256,7 +279,9 @@ class BeamCaustics(PassCaustics):
             points, normals = face_samples(receivers)
             self.face_points = wp.array(points.astype(np.float32), dtype=wp.vec3, device=device)
             self.face_normals = wp.array(normals.astype(np.float32), dtype=wp.vec3, device=device)
-            self.face_ids = wp.zeros(len(points), dtype=wp.int32, device=device)
+            ids = np.repeat(receivers.face_receiver_np[receivers.floor_face_count :], FACE_SAMPLES)
+            self.face_ids = wp.array(ids.astype(np.int32), dtype=wp.int32, device=device)
+            """Each sample's receiver id (glass and mirror faces gather nothing)."""
             self.face_values = wp.empty((k, len(points)), dtype=wp.float32, device=device)
         self.occluders = (
             (not periodic) or bool(receivers.face_count - receivers.floor_face_count) or (not self.flat_floor)
@@ -293,6 +318,33 @@ class BeamCaustics(PassCaustics):
             self.vertex_direction = wp.empty((n, n), dtype=wp.vec3, device=device)
             self.vertex_length = wp.empty((n, n), dtype=wp.float32, device=device)
             self.tolerance_m = cfg.caustics.beam_tolerance * self.extent_m / n
+
+    def allocate(self, slots: int) -> None:
+        """Beam buffers and tile bins for ``slots`` beams. When the bounced beams' region grows
+        within a frame, the primaries already built are kept."""
+        dev = self.device
+        kept = {name: getattr(self, name) for name in BEAM_ARRAYS if hasattr(self, name)}
+        self.base = wp.empty((slots, 3), dtype=wp.vec3, device=dev)
+        self.direction = wp.empty((slots, 3), dtype=wp.vec3, device=dev)
+        self.transmit = wp.empty((slots, 3), dtype=wp.float32, device=dev)
+        self.end_m = wp.empty((slots, 3), dtype=wp.float32, device=dev)
+        self.ends = wp.empty((slots, 4), dtype=wp.vec3, device=dev)
+        """Per beam: a point of its end plane, the plane's unit normal along the beam, the unit mean
+        edge direction, the base plane's unit normal (``kernels/caustics/beams/build.py fill_ends``)."""
+        self.weight = wp.zeros(slots, dtype=wp.float32, device=dev)
+        """A⊥ per beam [m²] (0: dropped)."""
+        self.area_coef = wp.empty(slots, dtype=wp.vec3, device=dev)
+        self.before = wp.zeros((slots if self.bounces else 1, 3), dtype=wp.float32, device=dev)
+        """A bounced beam's edges' water paths before its base [m]."""
+        for name, old in kept.items():
+            new = getattr(self, name)
+            per_beam = old.size // old.shape[0]
+            wp.copy(new, old, count=self.primary_slots * per_beam)
+        self.floor_bins = TileBins(self.grids[0], slots, dev)
+        """Bins of the sections over the floor's heights (the clipped-texel map)."""
+        self.point_bins = TileBins(self.grids[1], slots, dev)
+        """Bins of each beam's whole length (receiver points at any height)."""
+        self.volume_bins = None
 
     def attach_camera(self, camera) -> None:
         """Refine adaptive beams near ``camera``'s screen footprint."""
@@ -343,6 +395,8 @@ class BeamCaustics(PassCaustics):
             ],
             device=dev,
         )
+        if self.bounces:
+            self.bounces.build(self)
         self._points_binned = False
         self._volume_binned = False
         k, m = self.k, self.m
@@ -440,6 +494,9 @@ class BeamCaustics(PassCaustics):
         bm.wavelengths_per_group = self.k // self.groups
         bm.periodic, bm.smooth, bm.occluders = int(self.periodic), int(self.smooth), int(self.occluders)
         bm.mesh = self.receivers.mesh.id
+        bm.primaries = self.primary_slots
+        bm.before, bm.unlit_receiver = self.before, self.unlit_receiver
+        bm.source = self.bounces.source if self.bounces else self.no_source
         return bm
 
     def _bin_horizontal(self, bins: TileBins, lo_z: float, hi_z: float) -> None:
@@ -483,7 +540,7 @@ class BeamCaustics(PassCaustics):
         point_inscatter``; ``sb``: the medium's scattering and phase function). The beams are
         binned over the whole water column, from the receivers' lowest point to ``top_z``."""
         if not self._volume_binned:
-            if getattr(self, "volume_bins", None) is None:
+            if self.volume_bins is None:
                 self.volume_bins = TileBins(self.point_bins.grid, self.weight.shape[0], self.device)
             self._bin_horizontal(self.volume_bins, self.query_z[0], top_z)
             self._volume_binned = True
@@ -511,12 +568,17 @@ class BeamCaustics(PassCaustics):
         return e * np.repeat(per_group, len(e) // self.groups)
 
     def _stats(self) -> BeamStats:
-        w = self.weight.numpy()
+        used = self.groups * self.beams_per_group
+        w = self.weight.numpy()[:used]
+        built, parted, rising = self.bounces.counts() if self.bounces else (0, 0, 0)
         return BeamStats(
-            beams=self.groups * self.beams_per_group,
+            beams=used,
             carrying=int(np.count_nonzero(w > 0)),
             dropped=int(self.dropped.numpy()[0]),
             tile_entries=self.floor_bins.entries,
+            bounced=built,
+            parted=parted,
+            rising=rising,
         )
 
 

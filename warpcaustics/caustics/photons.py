@@ -11,14 +11,14 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage
+from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage, receiver_optics
 from warpcaustics.config import Config, Intersection, PhotonSplat
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photon_footprints as footprint_kernels
 from warpcaustics.kernels.caustics import photon_slices as slice_kernels
 from warpcaustics.kernels.caustics import photons as photon_kernels
 from warpcaustics.optics.refraction import still_water_refraction
-from warpcaustics.scene.receivers import FIRST_MESH_ID, WALLS_ID
+from warpcaustics.scene.receivers import WALLS_ID
 from warpcaustics.water import Surface
 
 PHOTON_BYTES = 12 + 12 + 4 + 12 + 4 + 4 + 4
@@ -90,23 +90,6 @@ def light_view_frame(points: np.ndarray, view_dir: np.ndarray, resolution: int):
     texel = span * (1.0 + 2.0 / resolution) / resolution
     origin = u * (a.min() - texel) + v * (b.min() - texel)
     return origin, u, v, texel
-
-
-def receiver_optics(cfg, receivers, group_ior: np.ndarray, device: str) -> photon_kernels.Optics:
-    """Per receiver id (floor, walls, ``receivers[i]``) its refractive index (0: opaque) and whether
-    it is a mirror, for ``caustics.bounces`` > 1."""
-    count = len(receivers.names)
-    ior = np.zeros(count, np.float32)
-    specular = np.zeros(count, np.int32)
-    for i, r in enumerate(cfg.receivers):
-        ior[FIRST_MESH_ID + i] = r.ior or 0.0
-        specular[FIRST_MESH_ID + i] = int(r.specular)
-    optics = photon_kernels.Optics()
-    optics.ior = wp.array(ior, dtype=wp.float32, device=device)
-    optics.specular = wp.array(specular, dtype=wp.int32, device=device)
-    optics.water_ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
-    optics.object_bounces = cfg.caustics.bounces - 1
-    return optics
 
 
 class PhotonCaustics(PassCaustics):

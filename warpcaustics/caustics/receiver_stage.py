@@ -8,15 +8,23 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+import warp as wp
 
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
 from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
+from warpcaustics.kernels.caustics.bounces import Optics
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.optics.refraction import still_water_refraction, sun_visibility
 from warpcaustics.scene.above import AboveWaterCamera, above_camera_bytes
 from warpcaustics.scene.camera import UnderwaterCamera, camera_bytes
-from warpcaustics.scene.receivers import WALL_FACES, Receivers, floor_mesh_cells, floor_relief_height
+from warpcaustics.scene.receivers import (
+    FIRST_MESH_ID,
+    WALL_FACES,
+    Receivers,
+    floor_mesh_cells,
+    floor_relief_height,
+)
 
 WALL_TOP_M = 1.0
 """Height of a walled pool's walls above the water at rest [m]."""
@@ -36,6 +44,32 @@ def check_camera_position(cfg, floor_relief: np.ndarray | None, periodic: bool) 
     if z <= floor_z:
         raise ConfigError(f"camera.position_m = {list(cfg.camera.position_m)} is below the floor (z = "
                           f"{floor_z:.3f} m there); move the camera up into the water")
+
+
+def unlit_receivers(cfg, receivers: Receivers) -> np.ndarray:
+    """Per receiver id (floor, walls, ``receivers[i]``): 1 for one that passes or sends on the light
+    it meets instead of gathering it (glass, a mirror; ``caustics.bounces`` > 1)."""
+    unlit = np.zeros(len(receivers.names), np.int32)
+    for i, r in enumerate(cfg.receivers):
+        unlit[FIRST_MESH_ID + i] = int(r.ior is not None or r.specular)
+    return unlit
+
+
+def receiver_optics(cfg, receivers: Receivers, group_ior: np.ndarray, device: str) -> Optics:
+    """Per receiver id its refractive index (0: opaque) and whether it is a mirror, with the water's
+    index per group, for ``caustics.bounces`` > 1."""
+    count = len(receivers.names)
+    ior = np.zeros(count, np.float32)
+    specular = np.zeros(count, np.int32)
+    for i, r in enumerate(cfg.receivers):
+        ior[FIRST_MESH_ID + i] = r.ior or 0.0
+        specular[FIRST_MESH_ID + i] = int(r.specular)
+    optics = Optics()
+    optics.ior = wp.array(ior, dtype=wp.float32, device=device)
+    optics.specular = wp.array(specular, dtype=wp.int32, device=device)
+    optics.water_ior = wp.array(np.asarray(group_ior, np.float32), dtype=wp.float32, device=device)
+    optics.object_bounces = cfg.caustics.bounces - 1
+    return optics
 
 
 def check_meshes_inside_patch(cfg, meshes: tuple, sun_dir: np.ndarray, ior: np.ndarray) -> None:

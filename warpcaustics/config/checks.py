@@ -249,7 +249,7 @@ def _check_eikonal_threshold(cfg: Config) -> None:
 
 
 def _check_bounces(cfg: Config) -> None:
-    """Glass and mirror receivers need bounces, which the exact photons implement."""
+    """Glass and mirror receivers need bounces, which the beams and the exact photons implement."""
     c = cfg.caustics
     special = [i for i, r in enumerate(cfg.receivers) if r.ior is not None or r.specular]
     for i in special:
@@ -258,10 +258,12 @@ def _check_bounces(cfg: Config) -> None:
             raise ConfigError(f"receivers[{i}] sets both ior and specular; a receiver is glass (ior) or a "
                               "mirror (specular), not both")
     if c.bounces > 1:
-        if c.method is not CausticsMethod.PHOTONS or c.intersection is not Intersection.EXACT:
+        photons = c.method in (CausticsMethod.PHOTONS, CausticsMethod.BOTH)
+        if not (c.method is CausticsMethod.BEAMS or (photons and c.intersection is Intersection.EXACT)):
             raise ConfigError(f"caustics.bounces = {c.bounces} is implemented for caustics.method = "
-                              "\"photons\" with caustics.intersection = \"exact\" (the method is "
-                              f"{c.method.value!r}, {c.intersection.value!r}); or set caustics.bounces = 1")
+                              "\"beams\", and for \"photons\" and \"both\" with caustics.intersection = "
+                              f"\"exact\" (the method is {c.method.value!r}, {c.intersection.value!r}); "
+                              "or set caustics.bounces = 1")
         if not special:
             raise ConfigError(f"caustics.bounces = {c.bounces} has nothing to bounce off: give a receiver "
                               "ior (glass) or specular = true; or set caustics.bounces = 1")

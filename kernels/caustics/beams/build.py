@@ -77,6 +77,22 @@ def corner_offset(half: int, corner: int) -> wp.vec2i:
 
 
 @wp.func
+def section_coefficients(p0: wp.vec3, p1: wp.vec3, p2: wp.vec3, d0: wp.vec3, d1: wp.vec3,
+                         d2: wp.vec3) -> wp.vec3:
+    """(a0, a1, a2) of the signed section area A(z) = a0 + a1 z + a2 z² of the beam with base
+    vertices p_i and edge directions d_i: A(z) = ½ cross(p1(z) − p0(z), p2(z) − p0(z)) with
+    p_i(z) = u_i + z r_i, r_i = d_xy / d_z."""
+    r0 = xy(d0) / d0[2]
+    r1 = xy(d1) / d1[2]
+    r2 = xy(d2) / d2[2]
+    u1 = xy(p1) - p1[2] * r1 - (xy(p0) - p0[2] * r0)
+    u2 = xy(p2) - p2[2] * r2 - (xy(p0) - p0[2] * r0)
+    q1 = r1 - r0
+    q2 = r2 - r0
+    return 0.5 * wp.vec3(cross2(u1, u2), cross2(u1, q2) + cross2(q1, u2), cross2(q1, q2))
+
+
+@wp.func
 def edge_end(mesh: wp.uint64, origin: wp.vec3, d: wp.vec3, plane_z: float) -> float:
     """Length along an edge to the first receiver; a miss ends on the plane z = plane_z."""
     q = wp.mesh_query_ray(mesh, origin, d, RAY_LENGTH_M)
@@ -150,15 +166,7 @@ def build_beams(
     transmit[b, 0] = t0
     transmit[b, 1] = t1
     transmit[b, 2] = t2
-    # A(z) = 0.5 cross(p1(z) − p0(z), p2(z) − p0(z)) with p_i(z) = u_i + z r_i, r_i = d_xy / d_z.
-    r0 = xy(d0) / d0[2]
-    r1 = xy(d1) / d1[2]
-    r2 = xy(d2) / d2[2]
-    u1 = xy(p1) - p1[2] * r1 - (xy(p0) - p0[2] * r0)
-    u2 = xy(p2) - p2[2] * r2 - (xy(p0) - p0[2] * r0)
-    q1 = r1 - r0
-    q2 = r2 - r0
-    area_coef[b] = 0.5 * wp.vec3(cross2(u1, u2), cross2(u1, q2) + cross2(q1, u2), cross2(q1, q2))
+    area_coef[b] = section_coefficients(p0, p1, p2, d0, d1, d2)
     if w > 0.0:
         # Edges are traced from a hair inside the triangle: a wall vertex of a walled pool lies on
         # the wall, and its edge running down the wall would otherwise stop there at once.

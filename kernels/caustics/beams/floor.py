@@ -230,7 +230,7 @@ def floor_texels(
                         continue
                     p = floor_point(corner, polygon_centroid(rx, ry, rn), texel_m, za, n, shift)
                     s = piece_sample(bm, b, p)
-                    if not lit(bm.mesh, bm.occluders, s, p):
+                    if not lit(bm, b, s, p):
                         continue
                     cut = 0.5 * wp.abs(cross2(q1 - q0, q2 - q0))  # the beam's cut through the plane [m²]
                     scale = share * texel_m * texel_m * inv_area

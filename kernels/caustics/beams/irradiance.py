@@ -9,10 +9,12 @@ from warpcaustics.kernels.caustics.beams.raster import TileGrid, tile_of
 from warpcaustics.kernels.caustics.beams.section import (
     Beams,
     BeamSample,
+    beam_group,
     lit,
     safe_area,
     sample_beam,
     section_copies,
+    water_path,
     xy,
 )
 
@@ -72,7 +74,7 @@ def flux_density(bm: Beams, b: int, s: BeamSample, z: float, periodic: int) -> f
     ρ_i the wave-front density of the beams around vertex i at this height, so the irradiance is
     continuous from beam to beam and no triangle edges show; flux is then conserved only to the
     interpolation's accuracy (docs/validation.md). ``periodic``: the lattice wraps."""
-    if bm.smooth == 0:
+    if bm.smooth == 0 or b >= bm.primaries:  # a bounced beam is on no lattice: its own density
         return bm.weight[b] * s.transmit / s.area
     quads = bm.quads
     per_group = quads * quads * 2
@@ -94,11 +96,12 @@ def add_beam_irradiance(
     out: wp.array2d[wp.float32], point: int, scale: float, bm: Beams, b: int, s: BeamSample, density: float
 ):
     """out[k, point] += scale · E_sun(k) · density · exp(−c(k) ℓ) for the bands of b's group."""
-    g = b / bm.beams_per_group
+    g = beam_group(bm, b)
     f = scale * density
+    path = water_path(bm, b, s)
     for j in range(bm.wavelengths_per_group):
         k = g * bm.wavelengths_per_group + j
-        out[k, point] = out[k, point] + f * bm.sun_irradiance[k] * wp.exp(-bm.attenuation_per_m[k] * s.path_m)
+        out[k, point] = out[k, point] + f * bm.sun_irradiance[k] * wp.exp(-bm.attenuation_per_m[k] * path)
 
 
 @wp.kernel
@@ -113,12 +116,15 @@ def point_irradiance(
     point_ids: wp.array[wp.int32],
     out: wp.array2d[wp.float32],
 ):
-    """Irradiance on the receiver at each point (K, P) [W m^-2 nm^-1] (points with id < 0 skipped):
+    """Irradiance on the receiver at each point (K, P) [W m^-2 nm^-1] (``point_ids``: each point's
+    receiver id; ids < 0 and receivers that gather no light are skipped):
     the sum over the beams of the point's horizontal tile of ``E_h · |d·n| / |d_z|``."""
     p_index = wp.tid()
     for k in range(out.shape[0]):
         out[k, p_index] = 0.0
     if point_ids[p_index] < 0:
+        return
+    if bm.unlit_receiver[point_ids[p_index]] != 0:
         return
     p = points[p_index]
     n = normals[p_index]
@@ -135,7 +141,7 @@ def point_irradiance(
                 s = sample_beam(bm, b, q)
                 if s.inside == 0:
                     continue
-                if not lit(bm.mesh, bm.occluders, s, q):
+                if not lit(bm, b, s, q):
                     continue
                 cos_factor = wp.abs(wp.dot(s.d, n)) / wp.abs(s.d[2])
                 density = flux_density(bm, b, s, q[2], bm.periodic)

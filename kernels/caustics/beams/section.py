@@ -131,7 +131,10 @@ class Beams:
     group ``wavelengths_per_group`` bands of ``sun_irradiance`` and ``attenuation_per_m``; the
     patch ``extent_m`` (``periodic``: the sea repeats), ``quads`` per side of the uniform grid
     (``smooth`` interpolation reads the beams around a lattice vertex), and the receivers' BVH
-    ``mesh`` casting shadows where ``occluders`` is set."""
+    ``mesh`` casting shadows where ``occluders`` is set. With ``caustics.bounces`` > 1 the beams from
+    ``primaries`` on are bounced beams (``bounces.py``), each edge with its water path ``before``
+    its base, ``source`` the primary beam each came from; ``unlit_receiver[r]`` = 1 for a receiver
+    that gathers no light (glass, mirrors)."""
 
     base: wp.array2d[wp.vec3]
     direction: wp.array2d[wp.vec3]
@@ -149,6 +152,27 @@ class Beams:
     smooth: int
     mesh: wp.uint64
     occluders: int
+    primaries: int
+    before: wp.array2d[wp.float32]
+    source: wp.array[wp.int32]
+    unlit_receiver: wp.array[wp.int32]
+
+
+@wp.func
+def beam_group(bm: Beams, b: int) -> int:
+    """Index group of beam b (a bounced beam's is that of the primary it came from)."""
+    if b >= bm.primaries:
+        return bm.source[b - bm.primaries] / bm.beams_per_group
+    return b / bm.beams_per_group
+
+
+@wp.func
+def water_path(bm: Beams, b: int, s: BeamSample) -> float:
+    """Water path from the surface to the sample [m]: a bounced beam's path from its base plus its
+    edges' paths before it (glass does not attenuate)."""
+    if b < bm.primaries:
+        return s.path_m
+    return s.path_m + s.lam[0] * bm.before[b, 0] + s.lam[1] * bm.before[b, 1] + s.lam[2] * bm.before[b, 2]
 
 
 @wp.func
@@ -198,17 +222,25 @@ def shadow_slack(area: float) -> float:
 
 
 @wp.func
-def lit(mesh: wp.uint64, occluders: int, s: BeamSample, p: wp.vec3) -> bool:
-    """Whether the beam's light reaches receiver point p. With occluders (walls, meshes, a relief)
-    a ray from p back along the beam towards the surface must reach it unblocked (exact shadows at
-    the resolution of the BVH); with a flat floor alone the beam's end plane decides."""
-    if occluders == 0:
+def lit(bm: Beams, b: int, s: BeamSample, p: wp.vec3) -> bool:
+    """Whether beam b's light reaches receiver point p. With occluders (walls, meshes, a relief)
+    a ray from p back along the beam towards its base must reach it unblocked (exact shadows at
+    the resolution of the BVH); with a flat floor alone the beam's end plane decides. A bounced
+    beam's base spans the points where its edges left a curved object, whose surface bulges past
+    that triangle (by less than half its longest side, for an object wider than the triangle): the
+    ray stops that side's length short of the base."""
+    if bm.occluders == 0:
         return s.beyond_end_m <= shadow_slack(s.area)
     eps = 1.0e-4 * (1.0 + s.path_m)
     length = s.path_m - 2.0 * eps
+    if b >= bm.primaries:
+        v0 = bm.base[b, 0]
+        v1 = bm.base[b, 1]
+        v2 = bm.base[b, 2]
+        length -= wp.max(wp.length(v1 - v0), wp.max(wp.length(v2 - v0), wp.length(v2 - v1)))
     if length <= 0.0:
         return True
-    q = wp.mesh_query_ray(mesh, p - eps * s.d, -s.d, length)
+    q = wp.mesh_query_ray(bm.mesh, p - eps * s.d, -s.d, length)
     return not q.result
 
 

@@ -10,6 +10,7 @@ from warpcaustics.kernels.caustics.beams.section import (
     BeamCorners,
     Beams,
     barycentrics,
+    beam_group,
     clamped_sample,
     copy_offset,
     load_corners,
@@ -17,6 +18,7 @@ from warpcaustics.kernels.caustics.beams.section import (
     sample_beam,
     section_copies,
     shadow_slack,
+    water_path,
     xy,
 )
 from warpcaustics.kernels.optics.phase import phase_value
@@ -207,7 +209,7 @@ def chord_radiance(
         pieces = wp.clamp(int(ds / wp.max(wp.sqrt(area_mid), 1.0e-6)) + 1, 1, MAX_CHORD_PIECES)
         piece = ds / float(pieces)
     bm = sb.beams
-    g = b / bm.beams_per_group
+    g = beam_group(bm, b)
     lattice_wraps = int(0)
     if sb.copies > 1:
         lattice_wraps = 1  # a periodic sea
@@ -224,11 +226,12 @@ def chord_radiance(
         f = piece * phase * e_perp
         if sb.soft_fade_m > 0.0:
             f = f * fade
+        path = water_path(bm, b, smp) + s_m
         for jj in range(bm.wavelengths_per_group):
             k = g * bm.wavelengths_per_group + jj
             scattered = f * sb.scattering_per_m[k]
             radiance[k, j, i] = radiance[k, j, i] + scattered * bm.sun_irradiance[k] * wp.exp(
-                -bm.attenuation_per_m[k] * (smp.path_m + s_m)
+                -bm.attenuation_per_m[k] * path
             )
     return 1
 
@@ -408,9 +411,10 @@ def point_inscatter(
                 phase = phase_value(sb.phase_kind, sb.hg_g, sb.angles_rad, sb.log_phase, sb.cone_phase,
                                     -wp.dot(smp.d, v))
                 f = piece * phase * flux_density(bm, b, smp, q[2], bm.periodic) / wp.abs(smp.d[2])
-                g = b / bm.beams_per_group
+                g = beam_group(bm, b)
+                before = water_path(bm, b, smp)
                 for jj in range(bm.wavelengths_per_group):
                     k = g * bm.wavelengths_per_group + jj
-                    path = smp.path_m + along_m[p_index]
+                    path = before + along_m[p_index]
                     light = bm.sun_irradiance[k] * wp.exp(-bm.attenuation_per_m[k] * path)
                     radiance[k, p_index] = radiance[k, p_index] + f * sb.scattering_per_m[k] * light
