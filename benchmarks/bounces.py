@@ -1,9 +1,12 @@
-"""Photons through a glass receiver (``caustics.bounces = 2``) vs the same scene with it opaque.
+"""Light through a glass receiver (``caustics.bounces = 2``) vs the same scene with it opaque, by
+photons and by beams.
 
-``configs/two_sided.toml`` (a glass ball in a pool, photons traced exactly on the BVH, no camera)
-with the ball as glass (``receivers[0].ior = 1.9``, two more refractions per photon that meets it,
-exact Fresnel, the tallies) and as an opaque receiver (``caustics.bounces = 1``): the median time of
-the photon stage of a frame (emit, trace, deposit), after a warm-up frame, device synchronised.
+``configs/two_sided.toml`` (a glass ball in a pool, no camera) with the ball as glass
+(``receivers[0].ior = 1.9``: photons traced exactly on the BVH make two more refractions with exact
+Fresnel where they meet it; beams that meet it are followed past it as bounced beams, cut into
+sub-beams across its rim) and as an opaque receiver (``caustics.bounces = 1``): the median time of
+the caustic stage of a frame (photons: emit, trace, deposit; beams: build, bounce, bin, gather the
+floor and the faces), after a warm-up frame, device synchronised.
 ``python -m benchmarks.bounces --help``.
 """
 
@@ -13,19 +16,20 @@ import sys
 
 from benchmarks.run import ROOT, device_record, median_time, point_sun_scene
 
-FULL = [(128, 4), (256, 4)]
-QUICK = [(32, 2)]
+FULL = [("photons", 128, 4), ("photons", 256, 4), ("beams", 64, 0), ("beams", 128, 0)]
+QUICK = [("photons", 32, 2), ("beams", 32, 0)]
 
 
-def measure(n: int, subdivisions: int, device: str, repeats: int) -> dict:
+def measure(method: str, n: int, subdivisions: int, device: str, repeats: int) -> dict:
     import warpcaustics as wc
 
     times = {}
     for name, extra in (("glass", {}), ("opaque", {"caustics.bounces": 1, "receivers": [
             {"mesh": "sphere", "scale": 0.8, "translate_m": [0.0, 0.0, -0.7]}]})):
+        sub = {"caustics.photon_subdivisions": subdivisions} if subdivisions else {}
         scene = point_sun_scene(ROOT / "configs" / "two_sided.toml", {
-            "water.resolution": n, "caustics.photon_subdivisions": subdivisions, "camera.enabled": False,
-            "optics.wavelengths": "rgb", **extra})
+            "caustics.method": method, "water.resolution": n, "camera.enabled": False,
+            "optics.wavelengths": "rgb", **sub, **extra})
         renderer = wc.Renderer(scene, device)
         renderer.render(0.0)  # warm-up: JIT compile
         stage = renderer.method.caustics[0]
@@ -35,9 +39,11 @@ def measure(n: int, subdivisions: int, device: str, repeats: int) -> dict:
             stage.trace(surface, renderer.visible, scene.sun_direction, renderer.light.sun_irradiance)
 
         times[name] = median_time(trace, repeats, device)
-        times[f"{name}_photons"] = stage.weight.shape[0]
-    return {"water_n": n, "subdivisions": subdivisions, "photons": times["glass_photons"],
-            "glass_s": times["glass"], "opaque_s": times["opaque"],
+        times[f"{name}_items"] = stage.primary_slots if method == "beams" else stage.weight.shape[0]
+        if method == "beams" and name == "glass":
+            times["bounced"] = stage.bounces.used
+    return {"method": method, "water_n": n, "subdivisions": subdivisions, "items": times["glass_items"],
+            "bounced_slots": times.get("bounced", 0), "glass_s": times["glass"], "opaque_s": times["opaque"],
             "glass_vs_opaque": times["glass"] / times["opaque"]}
 
 
@@ -51,14 +57,15 @@ def run(quick: bool, device: str) -> dict:
     print(f"bounces      warp {wp.__version__} [{device}: {record['device_name']}] | cpu {_cpu_name()}",
           flush=True)
     rows = []
-    for n, s in QUICK if quick else FULL:
-        r = measure(n, s, device, repeats)
+    for method, n, s in QUICK if quick else FULL:
+        r = measure(method, n, s, device, repeats)
         rows.append(r)
-        print(f"bounces      N={n:4d} {r['photons']:9d} photons | glass ball {r['glass_s'] * 1e3:9.1f} ms | "
-              f"opaque ball {r['opaque_s'] * 1e3:9.1f} ms | ratio {r['glass_vs_opaque']:5.2f}x", flush=True)
-    return {"benchmark": "photon_bounces", **record, "repeats": repeats,
-            "timing": "median of the photon stage's trace() (emit, trace, deposit) after a warm-up frame, "
-                      "device synchronised", "results": rows}
+        print(f"bounces      {method:7s} N={n:4d} {r['items']:9d} {method} | "
+              f"glass ball {r['glass_s'] * 1e3:9.1f} ms | opaque ball {r['opaque_s'] * 1e3:9.1f} ms | "
+              f"ratio {r['glass_vs_opaque']:5.2f}x", flush=True)
+    return {"benchmark": "bounces", **record, "repeats": repeats,
+            "timing": "median of the caustic stage's trace() (photons: emit, trace, deposit; beams: build, "
+                      "bounce, bin, gather) after a warm-up frame, device synchronised", "results": rows}
 
 
 def main(argv: list[str] | None = None) -> int:

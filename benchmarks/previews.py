@@ -9,6 +9,8 @@ the default 0.53° disk costs the flux-ratio map, photons and beams a pass per d
   spread into waves);
 - ``docs/images/beams_vs_photons.png``: the same camera frames of pool_pots, ocean_floor and
   above_water (seen from above) by photons (left) and by beams (right, ``caustics.method = "both"``);
+- ``docs/images/two_sided_beams_vs_photons.png``: configs/two_sided.toml's glass ball, its floor map
+  and camera frame by photons (left) and by bounced beams (right); alone with ``--two-sided``;
 - ``docs/images/beam_bounds.png``: a few beams of ocean_floor's camera view, their tight hull and
   an Ernst-style bounding prism projected on the screen;
 - ``docs/images/methods_ocean.png``, ``methods_mercier.png``: one frame of configs/ocean.toml
@@ -45,11 +47,14 @@ CAMERA_SCENES = {"ocean_floor": 0.0, "pool_pots": 1.0, "buried_in_sand": 1.0, "a
 picture shows."""
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
     import warpcaustics as wc
     from warpcaustics.io.png import write_png
 
     images = ROOT / "docs" / "images"
+    if "--two-sided" in (sys.argv[1:] if argv is None else argv):
+        _bounce_picture(images)
+        return 0
     ocean = wc.render(wc.load_scene(ROOT / "configs" / "ocean.toml"), device="cpu")
     write_png(images / "ocean.png", _preview(ocean))
 
@@ -65,8 +70,30 @@ def main() -> int:
         write_png(images / f"{name}.png", _camera_preview(renderer.render(time_s)))
         print(f"wrote {images / f'{name}.png'}")
     _beam_pictures(images)
+    _bounce_picture(images)
     _method_pictures(images)
     return 0
+
+
+def _bounce_picture(images: Path) -> None:
+    """configs/two_sided.toml by photons and by beams (``caustics.method = "both"``): the floor maps
+    (top) and the camera frames (bottom), each tone-mapped as a render's previews are."""
+    import warpcaustics as wc
+    from warpcaustics.io.png import write_png
+
+    scene = wc.load_scene(ROOT / "configs" / "two_sided.toml", {"caustics.method": "both"})
+    result = wc.Renderer(scene, device="cpu").render(0.0)
+    photons, beams = result.comparison, result
+    rows = []
+    for view in (_preview, _camera_preview):
+        left, right = view(photons), view(beams)
+        gap = np.full((left.shape[0], 6, 3), 255, np.uint8)
+        rows.append(np.concatenate([left, gap, right], axis=1))
+    width = max(r.shape[1] for r in rows)
+    rows = [np.pad(r, ((0, 0), (0, width - r.shape[1]), (0, 0)), constant_values=255) for r in rows]
+    gap = np.full((6, width, 3), 255, np.uint8)
+    write_png(images / "two_sided_beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1]], axis=0))
+    print(f"wrote {images / 'two_sided_beams_vs_photons.png'}")
 
 
 METHOD_SCENES = {

@@ -271,7 +271,7 @@ def main(argv: list[str] | None = None) -> int:
     # Photon footprint splats against texel deposits (benchmarks/photon_splats.py).
     photon_splats = _in_child("run", args.quick, args.device, module="photon_splats")
 
-    # Photons through a glass receiver against the same receiver opaque (benchmarks/bounces.py).
+    # Photons and beams through a glass receiver against the same receiver opaque (benchmarks/bounces.py).
     bounces = _in_child("run", args.quick, args.device, module="bounces")
 
     # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
