@@ -126,11 +126,48 @@ def test_lens_gain_before_focus_matches_paraxial_optics(depth_m):
 
 
 def test_eikonal_config_errors():
-    """A grid too coarse or too fine is refused with the key's name; eikonal needs a flat floor."""
+    """A grid too coarse or too fine is refused with the key's name; a relief is refused for the sun
+    map (the error names the methods that light one)."""
     with pytest.raises(wc.errors.ConfigError, match="caustics.eikonal_resolution"):
         _flat(60.0, **{"caustics.eikonal_resolution": 4})
-    with pytest.raises(wc.errors.ConfigError, match="floor.shape"):
-        _flat(60.0, **{"floor.shape": "ripples", "floor.ripple_wavelength_m": 0.5})
+    with pytest.raises(wc.errors.ConfigError, match="floor.shape = 'ripples' needs .*\"eikonal\""):
+        _flat(60.0, **{"caustics.method": "sunmap", "floor.shape": "ripples",
+                       "floor.ripple_wavelength_m": 0.5})
+
+
+def _slope(method, **extra):
+    """Still water in a 4 m pool over a floor sloping 10° (deeper towards +x, 1.5 m at the centre),
+    the sun 65° high at azimuth 200°, no absorption, 64² map and grid."""
+    return wc.load_scene(None, {
+        "caustics.method": method, "water.model": "pool", "water.extent_m": 4.0, "water.resolution": 64,
+        "floor.depth_m": 1.5, "floor.shape": "slope", "floor.slope_deg": 10.0, "optics.water_type": "none",
+        "optics.wavelengths": "rgb", "optics.ior": IOR, "sun.elevation_deg": 65.0, "sun.azimuth_deg": 200.0,
+        "sun.angular_diameter_deg": 0.0, "caustics.map_resolution": 64, "caustics.eikonal_resolution": 64,
+        "caustics.wave3d_resolution": 64, **extra})
+
+
+@pytest.mark.parametrize(("method", "rtol"), [("eikonal", 1e-4), ("wave3d", 0.02)])
+def test_a_sloping_floor_gets_the_analytic_irradiance(method, rtol):
+    """Mercier's 3-D texture lights any floor height (his Fig. 7's sand slope): still water over a
+    10° slope reads E_sun cosθ T(θ) |n·t|/|t_z| on the slope's true area (t the refracted sun, n the
+    slope's normal; float64 here) in every texel whose light enters the pool's water (the walls'
+    shadow and the light from beyond them left out): the eikonal to 1e-4, the wave texture to 2 %
+    (its damping band and lattice, as on a flat floor). The flux-ratio map is a flat floor's, so
+    there is no comparison map."""
+    result = wc.render(_slope(method), device="cpu")
+    assert result.comparison is None
+    theta = math.radians(25.0)
+    sun = np.array([math.sin(theta) * math.cos(math.radians(200.0)),
+                    math.sin(theta) * math.sin(math.radians(200.0)), math.cos(theta)])
+    sin_t = math.sin(theta) / IOR
+    t = np.array([-sun[0] / math.sin(theta) * sin_t, -sun[1] / math.sin(theta) * sin_t,
+                  -math.sqrt(1 - sin_t**2)])
+    slope = math.tan(math.radians(10.0))
+    n = np.array([slope, 0.0, 1.0]) / math.hypot(slope, 1.0)  # z = −1.5 − x tan 10°: the normal leans to +x
+    fresnel = fresnel_t_angles(np.array([theta]), 1.0, IOR)[0]
+    expected = result.sun_irradiance * math.cos(theta) * fresnel * abs(n @ t) / abs(t[2])
+    inner = result.floor_irradiance[:, 12:52, 12:52]
+    np.testing.assert_allclose(inner, np.broadcast_to(expected[:, None, None], inner.shape), rtol=rtol)
 
 
 @pytest.mark.parametrize("depth_m", [1.0, 4.0])

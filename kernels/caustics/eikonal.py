@@ -347,23 +347,35 @@ def floor_irradiance(
     grid: EikonalGrid,
     horizontal: wp.array3d[wp.float32],
     path: wp.array3d[wp.float32],
-    floor_z: float,
+    texel_z: wp.array2d[wp.float32],
+    texel_normal: wp.array2d[wp.vec3],
     sun_irradiance: wp.array[wp.float32],
     attenuation_per_m: wp.array[wp.float32],
     out: wp.array3d[wp.float32],
 ):
-    """Floor map (K, M, M): the horizontal irradiance of the two layers around the floor,
-    interpolated in z and bilinearly in x, y, times E_sun(λ) exp(−c(λ) ℓ). On a non-periodic grid
-    a texel is dark where its still-water ray comes from beyond the patch (no water surface there),
-    as in the flux-ratio map: the faces continue the front, so the field itself does not know."""
+    """Floor map (K, M, M): the horizontal irradiance of the two layers around the floor at the
+    texel's centre (height ``texel_z``), interpolated in z and bilinearly in x, y, times E_sun(λ)
+    exp(−c(λ) ℓ); on a relief, times ``facing``: irradiance on the floor's true area. On a
+    non-periodic grid a texel is dark where its still-water ray comes from beyond the patch (no
+    water surface there), as in the flux-ratio map: the faces continue the front, so the field
+    itself does not know."""
     b, j, i = wp.tid()
     xy = cell_centre(i, j, out.shape[1], grid.extent_m)
+    floor_z = texel_z[j, i]
     e = wp.max(floor_sample(grid, horizontal, floor_z, xy[0], xy[1]), 0.0)  # §3.3's waves may dip below 0
     length = floor_sample(grid, path, floor_z, xy[0], xy[1])
-    value = sun_irradiance[b] * e * wp.exp(-attenuation_per_m[b] * length)
+    value = sun_irradiance[b] * e * facing(grid, texel_normal[j, i]) * wp.exp(-attenuation_per_m[b] * length)
     if grid.periodic == 0 and beyond_patch(grid, xy[0], xy[1], floor_z):
         value = 0.0
     out[b, j, i] = value
+
+
+@wp.func
+def facing(grid: EikonalGrid, normal: wp.vec3) -> float:
+    """Irradiance on a floor of unit normal ``normal`` per horizontal irradiance, |n·t0| / |t0_z|
+    with t0 still water's refracted direction (the relief's tilt towards or away from the light;
+    the local rays' own tilt is neglected). Exactly 1 on a flat floor."""
+    return wp.abs(wp.dot(normal, grid.gradient)) / wp.abs(grid.gradient[2])
 
 
 @wp.func

@@ -16,6 +16,7 @@ import warp as wp
 from warpcaustics.kernels.caustics.eikonal import (
     EikonalGrid,
     beyond_patch,
+    facing,
     floor_sample,
     lateral_index,
     layer_z,
@@ -168,18 +169,21 @@ def floor_irradiance(
     eta: wp.array2d[wp.float32],
     gain: float,
     exponent: float,
-    floor_z: float,
+    texel_z: wp.array2d[wp.float32],
+    texel_normal: wp.array2d[wp.vec3],
     sun_irradiance: wp.array[wp.float32],
     attenuation_per_m: wp.array[wp.float32],
     out: wp.array3d[wp.float32],
 ):
-    """Floor map (K, M, M): the intensity I = 2⟨u²⟩ of the layers around the floor (interpolated in z,
-    bilinear in x, y), Mercier's post-process a·I^b, times |t0_z| (irradiance on the floor), E_sun
-    and exp(−c ℓ) along the still-water refracted direction from the surface. On a non-periodic
+    """Floor map (K, M, M): the intensity I = 2⟨u²⟩ of the layers around the floor at the texel's
+    centre (height ``texel_z``; interpolated in z, bilinear in x, y), Mercier's post-process a·I^b,
+    times |n·t0| (irradiance on the floor of normal n: |t0_z| on a flat one), E_sun and exp(−c ℓ)
+    along the still-water refracted direction from the surface. On a non-periodic
     grid a texel whose still-water ray comes from beyond the patch is dark, as for the other
     methods (the faces let the plane wave through, so the field itself does not know)."""
     b, j, i = wp.tid()
     xy = cell_centre(i, j, out.shape[1], grid.extent_m)
+    floor_z = texel_z[j, i]
     e = floor_sample(grid, energy, floor_z, xy[0], xy[1])
     intensity = gain * wp.pow(wp.max(2.0 * e / samples, 0.0), exponent)
     cos_t = wp.abs(grid.gradient[2]) / grid.slowness
@@ -188,7 +192,8 @@ def floor_irradiance(
     ci = wp.clamp(int((xy[0] + 0.5 * grid.extent_m) / grid.h), 0, n - 1)
     cj = wp.clamp(int((xy[1] + 0.5 * grid.extent_m) / grid.h), 0, n - 1)
     path = wp.max(eta[cj, ci] - floor_z, 0.0) / cos_t
-    value = sun_irradiance[b] * intensity * cos_t * wp.exp(-attenuation_per_m[b] * path)
+    on_floor = cos_t * facing(grid, texel_normal[j, i])  # = |n·t0|
+    value = sun_irradiance[b] * intensity * on_floor * wp.exp(-attenuation_per_m[b] * path)
     if grid.periodic == 0 and beyond_patch(grid, xy[0], xy[1], floor_z):
         value = 0.0
     out[b, j, i] = value

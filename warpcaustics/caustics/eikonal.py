@@ -20,6 +20,7 @@ from warpcaustics.config import Config
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
 from warpcaustics.optics.refraction import still_water_refraction
+from warpcaustics.scene.receivers import floor_relief_height
 from warpcaustics.water import Surface
 
 MAX_PASSES_PER_LAYER = 512
@@ -95,18 +96,42 @@ def all_lit(surface: Surface, device: str) -> wp.array2d:
     return wp.full((n, n), 1.0, dtype=wp.float32, device=device)
 
 
+def texel_floor(cfg: Config, relief: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """(M, M) floor heights at the map's texel centres [m] and (M, M, 3) unit floor normals there
+    (float64): the mean and the slope of the texel's four corner heights (``floor.shape``; exact on
+    a plane, and exactly −depth_m and straight up on a flat floor)."""
+    m = cfg.caustics.map_resolution
+    extent = float(cfg.water.extent_m)
+    texel = extent / m
+    corners = np.arange(m + 1) * texel - 0.5 * extent
+    cx, cy = np.meshgrid(corners, corners)
+    z = floor_relief_height(cfg.floor, relief, extent, cx, cy)
+    a, b, c, d = z[:-1, :-1], z[:-1, 1:], z[1:, :-1], z[1:, 1:]
+    gx = ((b - a) + (d - c)) / (2.0 * texel)
+    gy = ((c - a) + (d - b)) / (2.0 * texel)
+    normal = np.stack([-gx, -gy, np.ones_like(gx)], -1)
+    return (a + b + c + d) / 4.0, normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+
+
 class GridCaustics:
     """What the eikonal and wave methods share: their N×N columns over the patch, the sun and the
-    water, the floor map they fill and the frozen layers' depth per column."""
+    water, the floor map they fill (on the floor's relief: each texel's centre height and normal)
+    and the frozen layers' depth per column."""
 
     def __init__(self, cfg: Config, n: int, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool,
+                 relief: np.ndarray | None = None):
         self.cfg = cfg
         self.device = device
         self.n = n
         self.extent_m = float(cfg.water.extent_m)
         self.h = self.extent_m / self.n
-        self.floor_z = -float(cfg.floor.depth_m)
+        texel_z, texel_normal = texel_floor(cfg, relief)
+        self.floor_z = float(texel_z.min())
+        """The floor's lowest texel centre [m] (the grid reaches below it)."""
+        self.mean_depth_m = float(-texel_z.mean())
+        self.texel_z = wp.array(texel_z.astype(np.float32), dtype=wp.float32, device=device)
+        self.texel_normal = wp.array(texel_normal.astype(np.float32), dtype=wp.vec3, device=device)
         self.map_resolution = cfg.caustics.map_resolution
         self.periodic = periodic
         self.ior = float(ior)
@@ -129,8 +154,8 @@ class GridCaustics:
 
     def disk_average(self, floor: np.ndarray, disk_dirs: np.ndarray) -> np.ndarray:
         """The sun's disk for this grid method's map: :func:`parallax_disk_average`."""
-        return parallax_disk_average(floor, self.sun_dir, disk_dirs, self.ior, -self.floor_z, self.extent_m,
-                                     self.periodic)
+        return parallax_disk_average(floor, self.sun_dir, disk_dirs, self.ior, self.mean_depth_m,
+                                     self.extent_m, self.periodic)
 
 
 def parallax_disk_average(floor: np.ndarray, sun_dir: np.ndarray, disk_dirs: np.ndarray, ior: float,
@@ -178,9 +203,10 @@ class EikonalCaustics(GridCaustics):
     """Owns the 3-D grid (ψ, Laplacian, intensity, path, horizontal irradiance) of a scene."""
 
     def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool,
+                 relief: np.ndarray | None = None):
         super().__init__(cfg, cfg.caustics.eikonal_resolution, sun_dir, ior, sun_irradiance,
-                         attenuation_per_m, device, periodic=periodic)
+                         attenuation_per_m, device, periodic=periodic, relief=relief)
         self.scratch = wp.empty((self.n, self.n), dtype=wp.float32, device=device)
         self.changed = wp.zeros(1, dtype=wp.int32, device=device)
         self.stats = EikonalStats()
@@ -221,8 +247,8 @@ class EikonalCaustics(GridCaustics):
         self._threshold_post_process(grid)
         k_bands, m = self.irradiance.shape[0], self.map_resolution
         wp.launch(eikonal_kernels.floor_irradiance, dim=(k_bands, m, m),
-                  inputs=[grid, self.horizontal, self.path, self.floor_z, self.sun_irradiance,
-                          self.attenuation_per_m],
+                  inputs=[grid, self.horizontal, self.path, self.texel_z, self.texel_normal,
+                          self.sun_irradiance, self.attenuation_per_m],
                   outputs=[self.irradiance], device=dev)
         self.grid = grid
         return self.irradiance
@@ -286,7 +312,8 @@ class GridStage(ApproximateStage):
     def make(self, mean_ior: float) -> GridCaustics:
         light = self.light
         return self.grid(self.scene.config, self.scene.sun_direction, mean_ior, light.sun_irradiance,
-                         light.attenuation_per_m, self.device, periodic=self.water.periodic)
+                         light.attenuation_per_m, self.device, periodic=self.water.periodic,
+                         relief=self.scene.floor_relief)
 
     def sky_map(self, frame: Frame, flux_ratio: np.ndarray) -> np.ndarray | None:
         """The sky's floor map by the grid: a solve per sky direction, lit with its share of the

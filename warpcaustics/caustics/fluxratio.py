@@ -11,7 +11,7 @@ import warp as wp
 from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
-from warpcaustics.config import Scattering, SkySampling
+from warpcaustics.config import FloorShape, Scattering, SkySampling
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
 from warpcaustics.scene.receivers import albedo_spectrum
@@ -308,6 +308,8 @@ class ApproximateStage(FluxRatioStage):
         if method_sky is not None:
             extra["sky_floor_irradiance"] = method_sky
             floor = floor + method_sky
-        return StageOutput(floor, transmitted, self.name, extra,
-                           comparison=StageOutput(flux_ratio, transmitted, FluxRatioStage.name,
-                                                  {"delivered_flux_w_nm": fields["delivered_flux_w_nm"]}))
+        comparison = None  # the flux-ratio map is a flat floor's: no comparison on a relief (eikonal, wave3d)
+        if self.scene.config.floor.shape is FloorShape.FLAT:
+            comparison = StageOutput(flux_ratio, transmitted, FluxRatioStage.name,
+                                     {"delivered_flux_w_nm": fields["delivered_flux_w_nm"]})
+        return StageOutput(floor, transmitted, self.name, extra, comparison=comparison)

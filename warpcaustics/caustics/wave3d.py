@@ -57,10 +57,11 @@ class Wave3DCaustics(GridCaustics):
     """Owns the wave grid (frozen front, u at three times, ⟨u²⟩) of a scene."""
 
     def __init__(self, cfg: Config, sun_dir: np.ndarray, ior: float, sun_irradiance: np.ndarray,
-                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool):
+                 attenuation_per_m: np.ndarray, device: str, *, periodic: bool,
+                 relief: np.ndarray | None = None):
         c = cfg.caustics
         super().__init__(cfg, c.wave3d_resolution, sun_dir, ior, sun_irradiance, attenuation_per_m, device,
-                         periodic=periodic)
+                         periodic=periodic, relief=relief)
         self.cells_per_wavelength = float(c.wave3d_cells_per_wavelength)
         self.periods = float(c.wave3d_periods)
         self.gain = float(c.wave3d_gain)
@@ -163,7 +164,7 @@ class Wave3DCaustics(GridCaustics):
         k_bands, m = self.irradiance.shape[0], self.irradiance.shape[1]
         wp.launch(wave_kernels.floor_irradiance, dim=(k_bands, m, m),
                   inputs=[grid, self.energy, float(average), self.eta, self.gain, self.exponent,
-                          self.floor_z, self.sun_irradiance, self.attenuation_per_m],
+                          self.texel_z, self.texel_normal, self.sun_irradiance, self.attenuation_per_m],
                   outputs=[self.irradiance], device=dev)
         self.grid = grid
         self.stats = stats

@@ -285,16 +285,17 @@ def _check_photon_scene(cfg: Config) -> None:
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []
-    if cfg.floor.shape is not FloorShape.FLAT:
+    grid = cfg.caustics.method in (CausticsMethod.EIKONAL, CausticsMethod.WAVE3D)  # their 3-D texture
+    if cfg.floor.shape is not FloorShape.FLAT and not grid:
         needs.append(f"floor.shape = {cfg.floor.shape.value!r}")
     if cfg.receivers:
         needs.append("[[receivers]]")
     if cfg.camera.enabled:
         needs.append("camera.enabled = true")
     if needs and not photons:
-        raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" or \"beams\" "
-                          f"(the method is "
-                          f"{cfg.caustics.method.value!r})")
+        relief = " (a floor relief alone: or \"eikonal\", \"wave3d\")" if needs[0].startswith("floor") else ""
+        raise ConfigError(f"{', '.join(needs)} needs caustics.method = \"photons\" or \"beams\"{relief} "
+                          f"(the method is {cfg.caustics.method.value!r})")
     _check_file_key("floor.file", cfg.floor.file, "floor.shape", cfg.floor.shape, FloorShape.FILE,
                      "floor relief", "floor.npy")
     _check_periodic_floor(cfg)
