@@ -6,11 +6,17 @@
   post-process, beside the flux-ratio map of the same frames; the correlation of each with the
   flux-ratio map. Writes ``docs/images/mercier_fig1.png`` (rows: flux ratio, eikonal, eikonal with
   §3.3; columns: the times).
-- Fig. 7, the *buried in sand* scene, is ``configs/buried_in_sand.toml`` by photons (the paper's
-  reference panel; README picture by ``python -m benchmarks.previews``): our eikonal grid lights a
-  flat floor only, so the paper's marching panels are not reproduced.
+- Fig. 7, "Buried in sand scene computed with photon mapping and the marching method":
+  ``configs/buried_in_sand.toml`` (three objects half buried in a 10° sand slope under a wave pool)
+  at t = 1 s by photons (the reference panel; ours light the objects too, the paper's did not), and
+  the sand alone by photons and by the eikonal method on a 256³ grid (the paper's size) plain and
+  with §3.3's post-process: the eikonal texture sampled at the slope's heights (its "marching"
+  panels; as in the paper, without the objects, whose shadows and caustics the texture does not
+  know); correlation and relative L1 of each against the photons' sand. Writes
+  ``docs/images/mercier_fig7.png`` (photons with the objects, photons' sand, eikonal, with §3.3).
 
-CPU, about a minute; ``--quick`` renders two times at a 64³ grid and writes no picture.
+CPU, a few minutes (``--fig1`` / ``--fig7``: one of them); ``--quick`` renders both on 64³ grids and
+writes no picture.
 """
 
 from __future__ import annotations
@@ -65,6 +71,54 @@ def evolution(times=TIMES_S, overrides: dict | None = None, device: str = "cpu")
     return rows, maps
 
 
+FIG7_TIME_S = 1.0
+"""Fig. 7's frame [s]: the config's two drops spread into rings over the sand."""
+
+
+def buried_in_sand(overrides: dict | None = None, device: str = "cpu") -> tuple[dict, dict]:
+    """Fig. 7's panels (band-summed floor maps) and the eikonal variants' correlation, relative L1
+    and contrast against the photons' map of the sand alone."""
+    import warpcaustics as wc
+    from warpcaustics.io.comparison import map_correlation, relative_l1
+
+    sand = {"receivers": [], "camera.enabled": False}
+    eikonal = {**sand, "caustics.method": "eikonal", "caustics.eikonal_resolution": 256}
+    variants = {"photons_objects": {"camera.enabled": False}, "photons": sand, "eikonal": eikonal,
+                "eikonal_threshold": {**eikonal, **THRESHOLD}}
+    results = {}
+    for name, extra in variants.items():
+        scene = wc.load_scene(ROOT / "configs" / "buried_in_sand.toml", {**extra, **(overrides or {})})
+        results[name] = wc.Renderer(scene, device).render(FIG7_TIME_S)
+    widths = results["photons"].bin_widths_nm
+    maps = {name: (r.floor_irradiance * widths[:, None, None]).sum(0) for name, r in results.items()}
+    reference = results["photons"].floor_irradiance
+    row = {"time_s": FIG7_TIME_S, "contrast_photons": float(maps["photons"].std() / maps["photons"].mean())}
+    for name in ("eikonal", "eikonal_threshold"):
+        r = results[name]
+        row[f"correlation_{name}"] = map_correlation(r.floor_irradiance, reference, widths)
+        row[f"relative_l1_{name}"] = relative_l1(r.floor_irradiance, reference)
+        row[f"contrast_{name}"] = float(maps[name].std() / maps[name].mean())
+    print(f"mercier      fig. 7 t={FIG7_TIME_S:.1f} s | against the photons' sand: eikonal correlation "
+          f"{row['correlation_eikonal']:.3f}, L1 {row['relative_l1_eikonal']:.3f}; with §3.3 "
+          f"{row['correlation_eikonal_threshold']:.3f}, {row['relative_l1_eikonal_threshold']:.3f} | "
+          f"contrast photons {row['contrast_photons']:.3f}, eikonal {row['contrast_eikonal']:.3f}, "
+          f"with §3.3 {row['contrast_eikonal_threshold']:.3f}", flush=True)
+    return row, maps
+
+
+def fig7_picture(maps: dict, path: Path) -> None:
+    """The four panels side by side, grey, each scaled by the photons' sand mean; +y up."""
+    from warpcaustics.io.png import write_png
+
+    scale = 2.5 * maps["photons"].mean()
+    tiles = []
+    for name in ("photons_objects", "photons", "eikonal", "eikonal_threshold"):
+        tiles.append(np.clip(maps[name][::-1] / scale, 0, 1) ** (1 / 2.2))
+        tiles.append(np.ones((maps[name].shape[0], 4)))
+    grey = np.concatenate(tiles[:-1], axis=1)
+    write_png(path, np.repeat((grey * 255).astype(np.uint8)[..., None], 3, axis=2))
+
+
 def picture(maps: dict, path: Path) -> None:
     """Rows of grey maps (flux ratio, eikonal, eikonal with §3.3), each frame scaled by its flux
     ratio's mean so that the rows compare; +y up."""
@@ -85,16 +139,24 @@ def picture(maps: dict, path: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="two times on a 64³ grid, no picture")
+    parser.add_argument("--quick", action="store_true", help="both figures on 64³ grids, no picture")
+    parser.add_argument("--fig1", action="store_true", help="Fig. 1 only")
+    parser.add_argument("--fig7", action="store_true", help="Fig. 7 only")
     args = parser.parse_args(argv)
+    small = {"caustics.eikonal_resolution": 64, "water.resolution": 64, "caustics.map_resolution": 64}
     if args.quick:
-        evolution((0.0, 0.3), {"caustics.eikonal_resolution": 64, "water.resolution": 64,
-                               "caustics.map_resolution": 64})
+        evolution((0.0, 0.3), small)
+        buried_in_sand({**small, "caustics.photon_subdivisions": 2})
         return 0
-    rows, maps = evolution()
-    path = ROOT / "docs" / "images" / "mercier_fig1.png"
-    picture(maps, path)
-    print(f"wrote {path}")
+    images = ROOT / "docs" / "images"
+    if not args.fig7:
+        rows, maps = evolution()
+        picture(maps, images / "mercier_fig1.png")
+        print(f"wrote {images / 'mercier_fig1.png'}")
+    if not args.fig1:
+        _, maps = buried_in_sand()
+        fig7_picture(maps, images / "mercier_fig7.png")
+        print(f"wrote {images / 'mercier_fig7.png'}")
     return 0
 
 
