@@ -248,6 +248,24 @@ def spread_triangle(
     within it when ``wrap``]: each texel gets overlap area / triangle area × ``inv_texel_area`` of it,
     the overlap clipped exactly (texels outside an unwrapped map are dropped). Triangles whose box
     exceeds ``max_clipped`` texels go by area samples, counted in ``coarse_count``."""
+    spread_triangle_at(dep, wp.vec2i(0, 0), q0, e1, e2, m, wrap, max_clipped, inv_texel_area, coarse_count)
+
+
+@wp.func
+def spread_triangle_at(
+    dep: TriangleDeposit,
+    base: wp.vec2i,
+    q0: wp.vec2,
+    e1: wp.vec2,
+    e2: wp.vec2,
+    m: int,
+    wrap: int,
+    max_clipped: int,
+    inv_texel_area: float,
+    coarse_count: wp.array[wp.int32],
+):
+    """:func:`spread_triangle` of the triangle whose corner q0 is given relative to texel ``base``
+    (its coordinates small, so that the clipping keeps float32's precision wherever it lies)."""
     q1 = q0 + e1
     q2 = q0 + e2
     u_lo = wp.floor(wp.min(q0[0], wp.min(q1[0], q2[0])))
@@ -256,21 +274,22 @@ def spread_triangle(
     v_hi = wp.floor(wp.max(q0[1], wp.max(q1[1], q2[1])))
     single_texel = u_lo == u_hi and v_lo == v_hi
     if wrap == 0:  # only the texels inside the map are visited
-        u_lo = wp.max(u_lo, 0.0)
-        v_lo = wp.max(v_lo, 0.0)
-        u_hi = wp.min(u_hi, float(m - 1))
-        v_hi = wp.min(v_hi, float(m - 1))
+        u_lo = wp.max(u_lo, float(-base[0]))
+        v_lo = wp.max(v_lo, float(-base[1]))
+        u_hi = wp.min(u_hi, float(m - 1 - base[0]))
+        v_hi = wp.min(v_hi, float(m - 1 - base[1]))
         if u_lo > u_hi or v_lo > v_hi:
             return  # the footprint misses the map
     if (u_hi - u_lo + 1.0) * (v_hi - v_lo + 1.0) > float(max_clipped):
         # A huge footprint (grazing rays, a deep floor): bounded work, flux still conserved.
         wp.atomic_add(coarse_count, 0, 1)
-        deposit_by_samples(dep, q0, e1, e2, m, wrap, inv_texel_area)
+        at = q0 + wp.vec2(float(base[0]), float(base[1]))
+        deposit_by_samples(dep, at, e1, e2, m, wrap, inv_texel_area)
         return
-    i_lo = int(u_lo)
-    j_lo = int(v_lo)
-    i_hi = int(u_hi)
-    j_hi = int(v_hi)
+    i_lo = base[0] + int(u_lo)
+    j_lo = base[1] + int(v_lo)
+    i_hi = base[0] + int(u_hi)
+    j_hi = base[1] + int(v_hi)
     # Coordinates relative to the footprint's first texel keep the clipping arithmetic small.
     corner = wp.vec2(u_lo, v_lo)
     q0 = q0 - corner

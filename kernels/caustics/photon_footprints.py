@@ -21,9 +21,21 @@ the cell), the shares normalised to one so that the flux is kept exactly.
 
 import warp as wp
 
-from warpcaustics.kernels.caustics.fluxratio import FloorMap, TriangleDeposit, spread_triangle, wrap_coord
-from warpcaustics.kernels.caustics.photon_lattice import MIN_CELL_ALIGNMENT, photon_lattice
-from warpcaustics.kernels.caustics.photons import Photons
+from warpcaustics.kernels.caustics.fluxratio import (
+    FloorMap,
+    TriangleDeposit,
+    grid_corner,
+    lift,
+    spread_triangle_at,
+    wrap_coord,
+)
+from warpcaustics.kernels.caustics.photon_lattice import (
+    MIN_CELL_ALIGNMENT,
+    grid_neighbour,
+    on_receiver,
+    photon_lattice,
+)
+from warpcaustics.kernels.caustics.photons import Photons, bilinear_vec3
 from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
 
 wp.set_module_options({"enable_backward": False})
@@ -45,6 +57,78 @@ def photon_deposit(texels: wp.array3d[wp.float32], flux: wp.array4d[wp.float32],
     return dep
 
 
+# --- the cells on a flat floor in float64 ------------------------------------------------------
+# float32 hits 2–4 m from the origin are rounded to ~2.4e-7 m each, so neighbouring cells, each
+# placed about its own hit, overlap or leave gaps of that size: 1e-5 of a texel's irradiance. On a
+# flat floor (no bounces) the splat recomputes each hit in float64 from the photon's own start on
+# the surface (the vertices' float32 positions, interpolated in float64) and direction, and places
+# the cell relative to its texel: still water is then exact to float32's flux sums.
+
+
+@wp.func
+def to64(v: wp.vec3) -> wp.vec3d:
+    return wp.vec3d(wp.float64(v[0]), wp.float64(v[1]), wp.float64(v[2]))
+
+
+@wp.func
+def plane_hit64(positions: wp.array2d[wp.vec3], ph: Photons, p: int, plane_z: float) -> wp.vec3d:
+    """Photon p's hit on the plane z = ``plane_z`` in float64: its start on the bilinear surface
+    patch (``emit_photons``) recomputed in float64, moved by the whole periods its trace moved it
+    (``periodic_start``), followed along its direction."""
+    s = ph.subdivisions
+    sub = p % (s * s)
+    cell = p / (s * s)
+    qx = cell % ph.quads
+    qy = (cell / ph.quads) % ph.quads
+    n = positions.shape[0]
+    x00, y00, h00 = grid_corner(qx, qy, 0, 0, n, ph.extent_m, ph.periodic)
+    x10, y10, h10 = grid_corner(qx, qy, 1, 0, n, ph.extent_m, ph.periodic)
+    x01, y01, h01 = grid_corner(qx, qy, 0, 1, n, ph.extent_m, ph.periodic)
+    x11, y11, h11 = grid_corner(qx, qy, 1, 1, n, ph.extent_m, ph.periodic)
+    p00 = lift(positions[y00, x00], h00)
+    p10 = lift(positions[y10, x10], h10)
+    p01 = lift(positions[y01, x01], h01)
+    p11 = lift(positions[y11, x11], h11)
+    tu = (float(sub % s) + 0.5) / float(s)
+    tv = (float(sub / s) + 0.5) / float(s)
+    emitted = bilinear_vec3(p00, p10, p01, p11, tu, tv)  # the float32 start, as emitted
+    tu64 = (wp.float64(sub % s) + wp.float64(0.5)) / wp.float64(s)
+    tv64 = (wp.float64(sub / s) + wp.float64(0.5)) / wp.float64(s)
+    one = wp.float64(1.0)
+    start = (one - tv64) * ((one - tu64) * to64(p00) + tu64 * to64(p10)) + tv64 * (
+        (one - tu64) * to64(p01) + tu64 * to64(p11))
+    if ph.periodic != 0:
+        moved = ph.origin[p] - emitted
+        period = wp.float64(ph.extent_m)
+        start = start + wp.vec3d(period * wp.float64(wp.round(moved[0] / ph.extent_m)),
+                                 period * wp.float64(wp.round(moved[1] / ph.extent_m)), wp.float64(0.0))
+    d = to64(ph.direction[p])
+    return start + ((wp.float64(plane_z) - start[2]) / d[2]) * d
+
+
+@wp.func
+def unwrap64(a: wp.vec3d, b: wp.vec3d, periodic: int, extent_m: float) -> wp.vec3d:
+    """b − a in float64, with whole periods removed on a periodic sea."""
+    e = b - a
+    if periodic != 0:
+        period = wp.float64(extent_m)
+        e = e - wp.vec3d(period * wp.round(e[0] / period), period * wp.round(e[1] / period), wp.float64(0.0))
+    return e
+
+
+@wp.func
+def lattice_step64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.array[wp.int32], p: int,
+                   along_v: int, plane_z: float, hit: wp.vec3d) -> wp.vec3d:
+    """``lattice_step`` in float64 on the plane: to the forward grid neighbour on the same receiver,
+    or from the backward one (the caller has checked that one of them is)."""
+    r = face_receiver[ph.face[p]]
+    n = grid_neighbour(p, along_v, 1, ph.quads, ph.subdivisions, ph.periodic)
+    if on_receiver(n, r, ph.face, face_receiver):
+        return unwrap64(hit, plane_hit64(positions, ph, n, plane_z), ph.periodic, ph.extent_m)
+    n = grid_neighbour(p, along_v, -1, ph.quads, ph.subdivisions, ph.periodic)
+    return unwrap64(plane_hit64(positions, ph, n, plane_z), hit, ph.periodic, ph.extent_m)
+
+
 @wp.kernel
 def splat_footprints(
     ph: Photons,
@@ -52,6 +136,9 @@ def splat_footprints(
     face_normal: wp.array[wp.vec3],
     spacing_m: float,
     floor_map: FloorMap,
+    positions: wp.array2d[wp.vec3],
+    flat_plane: int,
+    plane_z: float,
     flux: wp.array4d[wp.float32],
     texels: wp.array3d[wp.float32],
     coarse_count: wp.array[wp.int32],
@@ -61,7 +148,8 @@ def splat_footprints(
     kept in ``flux`` (P, 1, 1, K)) spread over the cell's horizontal projection into ``texels``
     (M, M, K) as irradiance per horizontal texel area; ``splatted[p]`` = 1. Other photons, and those
     whose cell reaches past the edge of a map that does not wrap: 0 (the texel deposit takes
-    them)."""
+    them). ``flat_plane``: the floor is the plane z = ``plane_z`` and the photons come straight from
+    the surface ``positions``: the cell is placed in float64 (above)."""
     p = wp.tid()
     splatted[p] = 0
     f = ph.face[p]
@@ -83,17 +171,38 @@ def splat_footprints(
     scale = floor_map.scale
     u = wp.vec2(eu[0], eu[1]) * scale
     v = wp.vec2(ev[0], ev[1]) * scale
+    base = wp.vec2i(0, 0)
     q0 = (wp.vec2(hit[0], hit[1]) - floor_map.origin) * scale - 0.5 * (u + v)
-    if floor_map.wrap != 0:
+    if flat_plane != 0:
+        h64 = plane_hit64(positions, ph, p, plane_z)
+        eu64 = lattice_step64(positions, ph, face_receiver, p, 0, plane_z, h64)
+        ev64 = lattice_step64(positions, ph, face_receiver, p, 1, plane_z, h64)
+        sc = wp.float64(scale)
+        u64 = wp.vec2d(eu64[0], eu64[1]) * sc
+        v64 = wp.vec2d(ev64[0], ev64[1]) * sc
+        corner = (wp.vec2d(h64[0], h64[1]) - wp.vec2d(wp.float64(floor_map.origin[0]),
+                                                      wp.float64(floor_map.origin[1]))) * sc
+        corner = corner - wp.float64(0.5) * (u64 + v64)
+        whole = wp.vec2d(wp.floor(corner[0]), wp.floor(corner[1]))
+        base = wp.vec2i(int(whole[0]), int(whole[1]))
+        q0 = wp.vec2(float(corner[0] - whole[0]), float(corner[1] - whole[1]))
+        u = wp.vec2(float(u64[0]), float(u64[1]))
+        v = wp.vec2(float(v64[0]), float(v64[1]))
+        if floor_map.wrap != 0:
+            base = wp.vec2i(((base[0] % m) + m) % m, ((base[1] % m) + m) % m)
+    elif floor_map.wrap != 0:
         q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    else:  # a cell reaching past the map's edge (a pool's wall) would lose flux: keep the texel deposit
-        lo = wp.min(wp.min(q0, q0 + u), wp.min(q0 + v, q0 + u + v))
-        hi = wp.max(wp.max(q0, q0 + u), wp.max(q0 + v, q0 + u + v))
+    if floor_map.wrap == 0:  # a cell reaching past the map's edge (a pool's wall) would lose flux
+        at = q0 + wp.vec2(float(base[0]), float(base[1]))
+        lo = wp.min(wp.min(at, at + u), wp.min(at + v, at + u + v))
+        hi = wp.max(wp.max(at, at + u), wp.max(at + v, at + u + v))
         if lo[0] < 0.0 or lo[1] < 0.0 or hi[0] > float(m) or hi[1] > float(m):
-            return
+            return  # keep the texel deposit
     inv_texel_area = scale * scale
-    spread_triangle(dep, q0, u, u + v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area, coarse_count)
-    spread_triangle(dep, q0, u + v, v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area, coarse_count)
+    spread_triangle_at(dep, base, q0, u, u + v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area,
+                       coarse_count)
+    spread_triangle_at(dep, base, q0, u + v, v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area,
+                       coarse_count)
     splatted[p] = 1
 
 

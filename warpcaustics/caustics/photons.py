@@ -12,7 +12,7 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.caustics.receiver_stage import CausticsSetup, PassCaustics, ReceiverStage, receiver_optics
-from warpcaustics.config import Config, Intersection, PhotonSplat
+from warpcaustics.config import Config, FloorShape, Intersection, PhotonSplat
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.kernels.caustics import photon_footprints as footprint_kernels
 from warpcaustics.kernels.caustics import photon_slices as slice_kernels
@@ -143,6 +143,7 @@ class PhotonCaustics(PassCaustics):
         self.light_dir = wp.vec3(*sun.astype(np.float32))  # the photons' direction (set per pass)
         # A flat-floor plane for moving periodic photons by whole periods before they are traced.
         self.plane_z = -cfg.floor.depth_m
+        self.flat_floor = cfg.floor.shape is FloorShape.FLAT
         self.view = self._light_view(
             light_view_direction(sun, group_ior),
             cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 1,
@@ -271,9 +272,11 @@ class PhotonCaustics(PassCaustics):
         traced = self.traced()
         if self.footprint is not None:
             self.footprint.zero_()
+            flat_plane = self.flat_floor and self.cfg.caustics.bounces == 1
             wp.launch(footprint_kernels.splat_footprints, dim=self.weight.shape[0],
                       inputs=[traced, self.receivers.face_receiver, self.receivers.face_normal,
-                              self.spacing_m, self.floor_map],
+                              self.spacing_m, self.floor_map, surface.positions, int(flat_plane),
+                              float(self.plane_z)],
                       outputs=[self.splat_flux, self.footprint, self.coarse_count, self.splatted], device=dev)
             if self.receivers.face_count > self.receivers.floor_face_count:
                 mesh = self.receivers.mesh
