@@ -61,7 +61,7 @@ def test_photon_flux_is_conserved_on_a_rough_ocean(device):
 
 def test_photon_flux_is_conserved_in_a_walled_pool_with_an_object(device):
     """In a pool every transmitted photon lands on the floor, a wall or the object: their fluxes
-    add up to what entered the water (water_type = none)."""
+    add up to what entered the water (water_type = none) to 1e-6 (measured 1e-8 on the CPU)."""
     scene = wc.load_scene(
         CONFIGS / "pool.toml",
         {
@@ -81,7 +81,7 @@ def test_photon_flux_is_conserved_in_a_walled_pool_with_an_object(device):
     on_sphere = result.face_flux_w_nm[result.face_receiver == 2].sum(axis=0, dtype=np.float64)
     assert np.all(on_walls > 0) and np.all(on_sphere > 0)
     total = result.floor_flux_w_nm + on_walls + on_sphere
-    np.testing.assert_allclose(total, result.transmitted_flux_w_nm, rtol=1e-4)
+    np.testing.assert_allclose(total, result.transmitted_flux_w_nm, rtol=1e-6)
 
 
 def newton_errors(scene_overrides, iterations, receiver=0, device="cpu"):
