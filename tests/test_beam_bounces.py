@@ -48,7 +48,7 @@ def _overlap(lo, hi, a, b):
     return np.clip(np.minimum(hi, b) - np.maximum(lo, a), 0.0, None)
 
 
-def test_a_glass_slab_gives_the_analytic_floor_map():
+def test_a_glass_slab_gives_the_analytic_floor_map(device):
     """Still water, the light at θ_w in the water and θ_g in the glass. Followed up from a floor
     point x (heights above the floor h), the straight light is blocked where x + h tan θ_w meets the
     slab; the light through its top and bottom faces reaches x ∈ (−a − h_b tan θ_w,
@@ -58,8 +58,8 @@ def test_a_glass_slab_gives_the_analytic_floor_map():
     the beams' map, on rows well inside the slab's width, away from where the light through the
     slab's side faces lands: texels a beam width clear of every edge to 1e-4; all of them in
     relative L1 within what the sub-beams still across the edges lose (3 %)."""
-    flat = wc.render(_still_sea("beams", [], 1), device="cpu")
-    result = wc.render(_still_sea("beams", [SLAB], 2), device="cpu")
+    flat = wc.render(_still_sea("beams", [], 1), device=device)
+    result = wc.render(_still_sea("beams", [SLAB], 2), device=device)
     e0 = flat.floor_irradiance[:, 32, 32].astype(np.float64)
     uniform = np.broadcast_to(e0[:, None, None], flat.floor_irradiance.shape)
     np.testing.assert_allclose(flat.floor_irradiance, uniform, rtol=1e-5)
@@ -89,11 +89,11 @@ def test_a_glass_slab_gives_the_analytic_floor_map():
     assert 0.98 < t_slab < 1.0
 
 
-def test_bounced_beam_edges_follow_snell():
+def test_bounced_beam_edges_follow_snell(device):
     """The bounced beams' edges, each followed to the floor, land t (tan θ_w − tan θ_g) further
     back along the light than the same edge would without the slab (float64 Snell here), and their
     transmittances are the edge's own times T_wg T_gw."""
-    renderer = wc.Renderer(_still_sea("beams", [SLAB], 2), "cpu")
+    renderer = wc.Renderer(_still_sea("beams", [SLAB], 2), device)
     renderer.render(0.0)
     stage = renderer.method.caustics[0]
     tw, tg, t_slab = _angles()

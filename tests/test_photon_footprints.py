@@ -12,7 +12,7 @@ from helpers import CONFIGS, flat_floor_irradiance, flat_water_scene, fresnel_t_
 
 
 @pytest.mark.parametrize(("subdivisions", "map_m"), [(3, 50), (2, 97), (5, 64), (7, 81), (1, 33)])
-def test_still_water_is_analytic_in_every_texel_at_any_density(subdivisions, map_m):
+def test_still_water_is_analytic_in_every_texel_at_any_density(subdivisions, map_m, device):
     """A periodic still sea, sun 40° high, 3 m deep: every texel reads E_sun cosθ T(θ) e^{−cD/cosθ_t}
     whether or not a texel holds a whole number of photon spacings (the cells of a regular lattice
     tile the floor; exact clipping spreads each over the texels it covers; on a flat floor the cells
@@ -21,7 +21,7 @@ def test_still_water_is_analytic_in_every_texel_at_any_density(subdivisions, map
     scene = flat_water_scene(40.0, 3.0, "pure", **{
         "caustics.method": "photons", "caustics.photon_subdivisions": subdivisions,
         "caustics.map_resolution": map_m, "water.resolution": 32})
-    result = wc.render(scene, device="cpu")
+    result = wc.render(scene, device=device)
     expected = flat_floor_irradiance(result, 40.0, 3.0)
     uniform = np.broadcast_to(expected[:, None, None], result.floor_irradiance.shape)
     np.testing.assert_allclose(result.floor_irradiance, uniform, rtol=1e-6)
@@ -41,7 +41,7 @@ def test_still_pool_is_analytic_inside_its_walls():
         np.testing.assert_allclose(inner, np.broadcast_to(expected[:, None, None], inner.shape), rtol=1e-6)
 
 
-def test_footprints_keep_the_flux_on_a_rough_ocean():
+def test_footprints_keep_the_flux_on_a_rough_ocean(device):
     """No absorption, a rough FFT ocean (focusing, folds at the crests): the floor map's flux equals
     the flux that entered the water to 1e-6 (float32 fluxes and texels summed in float64; measured
     3.5e-7)."""
@@ -49,7 +49,7 @@ def test_footprints_keep_the_flux_on_a_rough_ocean():
         "caustics.method": "photons", "water.resolution": 64, "caustics.map_resolution": 64,
         "optics.water_type": "none", "optics.wavelengths": "rgb", "water.wind_speed_m_s": 8.0,
         "floor.depth_m": 6.0})
-    result = wc.render(scene, device="cpu")
+    result = wc.render(scene, device=device)
     assert result.photon_stats["landed"] == result.photon_stats["carrying"]
     np.testing.assert_allclose(result.floor_flux_w_nm, result.transmitted_flux_w_nm, rtol=1e-6)
 
