@@ -28,6 +28,7 @@ SCENES = {
         ("`ocean_floor.toml` with beams (rippled floor, camera 480×320)", "ocean_floor.toml", {}),
         ("`ocean_floor.toml` with `both`", "ocean_floor.toml", {"caustics.method": "both"}),
         ("`pool_pots.toml` with beams", "pool_pots.toml", {}),
+        ("`two_sided.toml` with beams (a glass ball: bounced beams, camera 480×320)", "two_sided.toml", {}),
     ],
     "photons": [
         ("`ocean.toml` with photons (256², s = 4, 512² map, 16 bands)", "ocean.toml", {}),
@@ -38,6 +39,8 @@ SCENES = {
         ("`ocean_floor.toml` (rippled floor mesh 512² + margin, camera 480×320)", "ocean_floor.toml", {}),
         ("`pool_pots.toml`", "pool_pots.toml", {}),
         ("`buried_in_sand.toml`", "buried_in_sand.toml", {}),
+        ("`two_sided.toml` (a glass ball, 2 bounces)", "two_sided.toml", {}),
+        ("`above_water.toml` with photons (the camera above, shafts from slices)", "above_water.toml", {}),
     ],
 }
 """Per caustic method: (row label, config, overrides); ``caustics.method`` is set to the method

@@ -36,7 +36,8 @@ def photons_bytes(cfg: Config, n: int, k: int, groups: int, periodic: bool, face
     r = cfg.caustics.newton_buffer_resolution if cfg.caustics.intersection is Intersection.NEWTON else 0
     carried = 4 if cfg.caustics.bounces > 1 else 0  # the weight left after the bounces
     footprint = cfg.caustics.photon_splat is PhotonSplat.FOOTPRINT
-    splat = (4 * k if footprint else 0)  # each photon's flux per band for its footprint
+    slices = cfg.camera.enabled and cfg.camera.position_m[2] > 0.0 and cfg.caustics.shafts
+    splat = (4 * k if footprint or slices else 0)  # each photon's flux per band: footprints, slices
     return (
         photon_count(cfg, n, groups, periodic) * (PHOTON_BYTES + carried + splat)
         + (k * m * m * 4 if footprint else 0)
