@@ -69,7 +69,7 @@ class BouncedBeams:
         wp.launch(bounce_kernels.bounce_needs, dim=first,
                   inputs=[mesh, face_receiver, self.optics, stage.beams_per_group, stage.base,
                           stage.direction, stage.weight],
-                  outputs=[self.need, self.slots, self.count_array], device=dev)
+                  outputs=[self.need, self.slots], device=dev)
         wp.utils.array_scan(self.slots, self.offset, inclusive=False)
         total = int(self.offset[-1:].numpy()[0] + self.slots[-1:].numpy()[0])
         if total > self.capacity:

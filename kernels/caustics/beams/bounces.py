@@ -72,6 +72,12 @@ def same_way(tr: BounceTrace, first: BounceTrace) -> bool:
 
 
 @wp.func
+def lost_inside(tr: BounceTrace) -> bool:
+    """Whether an edge's light ended in the objects (beyond the bounce limit, or trapped)."""
+    return tr.bounces > 0 and tr.end != LANDED and tr.end != MISSED
+
+
+@wp.func
 def interior_ray(base: wp.array2d[wp.vec3], direction: wp.array2d[wp.vec3], b: int, lam: wp.vec3):
     """(start, unit direction) of beam b's interior ray at barycentrics ``lam``: the line through
     the points Σ λ_i p_i(z) of its horizontal sections (``section.py``), started on the base plane
@@ -120,7 +126,6 @@ def bounce_needs(
     weight: wp.array[wp.float32],
     need: wp.array[wp.int32],
     slots: wp.array[wp.int32],
-    counts: wp.array[wp.int32],
 ):
     """How primary beam b's light goes on past the objects (``need``) and the bounced slots it
     takes (``slots``: 0, 1 or SPLIT²)."""
@@ -139,15 +144,7 @@ def bounce_needs(
         need[b] = WHOLE
         slots[b] = 1
         return
-    lost = int(0)
-    for tr in range(3):
-        if tr == 0:
-            lost += int(t0.bounces > 0 and t0.end != LANDED and t0.end != MISSED)
-        elif tr == 1:
-            lost += int(t1.bounces > 0 and t1.end != LANDED and t1.end != MISSED)
-        else:
-            lost += int(t2.bounces > 0 and t2.end != LANDED and t2.end != MISSED)
-    if lost == 3:
+    if lost_inside(t0) and lost_inside(t1) and lost_inside(t2):
         return  # beyond the bounce limit or trapped, as a whole
     need[b] = SPLIT_UP
     slots[b] = SPLIT * SPLIT
