@@ -306,8 +306,8 @@ class GridStage(ApproximateStage):
 
     @classmethod
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
-        m = scene.config.caustics.map_resolution  # + the grid's own (K, M, M) floor map
-        return super().bytes_needed(scene, k, groups) + cls.grid_bytes(scene.config) + k * m * m * 4
+        m = scene.config.caustics.map_resolution  # + the grid's own (K, M, M) floor map and texels' floor
+        return super().bytes_needed(scene, k, groups) + cls.grid_bytes(scene.config) + (k * 4 + 16) * m * m
 
     def make(self, mean_ior: float) -> GridCaustics:
         light = self.light
