@@ -129,6 +129,40 @@ def lattice_step64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: w
     return unwrap64(plane_hit64(positions, ph, n, plane_z), hit, ph.periodic, ph.extent_m)
 
 
+@wp.func
+def wall_neighbour_face(ph: Photons, face_receiver: wp.array[wp.int32], p: int, walls_id: int) -> int:
+    """The face of the first of photon p's four grid neighbours that landed on a pool's wall, or −1."""
+    for k in range(4):
+        n = grid_neighbour(p, k / 2, 2 * (k % 2) - 1, ph.quads, ph.subdivisions, ph.periodic)
+        if n >= 0:
+            f = ph.face[n]
+            if f >= 0 and face_receiver[f] == walls_id:
+                return f
+    return -1
+
+
+@wp.func
+def inside_map(at: wp.vec2, u: wp.vec2, v: wp.vec2, m: int) -> float:
+    """Share of the parallelogram (at, at + u, at + u + v, at + v) [texels] inside the map [0, m]²."""
+    px = vec8()
+    py = vec8()
+    px[0] = at[0]
+    py[0] = at[1]
+    px[1] = at[0] + u[0]
+    py[1] = at[1] + u[1]
+    px[2] = at[0] + u[0] + v[0]
+    py[2] = at[1] + u[1] + v[1]
+    px[3] = at[0] + v[0]
+    py[3] = at[1] + v[1]
+    cx, cy, cn = clip_to_slab(px, py, 4, 0, 0.0, float(m))
+    if cn < 3:
+        return 0.0
+    rx, ry, rn = clip_to_slab(cx, cy, cn, 1, 0.0, float(m))
+    if rn < 3:
+        return 0.0
+    return polygon_area(rx, ry, rn) / wp.abs(u[0] * v[1] - u[1] * v[0])
+
+
 @wp.kernel
 def splat_footprints(
     ph: Photons,
@@ -139,8 +173,10 @@ def splat_footprints(
     positions: wp.array2d[wp.vec3],
     flat_plane: int,
     plane_z: float,
+    walls_id: int,
     flux: wp.array4d[wp.float32],
     texels: wp.array3d[wp.float32],
+    face_flux: wp.array2d[wp.float32],
     coarse_count: wp.array[wp.int32],
     splatted: wp.array[wp.int32],
 ):
@@ -148,8 +184,11 @@ def splat_footprints(
     kept in ``flux`` (P, 1, 1, K)) spread over the cell's horizontal projection into ``texels``
     (M, M, K) as irradiance per horizontal texel area; ``splatted[p]`` = 1. Other photons, and those
     whose cell reaches past the edge of a map that does not wrap: 0 (the texel deposit takes
-    them). ``flat_plane``: the floor is the plane z = ``plane_z`` and the photons come straight from
-    the surface ``positions``: the cell is placed in float64 (above)."""
+    them), unless a grid neighbour landed on a pool's wall (receiver ``walls_id``): then the part of
+    the cell inside the map is spread over it as usual and the rest goes to that wall face's flux
+    ``face_flux`` (F_other, K), so that the texels along the wall are exact and the flux is kept.
+    ``flat_plane``: the floor is the plane z = ``plane_z`` and the photons come straight from the
+    surface ``positions``: the cell is placed in float64 (above)."""
     p = wp.tid()
     splatted[p] = 0
     f = ph.face[p]
@@ -192,12 +231,21 @@ def splat_footprints(
             base = wp.vec2i(((base[0] % m) + m) % m, ((base[1] % m) + m) % m)
     elif floor_map.wrap != 0:
         q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    if floor_map.wrap == 0:  # a cell reaching past the map's edge (a pool's wall) would lose flux
+    if floor_map.wrap == 0:  # a cell reaching past the map's edge
         at = q0 + wp.vec2(float(base[0]), float(base[1]))
         lo = wp.min(wp.min(at, at + u), wp.min(at + v, at + u + v))
         hi = wp.max(wp.max(at, at + u), wp.max(at + v, at + u + v))
         if lo[0] < 0.0 or lo[1] < 0.0 or hi[0] > float(m) or hi[1] > float(m):
-            return  # keep the texel deposit
+            wall = wall_neighbour_face(ph, face_receiver, p, walls_id)
+            share = float(0.0)
+            if wall >= 0:
+                share = inside_map(at, u, v, m)
+            if not (share > 0.0):
+                return  # keep the texel deposit (no wall to give the rest to: the flux would be lost)
+            rest = 2.0 * (1.0 - share)  # of the photon's flux (half of it is kept per triangle)
+            for j in range(ph.wavelengths_per_group):
+                k = k0 + j
+                wp.atomic_add(face_flux, wall - ph.floor_face_count, k, rest * flux[p, 0, 0, k])
     inv_texel_area = scale * scale
     spread_triangle_at(dep, base, q0, u, u + v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area,
                        coarse_count)

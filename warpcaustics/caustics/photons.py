@@ -277,8 +277,9 @@ class PhotonCaustics(PassCaustics):
             wp.launch(footprint_kernels.splat_footprints, dim=self.weight.shape[0],
                       inputs=[traced, self.receivers.face_receiver, self.receivers.face_normal,
                               self.spacing_m, self.floor_map, surface.positions, int(flat_plane),
-                              float(self.plane_z)],
-                      outputs=[self.splat_flux, self.footprint, self.coarse_count, self.splatted], device=dev)
+                              float(self.plane_z), WALLS_ID],
+                      outputs=[self.splat_flux, self.footprint, self.face_flux, self.coarse_count,
+                               self.splatted], device=dev)
             if self.receivers.face_count > self.receivers.floor_face_count:
                 mesh = self.receivers.mesh
                 wp.launch(footprint_kernels.splat_receiver_footprints, dim=self.weight.shape[0],
