@@ -183,7 +183,8 @@ class UnderwaterCamera:
     def render_beams(self, beams, shafts: bool) -> wp.array3d:
         """Light the receivers the camera sees by the beams of ``beams``' pass (point-in-beam on the
         G-buffer), add the scan-plane volume caustics, shade: (K, H, W) radiance."""
-        from warpcaustics.caustics.beams import SCREEN_TILE_PIXELS, TileBins
+        from warpcaustics.caustics.beams import SCREEN_TILE_PIXELS
+        from warpcaustics.caustics.tile_bins import TileBins
         from warpcaustics.kernels.caustics import beams as beam_kernels
         from warpcaustics.kernels.caustics.beams import bounds
 
