@@ -34,6 +34,7 @@ from warpcaustics.kernels.caustics.photon_lattice import (
     grid_neighbour,
     on_receiver,
     photon_lattice,
+    stratum_ratio,
 )
 from warpcaustics.kernels.caustics.photons import Photons, bilinear_vec3
 from warpcaustics.kernels.geometry import clip_to_slab, polygon_area, vec8
@@ -123,10 +124,18 @@ def lattice_step64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: w
     or from the backward one (the caller has checked that one of them is)."""
     r = face_receiver[ph.face[p]]
     n = grid_neighbour(p, along_v, 1, ph.quads, ph.subdivisions, ph.periodic)
+    e = wp.vec3d()
     if on_receiver(n, r, ph.face, face_receiver):
-        return unwrap64(hit, plane_hit64(positions, ph, n, plane_z), ph.periodic, ph.extent_m)
-    n = grid_neighbour(p, along_v, -1, ph.quads, ph.subdivisions, ph.periodic)
-    return unwrap64(plane_hit64(positions, ph, n, plane_z), hit, ph.periodic, ph.extent_m)
+        e = unwrap64(hit, plane_hit64(positions, ph, n, plane_z), ph.periodic, ph.extent_m)
+    else:
+        n = grid_neighbour(p, along_v, -1, ph.quads, ph.subdivisions, ph.periodic)
+        e = unwrap64(plane_hit64(positions, ph, n, plane_z), hit, ph.periodic, ph.extent_m)
+    return e * wp.float64(stratum_ratio(p, n, along_v, ph.quads, ph.subdivisions, ph.periodic))
+
+
+MAP_EDGE_SLACK = 1.0e-3
+"""A cell at most this share outside the map (one ending at a pool's wall, to rounding) is spread
+over its inside part, its flux kept."""
 
 
 @wp.func
@@ -237,15 +246,17 @@ def splat_footprints(
         hi = wp.max(wp.max(at, at + u), wp.max(at + v, at + u + v))
         if lo[0] < 0.0 or lo[1] < 0.0 or hi[0] > float(m) or hi[1] > float(m):
             wall = wall_neighbour_face(ph, face_receiver, p, walls_id)
-            share = float(0.0)
-            if wall >= 0:
-                share = inside_map(at, u, v, m)
-            if not (share > 0.0):
+            share = inside_map(at, u, v, m)
+            if wall >= 0 and share > 0.0:
+                rest = 2.0 * (1.0 - share)  # of the photon's flux (half of it is kept per triangle)
+                for j in range(ph.wavelengths_per_group):
+                    k = k0 + j
+                    wp.atomic_add(face_flux, wall - ph.floor_face_count, k, rest * flux[p, 0, 0, k])
+            elif share >= 1.0 - MAP_EDGE_SLACK:  # a cell ending at the map's edge, to rounding
+                for j in range(ph.wavelengths_per_group):
+                    flux[p, 0, 0, k0 + j] = flux[p, 0, 0, k0 + j] / share
+            else:
                 return  # keep the texel deposit (no wall to give the rest to: the flux would be lost)
-            rest = 2.0 * (1.0 - share)  # of the photon's flux (half of it is kept per triangle)
-            for j in range(ph.wavelengths_per_group):
-                k = k0 + j
-                wp.atomic_add(face_flux, wall - ph.floor_face_count, k, rest * flux[p, 0, 0, k])
     inv_texel_area = scale * scale
     spread_triangle_at(dep, base, q0, u, u + v, m, floor_map.wrap, floor_map.max_clipped, inv_texel_area,
                        coarse_count)

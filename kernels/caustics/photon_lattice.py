@@ -76,6 +76,45 @@ def grid_neighbour(p: int, along_v: int, step: int, quads: int, s: int, periodic
 
 
 @wp.func
+def quarter_position(q: int, a: int, s: int, quads: int) -> int:
+    """Along one axis of a walled pool's lattice: where photon a (of s) of quad q sits, in quarters of
+    a stratum of a full surface cell (1/(4s) of a cell) from the wall; the quads at the walls are
+    half cells (``fluxratio.grid_corner``), so their strata are half as wide."""
+    if q == 0:
+        return 2 * a + 1
+    if q == quads - 1:
+        return 2 * s + 4 * s * (q - 1) + 2 * a + 1
+    return 2 * s + 4 * s * (q - 1) + 4 * a + 2
+
+
+@wp.func
+def stratum_ratio(p: int, n: int, along_v: int, quads: int, s: int, periodic: int) -> float:
+    """Photon p's stratum width along u or v over its distance on the surface to grid neighbour n:
+    1 on a periodic sea, where the lattice is uniform; in a walled pool the step to a neighbour
+    across the seam of a wall's half-width quad is scaled by it, so that each cell spans its own
+    stratum and the cells tile the floor there too (exactly 1 away from the seams)."""
+    if periodic != 0:
+        return 1.0
+    ss = s * s
+    cp = p / ss
+    cn = n / ss
+    qp = (cp / quads) % quads
+    qn = (cn / quads) % quads
+    ap = (p % ss) / s
+    an = (n % ss) / s
+    if along_v == 0:
+        qp = cp % quads
+        qn = cn % quads
+        ap = (p % ss) % s
+        an = (n % ss) % s
+    width = 4
+    if qp == 0 or qp == quads - 1:
+        width = 2
+    distance = wp.abs(quarter_position(qn, an, s, quads) - quarter_position(qp, ap, s, quads))
+    return float(width) / float(distance)
+
+
+@wp.func
 def lattice_step(
     hit: wp.array[wp.vec3],
     face: wp.array[wp.int32],
@@ -93,10 +132,12 @@ def lattice_step(
     r = face_receiver[face[p]]
     n = grid_neighbour(p, along_v, 1, quads, s, periodic)
     if on_receiver(n, r, face, face_receiver):
-        return unwrap(hit[p], hit[n], periodic, extent_m), int(1)
+        ratio = stratum_ratio(p, n, along_v, quads, s, periodic)
+        return unwrap(hit[p], hit[n], periodic, extent_m) * ratio, int(1)
     n = grid_neighbour(p, along_v, -1, quads, s, periodic)
     if on_receiver(n, r, face, face_receiver):
-        return unwrap(hit[n], hit[p], periodic, extent_m), int(1)
+        ratio = stratum_ratio(p, n, along_v, quads, s, periodic)
+        return unwrap(hit[n], hit[p], periodic, extent_m) * ratio, int(1)
     return wp.vec3(0.0), int(0)
 
 
