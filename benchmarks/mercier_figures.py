@@ -106,35 +106,32 @@ def buried_in_sand(overrides: dict | None = None, device: str = "cpu") -> tuple[
     return row, maps
 
 
-def fig7_picture(maps: dict, path: Path) -> None:
-    """The four panels side by side, grey, each scaled by the photons' sand mean; +y up."""
+def grey_grid(rows: list[list[np.ndarray]], path: Path) -> None:
+    """Rows of maps already divided by their scale, as grey tiles (clipped to [0, 1], gamma 2.2,
+    +y up) 4 white pixels apart."""
     from warpcaustics.io.png import write_png
 
-    scale = 2.5 * maps["photons"].mean()
-    tiles = []
-    for name in ("photons_objects", "photons", "eikonal", "eikonal_threshold"):
-        tiles.append(np.clip(maps[name][::-1] / scale, 0, 1) ** (1 / 2.2))
-        tiles.append(np.ones((maps[name].shape[0], 4)))
-    grey = np.concatenate(tiles[:-1], axis=1)
+    lines = []
+    for row in rows:
+        tiles = [x for m in row for x in (np.clip(m[::-1], 0, 1) ** (1 / 2.2), np.ones((m.shape[0], 4)))]
+        lines.append(np.concatenate(tiles[:-1], axis=1))
+        lines.append(np.ones((4, lines[-1].shape[1])))
+    grey = np.concatenate(lines[:-1], axis=0)
     write_png(path, np.repeat((grey * 255).astype(np.uint8)[..., None], 3, axis=2))
+
+
+def fig7_picture(maps: dict, path: Path) -> None:
+    """The four panels side by side, grey, each scaled by the photons' sand mean; +y up."""
+    scale = 2.5 * maps["photons"].mean()
+    names = ("photons_objects", "photons", "eikonal", "eikonal_threshold")
+    grey_grid([[maps[name] / scale for name in names]], path)
 
 
 def picture(maps: dict, path: Path) -> None:
     """Rows of grey maps (flux ratio, eikonal, eikonal with §3.3), each frame scaled by its flux
     ratio's mean so that the rows compare; +y up."""
-    from warpcaustics.io.png import write_png
-
-    rows = []
-    for name in ("fluxratio", "eikonal", "eikonal_threshold"):
-        tiles = []
-        for i, m in enumerate(maps[name]):
-            scale = 2.5 * maps["fluxratio"][i].mean()
-            tiles.append(np.clip(m[::-1] / scale, 0, 1) ** (1 / 2.2))
-            tiles.append(np.ones((m.shape[0], 4)))
-        rows.append(np.concatenate(tiles[:-1], axis=1))
-        rows.append(np.ones((4, rows[-1].shape[1])))
-    grey = np.concatenate(rows[:-1], axis=0)
-    write_png(path, np.repeat((grey * 255).astype(np.uint8)[..., None], 3, axis=2))
+    grey_grid([[m / (2.5 * maps["fluxratio"][i].mean()) for i, m in enumerate(maps[name])]
+               for name in ("fluxratio", "eikonal", "eikonal_threshold")], path)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -75,6 +75,20 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def _side_by_side(images: list[np.ndarray]) -> np.ndarray:
+    """Images (H, W, 3) left to right, 6 white pixels apart."""
+    gap = np.full((images[0].shape[0], 6, 3), 255, np.uint8)
+    return np.concatenate([x for image in images for x in (image, gap)][:-1], axis=1)
+
+
+def _stacked(rows: list[np.ndarray]) -> np.ndarray:
+    """Rows (H, W, 3) top to bottom, padded white to the widest, 6 white pixels apart."""
+    width = max(r.shape[1] for r in rows)
+    rows = [np.pad(r, ((0, 0), (0, width - r.shape[1]), (0, 0)), constant_values=255) for r in rows]
+    gap = np.full((6, width, 3), 255, np.uint8)
+    return np.concatenate([x for row in rows for x in (row, gap)][:-1], axis=0)
+
+
 def _bounce_picture(images: Path) -> None:
     """configs/two_sided.toml by photons and by beams (``caustics.method = "both"``): the floor maps
     (top) and the camera frames (bottom), each tone-mapped as a render's previews are."""
@@ -84,15 +98,8 @@ def _bounce_picture(images: Path) -> None:
     scene = wc.load_scene(ROOT / "configs" / "two_sided.toml", {"caustics.method": "both"})
     result = wc.Renderer(scene, device="cpu").render(0.0)
     photons, beams = result.comparison, result
-    rows = []
-    for view in (_preview, _camera_preview):
-        left, right = view(photons), view(beams)
-        gap = np.full((left.shape[0], 6, 3), 255, np.uint8)
-        rows.append(np.concatenate([left, gap, right], axis=1))
-    width = max(r.shape[1] for r in rows)
-    rows = [np.pad(r, ((0, 0), (0, width - r.shape[1]), (0, 0)), constant_values=255) for r in rows]
-    gap = np.full((6, width, 3), 255, np.uint8)
-    write_png(images / "two_sided_beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1]], axis=0))
+    rows = [_side_by_side([view(photons), view(beams)]) for view in (_preview, _camera_preview)]
+    write_png(images / "two_sided_beams_vs_photons.png", _stacked(rows))
     print(f"wrote {images / 'two_sided_beams_vs_photons.png'}")
 
 
@@ -125,15 +132,10 @@ def _beam_pictures(images: Path) -> None:
         scene = wc.load_scene(ROOT / "configs" / f"{name}.toml", {"caustics.method": "both"})
         renderer = wc.Renderer(scene, device="cpu")
         result = renderer.render(CAMERA_SCENES[name])
-        gap = np.full((result.camera_radiance.shape[1], 6, 3), 255, np.uint8)
-        pair = [_camera_preview(result.comparison), gap, _camera_preview(result)]
-        rows.append(np.concatenate(pair, axis=1))
+        rows.append(_side_by_side([_camera_preview(result.comparison), _camera_preview(result)]))
         if name == "ocean_floor":
             _bounds_plot(renderer, images / "beam_bounds.png")
-    width = max(r.shape[1] for r in rows)
-    rows = [np.pad(r, ((0, 0), (0, width - r.shape[1]), (0, 0)), constant_values=255) for r in rows]
-    gap = np.full((6, width, 3), 255, np.uint8)
-    write_png(images / "beams_vs_photons.png", np.concatenate([rows[0], gap, rows[1], gap, rows[2]], axis=0))
+    write_png(images / "beams_vs_photons.png", _stacked(rows))
     print(f"wrote {images / 'beams_vs_photons.png'} and {images / 'beam_bounds.png'}")
 
 

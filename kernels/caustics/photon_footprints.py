@@ -133,6 +133,14 @@ def lattice_step64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: w
     return e * wp.float64(stratum_ratio(p, n, along_v, ph.quads, ph.subdivisions, ph.periodic))
 
 
+@wp.func
+def add_face_flux(face_flux: wp.array2d[wp.float32], row: int, w: float, ph: Photons, k0: int, ell: float):
+    """face_flux[row, k] += w E(k) e^{−c(k) ℓ} for the photon's bands."""
+    for j in range(ph.wavelengths_per_group):
+        k = k0 + j
+        wp.atomic_add(face_flux, row, k, w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell))
+
+
 MAP_EDGE_SLACK = 1.0e-3
 """A cell at most this share outside the map (one ending at a pool's wall, to rounding) is spread
 over its inside part, its flux kept."""
@@ -220,7 +228,7 @@ def splat_footprints(
     u = wp.vec2(eu[0], eu[1]) * scale
     v = wp.vec2(ev[0], ev[1]) * scale
     base = wp.vec2i(0, 0)
-    q0 = (wp.vec2(hit[0], hit[1]) - floor_map.origin) * scale - 0.5 * (u + v)
+    q0 = wp.vec2(0.0)
     if flat_plane != 0:
         h64 = plane_hit64(positions, ph, p, plane_z)
         eu64 = lattice_step64(positions, ph, face_receiver, p, 0, plane_z, h64)
@@ -238,8 +246,10 @@ def splat_footprints(
         v = wp.vec2(float(v64[0]), float(v64[1]))
         if floor_map.wrap != 0:
             base = wp.vec2i(((base[0] % m) + m) % m, ((base[1] % m) + m) % m)
-    elif floor_map.wrap != 0:
-        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
+    else:
+        q0 = (wp.vec2(hit[0], hit[1]) - floor_map.origin) * scale - 0.5 * (u + v)
+        if floor_map.wrap != 0:
+            q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
     if floor_map.wrap == 0:  # a cell reaching past the map's edge
         at = q0 + wp.vec2(float(base[0]), float(base[1]))
         lo = wp.min(wp.min(at, at + u), wp.min(at + v, at + u + v))
@@ -248,10 +258,8 @@ def splat_footprints(
             wall = wall_neighbour_face(ph, face_receiver, p, walls_id)
             share = inside_map(at, u, v, m)
             if wall >= 0 and share > 0.0:
-                rest = 2.0 * (1.0 - share)  # of the photon's flux (half of it is kept per triangle)
-                for j in range(ph.wavelengths_per_group):
-                    k = k0 + j
-                    wp.atomic_add(face_flux, wall - ph.floor_face_count, k, rest * flux[p, 0, 0, k])
+                rest = (1.0 - share) * ph.weight[p]  # the cell's part beyond the map: the wall's
+                add_face_flux(face_flux, wall - ph.floor_face_count, rest, ph, k0, ell)
             elif share >= 1.0 - MAP_EDGE_SLACK:  # a cell ending at the map's edge, to rounding
                 for j in range(ph.wavelengths_per_group):
                     flux[p, 0, 0, k0 + j] = flux[p, 0, 0, k0 + j] / share
@@ -313,14 +321,6 @@ def cell_axes(eu: wp.vec3, ev: wp.vec3, normal: wp.vec3):
     a_axis = wp.cross(ev, normal)
     b_axis = wp.cross(normal, eu)
     return a_axis / wp.dot(eu, a_axis), b_axis / wp.dot(ev, b_axis)
-
-
-@wp.func
-def add_face_flux(face_flux: wp.array2d[wp.float32], row: int, w: float, ph: Photons, k0: int, ell: float):
-    """face_flux[row, k] += w E(k) e^{−c(k) ℓ} for the photon's bands."""
-    for j in range(ph.wavelengths_per_group):
-        k = k0 + j
-        wp.atomic_add(face_flux, row, k, w * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell))
 
 
 @wp.func

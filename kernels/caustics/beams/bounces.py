@@ -60,21 +60,21 @@ BOUNCE_COUNTS = 3
 
 
 @wp.func
+def lost_inside(tr: BounceTrace) -> bool:
+    """Whether an edge's light ended in the objects (beyond the bounce limit, or trapped)."""
+    return tr.bounces > 0 and tr.end != LANDED and tr.end != MISSED
+
+
+@wp.func
 def same_way(tr: BounceTrace, first: BounceTrace) -> bool:
     """Whether an edge went through the objects as the ``first`` did, and on past them."""
     if tr.bounces == 0 or tr.bounces != first.bounces or tr.signature != first.signature:
         return False
-    if tr.end != LANDED and tr.end != MISSED:
+    if lost_inside(tr):
         return False
     if wp.dot(tr.first_normal, first.first_normal) < MIN_NORMAL_AGREEMENT:
         return False
     return wp.dot(tr.last_normal, first.last_normal) >= MIN_NORMAL_AGREEMENT
-
-
-@wp.func
-def lost_inside(tr: BounceTrace) -> bool:
-    """Whether an edge's light ended in the objects (beyond the bounce limit, or trapped)."""
-    return tr.bounces > 0 and tr.end != LANDED and tr.end != MISSED
 
 
 @wp.func
