@@ -118,19 +118,54 @@ def unwrap64(a: wp.vec3d, b: wp.vec3d, periodic: int, extent_m: float) -> wp.vec
 
 
 @wp.func
+def step_neighbour(ph: Photons, face_receiver: wp.array[wp.int32], n: int, r: int, any_landed: int) -> bool:
+    """Whether grid neighbour n spans p's cell: it landed on p's receiver r (or, ``any_landed``, on
+    any receiver: on a flat floor its ray continued to the plane is as good)."""
+    if any_landed != 0:
+        return n >= 0 and ph.face[n] >= 0
+    return on_receiver(n, r, ph.face, face_receiver)
+
+
+@wp.func
 def lattice_step64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.array[wp.int32], p: int,
-                   along_v: int, plane_z: float, hit: wp.vec3d) -> wp.vec3d:
-    """``lattice_step`` in float64 on the plane: to the forward grid neighbour on the same receiver,
-    or from the backward one (the caller has checked that one of them is)."""
+                   along_v: int, plane_z: float, hit: wp.vec3d, any_landed: int):
+    """(e, ok): ``lattice_step`` in float64 on the plane: to the forward grid neighbour that spans
+    the cell (:func:`step_neighbour`), or from the backward one; ok = 0 if neither does."""
     r = face_receiver[ph.face[p]]
     n = grid_neighbour(p, along_v, 1, ph.quads, ph.subdivisions, ph.periodic)
     e = wp.vec3d()
-    if on_receiver(n, r, ph.face, face_receiver):
+    if step_neighbour(ph, face_receiver, n, r, any_landed):
         e = unwrap64(hit, plane_hit64(positions, ph, n, plane_z), ph.periodic, ph.extent_m)
     else:
         n = grid_neighbour(p, along_v, -1, ph.quads, ph.subdivisions, ph.periodic)
+        if not step_neighbour(ph, face_receiver, n, r, any_landed):
+            return e, int(0)
         e = unwrap64(plane_hit64(positions, ph, n, plane_z), hit, ph.periodic, ph.extent_m)
-    return e * wp.float64(stratum_ratio(p, n, along_v, ph.quads, ph.subdivisions, ph.periodic))
+    return e * wp.float64(stratum_ratio(p, n, along_v, ph.quads, ph.subdivisions, ph.periodic)), int(1)
+
+
+@wp.func
+def flat_cell64(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.array[wp.int32], p: int,
+                plane_z: float, floor_map: FloorMap, m: int, any_landed: int):
+    """(base, q0, u, v, ok): photon p's lattice cell on the floor plane z = ``plane_z`` in float64
+    (its ray and its grid neighbours' continued to the plane, :func:`lattice_step64`), in texels:
+    corner q0 relative to texel ``base`` (wrapped on a periodic map), sides u and v."""
+    h64 = plane_hit64(positions, ph, p, plane_z)
+    eu64, ok_u = lattice_step64(positions, ph, face_receiver, p, 0, plane_z, h64, any_landed)
+    ev64, ok_v = lattice_step64(positions, ph, face_receiver, p, 1, plane_z, h64, any_landed)
+    sc = wp.float64(floor_map.scale)
+    u64 = wp.vec2d(eu64[0], eu64[1]) * sc
+    v64 = wp.vec2d(ev64[0], ev64[1]) * sc
+    corner = (wp.vec2d(h64[0], h64[1]) - wp.vec2d(wp.float64(floor_map.origin[0]),
+                                                  wp.float64(floor_map.origin[1]))) * sc
+    corner = corner - wp.float64(0.5) * (u64 + v64)
+    whole = wp.vec2d(wp.floor(corner[0]), wp.floor(corner[1]))
+    base = wp.vec2i(int(whole[0]), int(whole[1]))
+    if floor_map.wrap != 0:
+        base = wp.vec2i(((base[0] % m) + m) % m, ((base[1] % m) + m) % m)
+    q0 = wp.vec2(float(corner[0] - whole[0]), float(corner[1] - whole[1]))
+    return (base, q0, wp.vec2(float(u64[0]), float(u64[1])), wp.vec2(float(v64[0]), float(v64[1])),
+            ok_u * ok_v)
 
 
 @wp.func
@@ -156,6 +191,23 @@ def wall_neighbour_face(ph: Photons, face_receiver: wp.array[wp.int32], p: int, 
             if f >= 0 and face_receiver[f] == walls_id:
                 return f
     return -1
+
+
+@wp.func
+def floor_neighbour(ph: Photons, p: int) -> int:
+    """1 if one of photon p's eight grid neighbours (the diagonal ones too: the photon in a corner
+    between two walls) landed on the floor, else 0."""
+    for k in range(9):
+        n = p
+        if k % 3 != 1:
+            n = grid_neighbour(n, 0, k % 3 - 1, ph.quads, ph.subdivisions, ph.periodic)
+        if k / 3 != 1 and n >= 0:
+            n = grid_neighbour(n, 1, k / 3 - 1, ph.quads, ph.subdivisions, ph.periodic)
+        if n >= 0 and n != p:
+            f = ph.face[n]
+            if f >= 0 and f < ph.floor_face_count:
+                return 1
+    return 0
 
 
 @wp.func
@@ -230,22 +282,7 @@ def splat_footprints(
     base = wp.vec2i(0, 0)
     q0 = wp.vec2(0.0)
     if flat_plane != 0:
-        h64 = plane_hit64(positions, ph, p, plane_z)
-        eu64 = lattice_step64(positions, ph, face_receiver, p, 0, plane_z, h64)
-        ev64 = lattice_step64(positions, ph, face_receiver, p, 1, plane_z, h64)
-        sc = wp.float64(scale)
-        u64 = wp.vec2d(eu64[0], eu64[1]) * sc
-        v64 = wp.vec2d(ev64[0], ev64[1]) * sc
-        corner = (wp.vec2d(h64[0], h64[1]) - wp.vec2d(wp.float64(floor_map.origin[0]),
-                                                      wp.float64(floor_map.origin[1]))) * sc
-        corner = corner - wp.float64(0.5) * (u64 + v64)
-        whole = wp.vec2d(wp.floor(corner[0]), wp.floor(corner[1]))
-        base = wp.vec2i(int(whole[0]), int(whole[1]))
-        q0 = wp.vec2(float(corner[0] - whole[0]), float(corner[1] - whole[1]))
-        u = wp.vec2(float(u64[0]), float(u64[1]))
-        v = wp.vec2(float(v64[0]), float(v64[1]))
-        if floor_map.wrap != 0:
-            base = wp.vec2i(((base[0] % m) + m) % m, ((base[1] % m) + m) % m)
+        base, q0, u, v, ok = flat_cell64(positions, ph, face_receiver, p, plane_z, floor_map, m, 0)
     else:
         q0 = (wp.vec2(hit[0], hit[1]) - floor_map.origin) * scale - 0.5 * (u + v)
         if floor_map.wrap != 0:
@@ -343,6 +380,31 @@ def cell_faces(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.
     return total
 
 
+@wp.func
+def floor_part(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.array[wp.int32], p: int,
+               plane_z: float, floor_map: FloorMap, flux: wp.array4d[wp.float32],
+               texels: wp.array3d[wp.float32], coarse_count: wp.array[wp.int32], k0: int) -> float:
+    """A wall photon's cell continued along the rays to the floor plane (:func:`flat_cell64`): the
+    part inside the map is spread over it as a floor photon's cell is (the rest lies beyond the
+    wall and is dropped); returns that part's share of the cell (0: nothing spread)."""
+    m = texels.shape[0]
+    base, q0, u, v, ok = flat_cell64(positions, ph, face_receiver, p, plane_z, floor_map, m, 1)
+    if ok == 0:
+        return 0.0
+    share = inside_map(q0 + wp.vec2(float(base[0]), float(base[1])), u, v, m)
+    if share <= 0.0:
+        return 0.0
+    h64 = plane_hit64(positions, ph, p, plane_z)  # the ray continued to the floor
+    ell = ph.path_before[p] + wp.length(wp.vec3(float(h64[0]), float(h64[1]), float(h64[2])) - ph.origin[p])
+    for j in range(ph.wavelengths_per_group):
+        k = k0 + j
+        flux[p, 0, 0, k] = 0.5 * ph.weight[p] * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
+    dep = photon_deposit(texels, flux, k0, ph.wavelengths_per_group, p)
+    inv_texel_area = floor_map.scale * floor_map.scale
+    spread_triangle_at(dep, base, q0, u, u + v, m, 0, floor_map.max_clipped, inv_texel_area, coarse_count)
+    spread_triangle_at(dep, base, q0, u + v, v, m, 0, floor_map.max_clipped, inv_texel_area, coarse_count)
+    return share
+
 @wp.kernel
 def splat_receiver_footprints(
     ph: Photons,
@@ -352,37 +414,59 @@ def splat_receiver_footprints(
     face_receiver: wp.array[wp.int32],
     face_normal: wp.array[wp.vec3],
     spacing_m: float,
+    floor_map: FloorMap,
+    positions: wp.array2d[wp.vec3],
+    flat_plane: int,
+    plane_z: float,
+    walls_id: int,
+    flux: wp.array4d[wp.float32],
+    texels: wp.array3d[wp.float32],
     face_flux: wp.array2d[wp.float32],
+    coarse_count: wp.array[wp.int32],
     splatted: wp.array[wp.int32],
 ):
     """Photon p on a receiver other than the floor with a lattice cell: its flux spread over the
     receiver's faces that the cell covers (``face_flux`` (F_other, K) [W nm^-1]), each its overlap
     / the cell's covered area; ``splatted[p]`` = 1. Runs after :func:`splat_footprints`, which
-    clears ``splatted``; photons it leaves keep the face deposit."""
+    clears ``splatted``; photons it leaves keep the face deposit.
+
+    On a pool's wall (receiver ``walls_id``) above a flat floor (``flat_plane``, as in
+    :func:`splat_footprints`) the cell of a photon next to one on the floor may reach below the
+    floor: that part is the strip of floor between the wall and the floor photons' cells. Its share
+    is the part of the cell, continued along the rays to the floor plane, that lies inside the map;
+    it is spread over the map as a floor photon's cell is (the rest of the continued cell lies
+    beyond the wall and is dropped), and the wall's faces share the rest."""
     p = wp.tid()
     f = ph.face[p]
     if f < ph.floor_face_count:  # the floor's, or no receiver
         return
+    r = face_receiver[f]
+    k0 = (p / ph.photons_per_group) * ph.wavelengths_per_group
+    share = float(0.0)  # the floor's
+    if flat_plane != 0 and r == walls_id and floor_map.wrap == 0 and floor_neighbour(ph, p) != 0:
+        share = floor_part(positions, ph, face_receiver, p, plane_z, floor_map, flux, texels, coarse_count,
+                           k0)
+    c = ph.hit[p]
+    ell = ph.path_before[p] + wp.length(c - ph.origin[p])
+    rest = ph.weight[p] * (1.0 - share)
     eu, ev, ok = photon_lattice(ph.hit, ph.face, face_receiver, face_normal, p, ph.quads, ph.subdivisions,
                                 ph.periodic, ph.extent_m, spacing_m)
-    if ok == 0:
-        return
-    normal = wp.normalize(wp.cross(eu, ev))
-    if wp.dot(normal, face_normal[f]) < 0.0:
-        normal = -normal
-    c = ph.hit[p]
-    corner = 0.5 * (wp.abs(eu) + wp.abs(ev))  # half the cell's box
-    reach = CELL_REACH * wp.max(wp.length(eu), wp.length(ev))
-    lo = c - corner - wp.vec3(reach)
-    hi = c + corner + wp.vec3(reach)
-    r = face_receiver[f]
-    a_axis, b_axis = cell_axes(eu, ev, normal)
-    ell = ph.path_before[p] + wp.length(c - ph.origin[p])
-    k0 = (p / ph.photons_per_group) * ph.wavelengths_per_group
-    covered = cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis, lo,
-                         hi, 0.0, face_flux, ph, k0, ell)  # the cover alone
-    if covered < MIN_CELL_COVER:
-        return
-    cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis, lo, hi,
-               ph.weight[p] / covered, face_flux, ph, k0, ell)  # the deposit, over the same faces
-    splatted[p] = 1
+    if ok != 0:
+        normal = wp.normalize(wp.cross(eu, ev))
+        if wp.dot(normal, face_normal[f]) < 0.0:
+            normal = -normal
+        corner = 0.5 * (wp.abs(eu) + wp.abs(ev))  # half the cell's box
+        reach = CELL_REACH * wp.max(wp.length(eu), wp.length(ev))
+        lo = c - corner - wp.vec3(reach)
+        hi = c + corner + wp.vec3(reach)
+        a_axis, b_axis = cell_axes(eu, ev, normal)
+        covered = cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis,
+                             lo, hi, 0.0, face_flux, ph, k0, ell)  # the cover alone
+        if covered >= MIN_CELL_COVER * (1.0 - share) and covered > 0.0:
+            cell_faces(mesh, points, indices, face_receiver, face_normal, r, normal, c, a_axis, b_axis, lo,
+                       hi, rest / covered, face_flux, ph, k0, ell)  # the deposit, over the same faces
+            splatted[p] = 1
+            return
+    if share > 0.0:  # the floor took its part: the rest goes to the photon's face
+        add_face_flux(face_flux, f - ph.floor_face_count, rest, ph, k0, ell)
+        splatted[p] = 1

@@ -284,8 +284,10 @@ class PhotonCaustics(PassCaustics):
                 mesh = self.receivers.mesh
                 wp.launch(footprint_kernels.splat_receiver_footprints, dim=self.weight.shape[0],
                           inputs=[traced, mesh.id, mesh.points, mesh.indices, self.receivers.face_receiver,
-                                  self.receivers.face_normal, self.spacing_m],
-                          outputs=[self.face_flux, self.splatted], device=dev)
+                                  self.receivers.face_normal, self.spacing_m, self.floor_map,
+                                  surface.positions, int(flat_plane), float(self.plane_z), WALLS_ID],
+                          outputs=[self.splat_flux, self.footprint, self.face_flux, self.coarse_count,
+                                   self.splatted], device=dev)
         wp.launch(
             photon_kernels.deposit_photons,
             dim=self.weight.shape[0],
