@@ -29,7 +29,7 @@ def test_still_water_is_analytic_in_every_texel_at_any_density(subdivisions, map
 
 @pytest.mark.parametrize(("elevation", "subdivisions", "map_m"),
                          [(20.0, 5, 64), (45.0, 4, 64), (75.0, 2, 97)])
-def test_still_pool_is_analytic_inside_its_walls(elevation, subdivisions, map_m):
+def test_still_pool_is_analytic_inside_its_walls(elevation, subdivisions, map_m, device):
     """The same in a walled pool (8 m, 3 m deep): every lit texel reads the analytic irradiance to
     1e-6 but those next to the walls' shadow (whose edge is not analytic), including the rows
     along the two walls the light runs towards. There a floor photon's cell that reaches past the
@@ -42,7 +42,7 @@ def test_still_pool_is_analytic_inside_its_walls(elevation, subdivisions, map_m)
     scene = flat_water_scene(elevation, 3.0, "pure", **{
         "caustics.method": "photons", "caustics.photon_subdivisions": subdivisions,
         "caustics.map_resolution": map_m, "water.resolution": 32, "water.model": "pool"})
-    result = wc.render(scene, device="cpu")
+    result = wc.render(scene, device=device)
     ratio = result.floor_irradiance / flat_floor_irradiance(result, elevation, 3.0)[:, None, None]
     dark = np.pad(ratio[0] < 0.5, 1, constant_values=False)
     near_dark = dark[1:-1, 1:-1] | dark[:-2, 1:-1] | dark[2:, 1:-1] | dark[1:-1, :-2] | dark[1:-1, 2:]
