@@ -280,6 +280,9 @@ def main(argv: list[str] | None = None) -> int:
     # The sun's disk against a point sun (benchmarks/sun_disk.py).
     sun_disk = _in_child("run", args.quick, args.device, module="sun_disk")
 
+    # The crest-shading march over height blocks against the step-by-step one (benchmarks/shading.py).
+    shading = _in_child("run", args.quick, args.device, module="shading")
+
     # The multiple-scattering random walk's photon rate (benchmarks/multiple.py).
     multiple = _in_child("run", args.quick, args.device, module="multiple")
 
@@ -321,6 +324,7 @@ def main(argv: list[str] | None = None) -> int:
         "photon_splats": photon_splats,
         "eikonal": eikonal,
         "sun_disk": sun_disk,
+        "shading": shading,
         "multiple": multiple,
         "small_angle": small_angle,
         "spectra": spectra,

@@ -19,7 +19,7 @@ from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch,
 from warpcaustics.config import Scattering, SkySampling
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.optics import spectra
-from warpcaustics.optics.refraction import height_range, sun_visibility
+from warpcaustics.optics.refraction import height_blocks, height_range, sun_visibility
 from warpcaustics.result import RenderResult
 from warpcaustics.scene import Scene
 from warpcaustics.water import make_water, water_bytes
@@ -133,11 +133,13 @@ class Renderer:
                 f"z = {lowest:.3f} m at t = {time_s:g} s, the floor z = {self.method.floor_top_z:.3f} m; "
                 "make the floor deeper or the waves lower")
         with watch.stage("shading"):
-            visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible)
+            blocks = height_blocks(surface, dev)
+            visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible,
+                                     blocks=blocks)
         if cfg.sky.sampling is SkySampling.HALVES:  # the config check ensures a sky
             self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
-                      watch=watch)
+                      watch=watch, height_blocks=blocks)
         self.method.check_frame(frame)
         out = self.method.render(frame)
         check_finite(out, time_s)

@@ -246,7 +246,8 @@ class FluxRatioStage(CausticStage):
             direction, irradiance = light.sky_directions[i], light.sky_irradiance_per_dir[i]
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
-                visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out)
+                visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out,
+                                         blocks=frame.height_blocks)
             floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
                                         irradiance=irradiance)
             transmitted = transmitted + flux

@@ -134,6 +134,9 @@ class Frame:
     """Lowest and highest surface heights [m]."""
     highest: float
     watch: Stopwatch
+    height_blocks: tuple | None = None
+    """The surface's :func:`~warpcaustics.optics.refraction.height_blocks`, built once for the
+    frame's light directions (None: each shading pass builds its own)."""
 
 
 @dataclass

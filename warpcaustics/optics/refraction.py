@@ -47,15 +47,33 @@ def height_range(surface: Surface, device: str) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
+def height_blocks(surface: Surface, device: str) -> tuple[wp.array2d, wp.array2d]:
+    """The highest vertex of each coarse and fine block of the surface's cells
+    (``refract_kernels.COARSE_CELLS``, ``FINE_CELLS``): what :func:`sun_visibility` steps over.
+    One pass per level over the heights; a frame builds them once for all its light directions."""
+    n = surface.resolution
+    blocks = []
+    for cells in (refract_kernels.COARSE_CELLS, refract_kernels.FINE_CELLS):
+        count = -(-n // cells)
+        highest = wp.empty((count, count), dtype=wp.float32, device=device)
+        wp.launch(refract_kernels.block_heights, dim=(count, count), inputs=[surface.positions, cells],
+                  outputs=[highest], device=device)
+        blocks.append(highest)
+    return blocks[0], blocks[1]
+
+
 def sun_visibility(surface: Surface, sun_dir: np.ndarray, highest_m: float, device: str,
-                   out: wp.array2d | None = None) -> wp.array2d:
-    """(N, N) 1 where a vertex sees the sun, 0 where a crest of the surface shades it."""
+                   out: wp.array2d | None = None, blocks: tuple[wp.array2d, wp.array2d] | None = None
+                   ) -> wp.array2d:
+    """(N, N) 1 where a vertex sees the sun, 0 where a crest of the surface hides it. ``blocks``:
+    this surface's :func:`height_blocks` (built here if not given)."""
     n = surface.resolution
     out = out if out is not None else wp.empty((n, n), dtype=wp.float32, device=device)
+    coarse, fine = blocks if blocks is not None else height_blocks(surface, device)
     z_range = wp.array(np.array([0.0, highest_m], np.float32), dtype=wp.float32, device=device)
     wp.launch(refract_kernels.sun_visibility, dim=(n, n),
               inputs=[surface.positions, wp.vec3(*np.asarray(sun_dir, np.float32)),
-                      float(surface.extent_m), int(surface.periodic), z_range],
+                      float(surface.extent_m), int(surface.periodic), z_range, coarse, fine],
               outputs=[out], device=device)
     return out
 
