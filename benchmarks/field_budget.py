@@ -133,6 +133,16 @@ def merged(path: Path, results: list[dict]) -> list[dict]:
     return [r for name in names for r in (results if name in ran else old) if r["row"] == name]
 
 
+def write_table(path: Path, results: list[dict]) -> None:
+    """The CSV of ``results``, its columns those of every row (a column newer than a row's run is
+    left empty there)."""
+    columns = list(dict.fromkeys(key for r in results for key in r))
+    with path.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, restval="")
+        writer.writeheader()
+        writer.writerows(results)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rows", default=",".join(ROWS), help=f"comma-separated, of: {', '.join(ROWS)}")
@@ -149,11 +159,7 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out) / ("quick" if args.quick else "")
     results = [r for name in names for r in run_row(name, out, args.workers, args.quick)]
     if not args.quick:
-        results = merged(Path(args.csv), results)
-        with open(args.csv, "w", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(results[0]))
-            writer.writeheader()
-            writer.writerows(results)
+        write_table(Path(args.csv), merged(Path(args.csv), results))
     print(table(results) if any(r["row"] == "baseline" for r in results)
           else "\n".join(map(str, results)))
     return 0
