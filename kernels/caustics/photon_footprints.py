@@ -58,6 +58,15 @@ def photon_deposit(texels: wp.array3d[wp.float32], flux: wp.array4d[wp.float32],
     return dep
 
 
+@wp.func
+def half_flux(flux: wp.array4d[wp.float32], ph: Photons, p: int, k0: int, ell: float):
+    """flux[p, 0, 0, k] = ½ w E(k) e^{−c(k) ℓ} in photon p's bands: what each of its cell's two
+    triangles spreads after a water path ``ell``."""
+    for j in range(ph.wavelengths_per_group):
+        k = k0 + j
+        flux[p, 0, 0, k] = 0.5 * ph.weight[p] * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
+
+
 # --- the cells on a flat floor in float64 ------------------------------------------------------
 # float32 hits 2–4 m from the origin are rounded to ~2.4e-7 m each, so neighbouring cells, each
 # placed about its own hit, overlap or leave gaps of that size: 1e-5 of a texel's irradiance. On a
@@ -271,9 +280,7 @@ def splat_footprints(
     hit = ph.hit[p]
     ell = ph.path_before[p] + wp.length(hit - ph.origin[p])
     k0 = g * ph.wavelengths_per_group
-    for j in range(ph.wavelengths_per_group):
-        k = k0 + j
-        flux[p, 0, 0, k] = 0.5 * ph.weight[p] * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
+    half_flux(flux, ph, p, k0, ell)
     dep = photon_deposit(texels, flux, k0, ph.wavelengths_per_group, p)
     m = texels.shape[0]
     scale = floor_map.scale
@@ -396,9 +403,7 @@ def floor_part(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.ar
         return 0.0
     h64 = plane_hit64(positions, ph, p, plane_z)  # the ray continued to the floor
     ell = ph.path_before[p] + wp.length(wp.vec3(float(h64[0]), float(h64[1]), float(h64[2])) - ph.origin[p])
-    for j in range(ph.wavelengths_per_group):
-        k = k0 + j
-        flux[p, 0, 0, k] = 0.5 * ph.weight[p] * ph.sun_irradiance[k] * wp.exp(-ph.attenuation_per_m[k] * ell)
+    half_flux(flux, ph, p, k0, ell)
     dep = photon_deposit(texels, flux, k0, ph.wavelengths_per_group, p)
     inv_texel_area = floor_map.scale * floor_map.scale
     spread_triangle_at(dep, base, q0, u, u + v, m, 0, floor_map.max_clipped, inv_texel_area, coarse_count)
