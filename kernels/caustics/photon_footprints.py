@@ -30,6 +30,7 @@ from warpcaustics.kernels.caustics.fluxratio import (
     wrap_coord,
 )
 from warpcaustics.kernels.caustics.photon_lattice import (
+    MAX_CELL_SPACINGS,
     MIN_CELL_ALIGNMENT,
     grid_neighbour,
     on_receiver,
@@ -390,16 +391,24 @@ def cell_faces(mesh: wp.uint64, points: wp.array[wp.vec3], indices: wp.array[wp.
 @wp.func
 def floor_part(positions: wp.array2d[wp.vec3], ph: Photons, face_receiver: wp.array[wp.int32], p: int,
                plane_z: float, floor_map: FloorMap, flux: wp.array4d[wp.float32],
-               texels: wp.array3d[wp.float32], coarse_count: wp.array[wp.int32], k0: int) -> float:
+               texels: wp.array3d[wp.float32], coarse_count: wp.array[wp.int32], k0: int,
+               spacing_m: float) -> float:
     """A wall photon's cell continued along the rays to the floor plane (:func:`flat_cell64`): the
     part inside the map is spread over it as a floor photon's cell is (the rest lies beyond the
-    wall and is dropped); returns that part's share of the cell (0: nothing spread)."""
+    wall and is dropped); returns that part's share of the cell (0: nothing spread). A cell that
+    ``photon_lattice`` would refuse on the floor (flat, or longer than ``MAX_CELL_SPACINGS``
+    spacings: a fold of the light) is not spread."""
     m = texels.shape[0]
     base, q0, u, v, ok = flat_cell64(positions, ph, face_receiver, p, plane_z, floor_map, m, 1)
     if ok == 0:
         return 0.0
-    share = inside_map(q0 + wp.vec2(float(base[0]), float(base[1])), u, v, m)
-    if share <= 0.0:
+    longest = wp.max(wp.length(u), wp.length(v))
+    if wp.abs(u[0] * v[1] - u[1] * v[0]) <= 1.0e-6 * longest * longest:
+        return 0.0
+    if longest > MAX_CELL_SPACINGS * spacing_m * floor_map.scale:
+        return 0.0
+    share = wp.min(inside_map(q0 + wp.vec2(float(base[0]), float(base[1])), u, v, m), 1.0)
+    if not (share > 0.0):  # NaN too
         return 0.0
     h64 = plane_hit64(positions, ph, p, plane_z)  # the ray continued to the floor
     ell = ph.path_before[p] + wp.length(wp.vec3(float(h64[0]), float(h64[1]), float(h64[2])) - ph.origin[p])
@@ -450,7 +459,7 @@ def splat_receiver_footprints(
     share = float(0.0)  # the floor's
     if flat_plane != 0 and r == walls_id and floor_map.wrap == 0 and floor_neighbour(ph, p) != 0:
         share = floor_part(positions, ph, face_receiver, p, plane_z, floor_map, flux, texels, coarse_count,
-                           k0)
+                           k0, spacing_m)
     c = ph.hit[p]
     ell = ph.path_before[p] + wp.length(c - ph.origin[p])
     rest = ph.weight[p] * (1.0 - share)
