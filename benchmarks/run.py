@@ -283,6 +283,9 @@ def main(argv: list[str] | None = None) -> int:
     # The crest-shading march over height blocks against the step-by-step one (benchmarks/shading.py).
     shading = _in_child("run", args.quick, args.device, module="shading")
 
+    # The flux-ratio deposit by the footprints' edges against clipping every texel (benchmarks/deposit.py).
+    deposit = _in_child("run", args.quick, args.device, module="deposit")
+
     # The multiple-scattering random walk's photon rate (benchmarks/multiple.py).
     multiple = _in_child("run", args.quick, args.device, module="multiple")
 
@@ -325,6 +328,7 @@ def main(argv: list[str] | None = None) -> int:
         "eikonal": eikonal,
         "sun_disk": sun_disk,
         "shading": shading,
+        "deposit": deposit,
         "multiple": multiple,
         "small_angle": small_angle,
         "spectra": spectra,

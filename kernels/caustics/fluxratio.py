@@ -2,10 +2,15 @@
 
 The footprint of a surface triangle's refracted rays on the horizontal floor plane is the
 horizontal section of its caustic volume (Sandberg & Falemo 2005; Ernst et al. 2005). Its flux is
-spread over the footprint by exact area overlap with each texel (Sutherland–Hodgman clipping), so
-the flux deposited equals the triangle's flux to rounding, whatever the footprint's size or
-orientation (folded footprints count by their unsigned area). Texel indices wrap: the surface
-and the floor map are periodic with period L (in walled pools light beyond the walls is dropped).
+spread over the footprint by exact area overlap with each texel, so the flux deposited equals the
+triangle's flux to rounding, whatever the footprint's size or orientation (folded footprints count
+by their unsigned area). Texel indices wrap: the surface and the floor map are periodic with period
+L (in walled pools light beyond the walls is dropped).
+
+This module holds the triangles' fluxes and the overlap by clipping against each texel
+(Sutherland–Hodgman, :func:`spread_triangle`), which the photons' footprints use; the flux-ratio
+map's own deposit accumulates the same overlaps by the footprints' edges
+(``kernels/caustics/coverage.py``), at the cost of their perimeter rather than their area.
 
 Surface triangles: each quad of the vertex grid splits into ``half = 0``: corners (0,0), (1,0),
 (1,1) and ``half = 1``: (0,0), (1,1), (0,1), both counter-clockwise seen from above (see
@@ -325,63 +330,6 @@ def spread_triangle_at(
             if rn >= 3:
                 w = polygon_area(rx, ry, rn) / area * inv_texel_area
                 add_to_texel(dep, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
-
-
-@wp.kernel
-def deposit_footprints(
-    hit_xy: wp.array3d[wp.vec2],
-    flux_w_nm: wp.array4d[wp.float32],
-    wavelengths_per_group: int,
-    extent_m: float,
-    periodic: int,
-    floor_map: FloorMap,
-    floor_texels: wp.array3d[wp.float32],
-    coarse_count: wp.array[wp.int32],
-):
-    """Spread triangle (iy, ix, half)'s flux over its floor footprint for index group g.
-
-    ``floor_texels`` is (M, M, K) [W m^-2 nm^-1] (wavelengths contiguous: one cache line per
-    texel); texel (ty, tx) spans ``origin + [tx, tx+1] / scale`` in x. Weight of a texel = overlap
-    area / footprint area. On a window of a periodic sea each footprint is taken at its periodic
-    image nearest the window. Footprints whose bounding box within the map exceeds
-    ``MAX_CLIPPED_TEXELS`` are deposited by area samples instead and counted in ``coarse_count``.
-    """
-    g, iy, ix, half = wp.tid()
-    n = hit_xy.shape[1]
-    m = floor_texels.shape[0]
-    k_begin = g * wavelengths_per_group
-    group_flux = float(0.0)
-    for j in range(wavelengths_per_group):
-        group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
-    if group_flux <= 0.0:
-        return  # facing away from the sun, fully reflected or fully absorbed: nothing to spread
-    dep = TriangleDeposit()
-    dep.floor_texels = floor_texels
-    dep.flux_w_nm = flux_w_nm
-    dep.k_begin = k_begin
-    dep.k_count = wavelengths_per_group
-    dep.iy = iy
-    dep.ix = ix
-    dep.half = half
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
-    scale = floor_map.scale
-    wrap = floor_map.wrap
-    # Footprint in texel units: corner 0 wrapped into [0, M) (a whole-period shift leaves the
-    # periodic deposit unchanged and keeps indices small), edges taken in metres first so their
-    # precision does not depend on where the footprint lies.
-    a = hit_xy[g, y0, x0] + s0
-    e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
-    e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
-    if periodic != 0 and wrap == 0:
-        # a window of a periodic sea: the footprint's periodic image nearest the window
-        a = a - extent_m * wp.vec2(wp.round((a[0] - floor_map.centre[0]) / extent_m),
-                                   wp.round((a[1] - floor_map.centre[1]) / extent_m))
-    q0 = (a - floor_map.origin) * scale
-    if wrap != 0:
-        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    spread_triangle(dep, q0, e1, e2, m, wrap, floor_map.max_clipped, scale * scale, coarse_count)
 
 
 @wp.kernel

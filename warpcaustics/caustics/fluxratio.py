@@ -12,6 +12,7 @@ from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
 from warpcaustics.config import FloorShape, Scattering, SkySampling
+from warpcaustics.kernels.caustics import coverage as cover_kernels
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
 from warpcaustics.scene.receivers import albedo_spectrum
@@ -26,7 +27,8 @@ def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
     triangle_flux = (k + groups) * 2 * (n + 1) * (n + 1) * 4  # delivered per band; entering per group
-    return refraction + triangle_flux + 2 * k * m * m * 4  # accumulation texels + band images
+    return refraction + triangle_flux + k * m * (m + 1) * 8 + 2 * k * m * m * 4  # differences, carry;
+    # the clipped footprints' texels, the band images
 
 
 class FloorCaustics:
@@ -53,7 +55,13 @@ class FloorCaustics:
         A⊥·mean T [m²]."""
         self.last_irradiance = self.sun_irradiance
         """The (K,) irradiance the last :meth:`run` used."""
+        self.cover = wp.empty((m, m, k), dtype=wp.float64, device=device)
+        """The deposit's differences along the map's rows (M, M, K), float64
+        (``kernels/caustics/coverage.py``)."""
+        self.carry = wp.empty((m, k), dtype=wp.float64, device=device)
+        """Where each row's prefix sum starts (M, K): the cover carried over a periodic map's seam."""
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
+        """The small footprints' overlaps, clipped texel by texel (M, M, K)."""
         self.irradiance = wp.empty((k, m, m), dtype=wp.float32, device=device)
         """Floor spectral irradiance (K, M, M) [W m^-2 nm^-1]."""
         self.coarse_count = wp.zeros(1, dtype=wp.int32, device=device)
@@ -65,7 +73,7 @@ class FloorCaustics:
         """Where the M×M map lies: the whole patch of side ``extent_m``, or the window. On a
         periodic sea a window as wide as the patch wraps (it is the patch, shifted), and a window's
         centre is reduced to the period nearest the origin (float32 positions stay small)."""
-        m = self.texels.shape[0]
+        m = self.irradiance.shape[1]
         side, centre = (extent_m, (0.0, 0.0)) if self.window is None else self.window
         centre = np.asarray(centre, np.float64)
         if self.periodic:
@@ -80,18 +88,20 @@ class FloorCaustics:
         return fm
 
     def run(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray, *,
-            clear: bool = True, irradiance: wp.array | None = None) -> wp.array3d:
+            clear: bool = True, irradiance: wp.array | None = None, bands: bool = True) -> wp.array3d:
         """Fill :attr:`irradiance`. On a periodic surface every triangle's flux lands on the floor,
         so per band ``sum(irradiance) * texel_area == sum(flux)`` to rounding; in a walled pool
         the flux that would land beyond the walls is not followed. ``clear = False`` adds to the
         last run's map (the directions of a sun disk, each with its share in ``sun_irradiance``);
-        ``irradiance`` (K,) replaces ``sun_irradiance`` for this run (a direction of the sky)."""
+        ``irradiance`` (K,) replaces ``sun_irradiance`` for this run (a direction of the sky).
+        ``bands = False`` leaves :attr:`irradiance` as it was, for a run whose map a later one adds
+        to (the prefix sums of the deposit's differences are taken once, when the map is read)."""
         quads = self.flux.shape[0]
         self.last_irradiance = self.sun_irradiance if irradiance is None else irradiance
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
         k = self.sun_irradiance.shape[0]
-        m = self.texels.shape[0]
+        m = self.irradiance.shape[1]
         groups = refracted.hit_xy.shape[0]
         per_group = k // groups
         wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
@@ -102,14 +112,17 @@ class FloorCaustics:
                           int(surface.periodic)],
                   outputs=[self.flux, self.entering], device=self.device)
         if clear:
+            self.cover.zero_()
+            self.carry.zero_()
             self.texels.zero_()
             self.coarse_count.zero_()
-        wp.launch(floor_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
+        wp.launch(cover_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
                   inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
                           int(surface.periodic), self.floor_map(float(surface.extent_m))],
-                  outputs=[self.texels, self.coarse_count], device=self.device)
-        wp.launch(floor_kernels.texels_to_bands, dim=(m, m), inputs=[self.texels],
-                  outputs=[self.irradiance], device=self.device)
+                  outputs=[self.cover, self.carry, self.texels, self.coarse_count], device=self.device)
+        if bands:
+            wp.launch(cover_kernels.cover_to_bands, dim=(m, k), inputs=[self.cover, self.carry, self.texels],
+                      outputs=[self.irradiance], device=self.device)
         return self.irradiance
 
     def entering_flux(self) -> np.ndarray:
@@ -178,9 +191,10 @@ class FluxRatioStage(CausticStage):
         # the flux (the deposit's irradiance was divided by their number); crests shade by the
         # disk's centre.
         flux = 0.0  # (2, K): entering the water, delivered to the floor
+        last = len(self.light.sun_directions) - 1
         for i, direction in enumerate(self.light.sun_directions):
             floor, pass_flux = self._deposit(frame, frame.visible, direction,
-                                             ("refraction", "floor_caustics"), clear=i == 0)
+                                             ("refraction", "floor_caustics"), clear=i == 0, bands=i == last)
             flux = flux + pass_flux
         with watch.stage("readback"):
             # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
@@ -248,8 +262,9 @@ class FluxRatioStage(CausticStage):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
                 visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out,
                                          blocks=frame.height_blocks)
+            read = separate or n == count - 1 or (halves and n == count // 2 - 1)  # this map is read next
             floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
-                                        irradiance=irradiance)
+                                        irradiance=irradiance, bands=read)
             transmitted = transmitted + flux
             if separate:
                 one = floor.numpy().copy()
@@ -262,7 +277,7 @@ class FluxRatioStage(CausticStage):
         return (floor.numpy().copy() if total is None else total), transmitted, even
 
     def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
-                 irradiance: wp.array | None = None) -> tuple[wp.array3d, np.ndarray]:
+                 irradiance: wp.array | None = None, bands: bool = True) -> tuple[wp.array3d, np.ndarray]:
         """One flux-ratio pass for light arriving from ``direction`` (the sun's centre, a point of
         its disk or of the sky): refraction, then the deposit added to the map unless ``clear``;
         returns the map and the pass's (2, K) flux per band entering the water and delivered to the
@@ -271,7 +286,8 @@ class FluxRatioStage(CausticStage):
             refracted = refract_to_floor(frame.surface, visible, self.light.group_ior, direction,
                                          -self.scene.config.floor.depth_m, self.device, out=self.refracted)
         with frame.watch.stage(stages[1]):
-            floor = self.floor.run(frame.surface, refracted, direction, clear=clear, irradiance=irradiance)
+            floor = self.floor.run(frame.surface, refracted, direction, clear=clear, irradiance=irradiance,
+                                   bands=bands)
             flux = np.stack([self.floor.entering_flux(),
                              self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
         return floor, flux
