@@ -43,6 +43,8 @@ ROWS: dict[str, tuple[dict | None, str]] = {
                          "Elfouhaily et al. 1997 on 7.8 mm cells"),
     "elfouhaily_0.4cm": ({"water.spectrum": "elfouhaily", "water.extent_m": 8.0, "water.resolution": 2048},
                          "Elfouhaily et al. 1997 on 3.9 mm cells over the same 8 m (does 7.8 mm converge?)"),
+    "elfouhaily_0.2cm": ({"water.spectrum": "elfouhaily", "water.extent_m": 8.0, "water.resolution": 4096},
+                         "Elfouhaily et al. 1997 on 1.95 mm cells over the same 8 m (does 3.9 mm converge?)"),
     "cie_clear": ({"sky.model": "cie_clear"}, "CIE clear sky (type 12) at the paper's diffuse share"),
     "point_sun": ({"sun.angular_diameter_deg": 0.0}, "a point sun instead of the 0.53° disk"),
     "choppy": ({"water.choppiness": 1.0}, "Lagrangian (choppy) displacement, λ = 1"),
