@@ -14,7 +14,7 @@ M = 12
 @wp.kernel
 def _deposit(q0: wp.array[wp.vec2], e1: wp.array[wp.vec2], e2: wp.array[wp.vec2],
              flux: wp.array4d[wp.float32], m: int, wrap: int, max_clipped: int,
-             cover: wp.array3d[wp.float64], carry: wp.array2d[wp.float64], texels: wp.array3d[wp.float32],
+             cover: wp.array3d[wp.float32], carry: wp.array2d[wp.float64], texels: wp.array3d[wp.float32],
              coarse: wp.array[wp.int32]):
     t = wp.tid()
     dep = CoverDeposit()
@@ -35,7 +35,7 @@ def _edge_accumulated(q0, e1, e2, flux, wrap, max_clipped, device):
     t = len(q0)
     vec = [wp.array(a.astype(np.float32), dtype=wp.vec2, device=device) for a in (q0, e1, e2)]
     flux_w = wp.array(flux.astype(np.float32).reshape(t, 1, 1, 1), dtype=wp.float32, device=device)
-    cover = wp.zeros((M, M, 1), dtype=wp.float64, device=device)
+    cover = wp.zeros((M, M, 1), dtype=wp.float32, device=device)
     carry = wp.zeros((M, 1), dtype=wp.float64, device=device)
     texels = wp.zeros((M, M, 1), dtype=wp.float32, device=device)
     coarse = wp.zeros(1, dtype=wp.int32, device=device)

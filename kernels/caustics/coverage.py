@@ -24,8 +24,11 @@ map (``wrap = 1``) a column index i is stored at i mod M; a footprint reaching j
 of its start would leave the cover it carries over the seam out of the prefix sum, so each difference
 stored from period j also takes j times itself off the row's ``carry``, where the prefix sum starts
 (for a difference array a with Σa = 0, Σ_k cov(c + kM) = Σ_{i≤c} Σ_k a[i + kM] − Σ_j j A_j, A_j the
-sum over period j). Rows wrap directly. The differences and the carry are float64: the prefix sums
-cancel the footprints' left and right edges, which float32 would leave as a floor of rounding.
+sum over period j). Rows wrap directly. Each edge piece's shares are formed in float64 and its last
+share is what the others left of its height (the heights taken in float64, where the difference of
+two float32 ends is exact), so a footprint's differences cancel along the row before each is rounded
+once into the float32 buffer; the carry and the prefix sums are float64. What is left beyond a
+footprint is float32 rounding of single adds, not of the footprint's geometry.
 """
 
 import warp as wp
@@ -50,9 +53,9 @@ adds as the edges would make, and less arithmetic: ``python -m benchmarks.deposi
 class CoverDeposit:
     """Where one surface triangle (iy, ix, half)'s flux goes: ``flux_w_nm[iy, ix, half, k]`` for the
     bands ``k_begin`` … ``k_begin + k_count − 1`` of its index group, as differences along the rows
-    of ``cover`` (M, M, K) and ``carry`` (M, K) (the module docstring), or into ``texels``."""
+    of ``cover`` (M, M, K) and ``carry`` (M, K, float64) (the module docstring), or into ``texels``."""
 
-    cover: wp.array3d[wp.float64]
+    cover: wp.array3d[wp.float32]
     carry: wp.array2d[wp.float64]
     texels: wp.array3d[wp.float32]
     """(M, M, K) the small footprints' overlaps, clipped texel by texel and added directly."""
@@ -80,7 +83,7 @@ def add_difference(dep: CoverDeposit, row: int, col: int, value: wp.float64, m: 
     for j in range(dep.k_count):
         k = dep.k_begin + j
         amount = value * wp.float64(dep.flux_w_nm[dep.iy, dep.ix, dep.half, k])
-        wp.atomic_add(dep.cover, row, col, k, amount)
+        wp.atomic_add(dep.cover, row, col, k, wp.float32(amount))
         if period != 0:
             wp.atomic_add(dep.carry, row, k, -wp.float64(period) * amount)
 
@@ -92,7 +95,8 @@ def cover_piece(dep: CoverDeposit, row: int, x0: float, x1: float, d: wp.float64
     column ``col0``), of signed height ``d`` (times the weight): the area to its right within each
     cell it crosses, the rest of ``d`` to the cell after (font-rs's accumulation). The last share is
     what the others left of ``d``, so that the piece's shares sum to ``d`` to float64 rounding
-    whatever the float32 geometry's: the row's differences cancel beyond the footprint."""
+    whatever the float32 geometry's: the row's differences cancel beyond the footprint (each then
+    rounded once, into the float32 buffer)."""
     x0_floor = wp.floor(x0)
     i0 = int(x0_floor)
     x1_ceil = wp.ceil(x1)
@@ -257,7 +261,7 @@ def deposit_footprints(
     extent_m: float,
     periodic: int,
     floor_map: FloorMap,
-    cover: wp.array3d[wp.float64],
+    cover: wp.array3d[wp.float32],
     carry: wp.array2d[wp.float64],
     texels: wp.array3d[wp.float32],
     coarse_count: wp.array[wp.int32],
@@ -308,7 +312,7 @@ def deposit_footprints(
 
 
 @wp.kernel
-def cover_to_bands(cover: wp.array3d[wp.float64], carry: wp.array2d[wp.float64],
+def cover_to_bands(cover: wp.array3d[wp.float32], carry: wp.array2d[wp.float64],
                    texels: wp.array3d[wp.float32], floor_irradiance: wp.array3d[wp.float32]):
     """Row ty of band k: the prefix sum of its differences from its carry, plus the clipped
     footprints' texels, into the (K, M, M) band images. Where no footprint reaches, the sum is zero
@@ -316,6 +320,6 @@ def cover_to_bands(cover: wp.array3d[wp.float64], carry: wp.array2d[wp.float64],
     ty, k = wp.tid()
     total = carry[ty, k]
     for tx in range(cover.shape[1]):
-        total += cover[ty, tx, k]
+        total += wp.float64(cover[ty, tx, k])
         value = total + wp.float64(texels[ty, tx, k])
         floor_irradiance[k, ty, tx] = wp.float32(wp.max(value, wp.float64(0.0)))

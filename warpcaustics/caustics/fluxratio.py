@@ -27,8 +27,8 @@ def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
     refraction = groups * n * n * (8 + 4 + 4) + n * n * 4  # hits, paths, T; sun visibility
     triangle_flux = (k + groups) * 2 * (n + 1) * (n + 1) * 4  # delivered per band; entering per group
-    return refraction + triangle_flux + k * m * (m + 1) * 8 + 2 * k * m * m * 4  # differences, carry;
-    # the clipped footprints' texels, the band images
+    # the deposit's differences, the clipped footprints' texels, the band images; the rows' carry
+    return refraction + triangle_flux + 3 * k * m * m * 4 + k * m * 8
 
 
 class FloorCaustics:
@@ -55,9 +55,8 @@ class FloorCaustics:
         A⊥·mean T [m²]."""
         self.last_irradiance = self.sun_irradiance
         """The (K,) irradiance the last :meth:`run` used."""
-        self.cover = wp.empty((m, m, k), dtype=wp.float64, device=device)
-        """The deposit's differences along the map's rows (M, M, K), float64
-        (``kernels/caustics/coverage.py``)."""
+        self.cover = wp.empty((m, m, k), dtype=wp.float32, device=device)
+        """The deposit's differences along the map's rows (M, M, K) (``kernels/caustics/coverage.py``)."""
         self.carry = wp.empty((m, k), dtype=wp.float64, device=device)
         """Where each row's prefix sum starts (M, K): the cover carried over a periodic map's seam."""
         self.texels = wp.empty((m, m, k), dtype=wp.float32, device=device)
