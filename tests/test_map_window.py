@@ -44,6 +44,23 @@ def test_window_is_the_crop_of_the_whole_map(centre):
     )
 
 
+def test_culling_blocks_away_from_the_window_changes_no_bit():
+    """The deposit on a small window skips the surface's blocks whose floor hits cannot reach it
+    (``coverage.block_reach``): the map is the same to the bit as with every triangle looked at,
+    here across the patch's seam, and most blocks are skipped."""
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {
+        **BASE, "water.resolution": 256, "caustics.map_resolution": 64, "caustics.map_extent_m": 1.0,
+        "caustics.map_center_m": [7.8, -3.0]})
+    culled = wc.Renderer(scene, "cpu")
+    every = wc.Renderer(scene, "cpu")
+    every.method.floor.reach_cells = 0
+    a, b = culled.render(0.5), every.render(0.5)
+    assert np.array_equal(a.floor_irradiance, b.floor_irradiance)
+    assert a.floor_irradiance.max() > 0
+    reach = culled.method.floor.reach.numpy()
+    assert 0 < reach.sum() < 0.5 * reach.size
+
+
 @pytest.mark.parametrize("elevation", [90.0, 30.0])
 def test_millimetre_window_on_still_water_is_the_flat_irradiance(elevation):
     """Still water seen through a 0.1 m window with 0.5 mm texels: every texel has

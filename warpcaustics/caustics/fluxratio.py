@@ -67,6 +67,12 @@ class FloorCaustics:
         """Footprints of the last run deposited by area samples (too large to clip texel by texel)."""
         self.window = window
         self.periodic = periodic
+        cull = periodic and window is not None
+        blocks = -(-n // cover_kernels.REACH_CELLS) if cull else 1
+        self.reach_cells = cover_kernels.REACH_CELLS if cull else 0
+        self.reach = wp.zeros((groups if cull else 1, blocks, blocks), dtype=wp.int32, device=device)
+        """Per index group and block of REACH_CELLS² quads, 1 if its footprints may reach the window
+        (a window of a periodic sea; else unused)."""
 
     def floor_map(self, extent_m: float) -> floor_kernels.FloorMap:
         """Where the M×M map lies: the whole patch of side ``extent_m``, or the window. On a
@@ -99,10 +105,7 @@ class FloorCaustics:
         self.last_irradiance = self.sun_irradiance if irradiance is None else irradiance
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
-        k = self.sun_irradiance.shape[0]
-        m = self.irradiance.shape[1]
-        groups = refracted.hit_xy.shape[0]
-        per_group = k // groups
+        per_group = self.sun_irradiance.shape[0] // refracted.hit_xy.shape[0]
         wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
                           wp.vec3(*np.asarray(sun_dir, np.float32)),
@@ -110,14 +113,28 @@ class FloorCaustics:
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux, self.entering], device=self.device)
+        return self.deposit(surface, refracted, clear=clear, bands=bands)
+
+    def deposit(self, surface: Surface, refracted: Refracted, *, clear: bool = True,
+                bands: bool = True) -> wp.array3d:
+        """:meth:`run`'s deposit of the triangle fluxes it computed (:attr:`flux`) on the floor hits
+        ``refracted``, and with ``bands`` the band images."""
+        groups = refracted.hit_xy.shape[0]
+        quads = self.flux.shape[0]
+        k, m = self.irradiance.shape[0], self.irradiance.shape[1]
+        floor_map = self.floor_map(float(surface.extent_m))
+        if self.reach_cells:
+            wp.launch(cover_kernels.block_reach, dim=self.reach.shape,
+                      inputs=[refracted.hit_xy, self.reach_cells, float(surface.extent_m), floor_map],
+                      outputs=[self.reach], device=self.device)
         if clear:
             self.cover.zero_()
             self.carry.zero_()
             self.texels.zero_()
             self.coarse_count.zero_()
         wp.launch(cover_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
-                  inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
-                          int(surface.periodic), self.floor_map(float(surface.extent_m))],
+                  inputs=[refracted.hit_xy, self.flux, k // groups, float(surface.extent_m),
+                          int(surface.periodic), floor_map, self.reach, self.reach_cells],
                   outputs=[self.cover, self.carry, self.texels, self.coarse_count], device=self.device)
         if bands:
             wp.launch(cover_kernels.cover_to_bands, dim=(m, k), inputs=[self.cover, self.carry, self.texels],
