@@ -27,10 +27,9 @@ import warp as wp
 from warpcaustics.kernels.caustics.fluxratio import (
     FloorMap,
     TriangleDeposit,
-    quad_corner,
+    footprint,
     spread_triangle,
     texels_to_bands,
-    wrap_coord,
 )
 
 from benchmarks.run import CONFIGS, device_record, interleaved_times
@@ -47,7 +46,6 @@ def clipped_deposit(hit_xy: wp.array3d[wp.vec2], flux_w_nm: wp.array4d[wp.float3
                     floor_texels: wp.array3d[wp.float32], coarse_count: wp.array[wp.int32]):
     """The deposit before the edges: each footprint clipped against every texel of its box."""
     g, iy, ix, half = wp.tid()
-    n = hit_xy.shape[1]
     m = floor_texels.shape[0]
     k_begin = g * wavelengths_per_group
     group_flux = float(0.0)  # noqa: UP018 (a dynamic Warp variable)
@@ -63,21 +61,9 @@ def clipped_deposit(hit_xy: wp.array3d[wp.vec2], flux_w_nm: wp.array4d[wp.float3
     dep.iy = iy
     dep.ix = ix
     dep.half = half
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
+    q0, e1, e2 = footprint(hit_xy, g, iy, ix, half, extent_m, periodic, floor_map, m)
     scale = floor_map.scale
-    wrap = floor_map.wrap
-    a = hit_xy[g, y0, x0] + s0
-    e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
-    e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
-    if periodic != 0 and wrap == 0:
-        a = a - extent_m * wp.vec2(wp.round((a[0] - floor_map.centre[0]) / extent_m),
-                                   wp.round((a[1] - floor_map.centre[1]) / extent_m))
-    q0 = (a - floor_map.origin) * scale
-    if wrap != 0:
-        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    spread_triangle(dep, q0, e1, e2, m, wrap, floor_map.max_clipped, scale * scale, coarse_count)
+    spread_triangle(dep, q0, e1, e2, m, floor_map.wrap, floor_map.max_clipped, scale * scale, coarse_count)
 
 
 def direction(zenith_deg: float, azimuth_deg: float = 30.0) -> np.ndarray:

@@ -37,9 +37,8 @@ from warpcaustics.kernels.caustics.fluxratio import (
     DEGENERATE_AREA_TEXELS,
     FloorMap,
     TriangleDeposit,
-    quad_corner,
+    footprint,
     spread_triangle,
-    wrap_coord,
 )
 
 wp.set_module_options({"enable_backward": False})
@@ -281,7 +280,6 @@ def deposit_footprints(
     if reach_cells > 0:
         if reach[g, iy // reach_cells, ix // reach_cells] == 0:
             return
-    n = hit_xy.shape[1]
     m = cover.shape[0]
     k_begin = g * wavelengths_per_group
     group_flux = float(0.0)
@@ -299,25 +297,9 @@ def deposit_footprints(
     dep.iy = iy
     dep.ix = ix
     dep.half = half
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
+    q0, e1, e2 = footprint(hit_xy, g, iy, ix, half, extent_m, periodic, floor_map, m)
     scale = floor_map.scale
-    wrap = floor_map.wrap
-    # Footprint in texel units: corner 0 wrapped into [0, M) (a whole-period shift leaves the
-    # periodic deposit unchanged and keeps indices small), edges taken in metres first so their
-    # precision does not depend on where the footprint lies.
-    a = hit_xy[g, y0, x0] + s0
-    e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
-    e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
-    if periodic != 0 and wrap == 0:
-        # a window of a periodic sea: the footprint's periodic image nearest the window
-        a = a - extent_m * wp.vec2(wp.round((a[0] - floor_map.centre[0]) / extent_m),
-                                   wp.round((a[1] - floor_map.centre[1]) / extent_m))
-    q0 = (a - floor_map.origin) * scale
-    if wrap != 0:
-        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
-    cover_triangle(dep, q0, e1, e2, m, wrap, floor_map.max_clipped, scale * scale, coarse_count)
+    cover_triangle(dep, q0, e1, e2, m, floor_map.wrap, floor_map.max_clipped, scale * scale, coarse_count)
 
 
 @wp.func

@@ -332,6 +332,31 @@ def spread_triangle_at(
                 add_to_texel(dep, texel(i_lo + ci, m, wrap), texel(j_lo + cj, m, wrap), w)
 
 
+@wp.func
+def footprint(hit_xy: wp.array3d[wp.vec2], g: int, iy: int, ix: int, half: int, extent_m: float,
+              periodic: int, floor_map: FloorMap, m: int):
+    """Triangle (iy, ix, half)'s floor footprint for index group g in texels of the M × M map: (q0,
+    e1, e2), its corners q0, q0 + e1, q0 + e2. Corner 0 is wrapped into [0, M) on a whole periodic
+    map (a whole-period shift leaves the periodic deposit unchanged and keeps indices small), taken
+    at its periodic image nearest a window of a periodic sea; the edges are taken in metres first so
+    their precision does not depend on where the footprint lies."""
+    n = hit_xy.shape[1]
+    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
+    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
+    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
+    scale = floor_map.scale
+    a = hit_xy[g, y0, x0] + s0
+    e1 = (hit_xy[g, y1, x1] + s1 - a) * scale
+    e2 = (hit_xy[g, y2, x2] + s2 - a) * scale
+    if periodic != 0 and floor_map.wrap == 0:
+        a = a - extent_m * wp.vec2(wp.round((a[0] - floor_map.centre[0]) / extent_m),
+                                   wp.round((a[1] - floor_map.centre[1]) / extent_m))
+    q0 = (a - floor_map.origin) * scale
+    if floor_map.wrap != 0:
+        q0 = wp.vec2(wrap_coord(q0[0], m), wrap_coord(q0[1], m))
+    return q0, e1, e2
+
+
 @wp.kernel
 def texels_to_bands(floor_texels: wp.array3d[wp.float32], floor_irradiance: wp.array3d[wp.float32]):
     """(M, M, K) accumulation layout → (K, M, M) band images."""
