@@ -57,10 +57,10 @@ command sets the sun, the sky's share and the wind at each point."""
 
 ZENITH_ONLY = {"cells_0.8cm"}
 """Rows run at the three sun zeniths only: 7.8 mm cells put 16× the triangles over the window, about
-150 s of CPU a frame (45 CPU minutes for all six points; ``elfouhaily_0.8cm`` runs them all: 22
-minutes for its three winds on 2 workers); 3.9 mm cells (2048² over 8 m, ``elfouhaily_0.4cm``) put
-4× as many again: 250–500 s a frame at the calm winds, about 2000 s at an 80° sun before the
-shading blocks."""
+150 s of CPU a frame with the clipped deposit (the rows that ran before 2026-12-05). Since the deposit
+by the footprints' edges, a frame on 3.9 mm cells (2048² over 8 m, ``elfouhaily_0.4cm``) takes about a
+minute and on 1.95 mm cells (4096², ``elfouhaily_0.2cm``) 5–8 minutes, most of it the crest shading
+from the sky's low directions (docs/benchmarks.md)."""
 
 
 def command(name: str, out: Path, workers: int, quick: bool) -> list[str]:
