@@ -27,6 +27,7 @@ import warp as wp
 from warpcaustics.kernels.caustics.fluxratio import (
     FloorMap,
     TriangleDeposit,
+    carries_flux,
     footprint,
     spread_triangle,
     texels_to_bands,
@@ -48,10 +49,7 @@ def clipped_deposit(hit_xy: wp.array3d[wp.vec2], flux_w_nm: wp.array4d[wp.float3
     g, iy, ix, half = wp.tid()
     m = floor_texels.shape[0]
     k_begin = g * wavelengths_per_group
-    group_flux = float(0.0)  # noqa: UP018 (a dynamic Warp variable)
-    for j in range(wavelengths_per_group):
-        group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
-    if group_flux <= 0.0:
+    if carries_flux(flux_w_nm, iy, ix, half, k_begin, wavelengths_per_group) == 0:
         return
     dep = TriangleDeposit()
     dep.floor_texels = floor_texels

@@ -37,6 +37,7 @@ from warpcaustics.kernels.caustics.fluxratio import (
     DEGENERATE_AREA_TEXELS,
     FloorMap,
     TriangleDeposit,
+    carries_flux,
     footprint,
     spread_triangle,
 )
@@ -282,11 +283,8 @@ def deposit_footprints(
             return
     m = cover.shape[0]
     k_begin = g * wavelengths_per_group
-    group_flux = float(0.0)
-    for j in range(wavelengths_per_group):
-        group_flux = wp.max(group_flux, flux_w_nm[iy, ix, half, k_begin + j])
-    if group_flux <= 0.0:
-        return  # facing away from the sun, fully reflected or fully absorbed: nothing to spread
+    if carries_flux(flux_w_nm, iy, ix, half, k_begin, wavelengths_per_group) == 0:
+        return
     dep = CoverDeposit()
     dep.cover = cover
     dep.carry = carry

@@ -333,6 +333,17 @@ def spread_triangle_at(
 
 
 @wp.func
+def carries_flux(flux_w_nm: wp.array4d[wp.float32], iy: int, ix: int, half: int, k_begin: int,
+                 k_count: int) -> int:
+    """1 if triangle (iy, ix, half) delivers flux in any band of its index group: one facing away
+    from the light, fully reflected or fully absorbed has nothing to spread."""
+    for j in range(k_count):
+        if flux_w_nm[iy, ix, half, k_begin + j] > 0.0:
+            return 1
+    return 0
+
+
+@wp.func
 def footprint(hit_xy: wp.array3d[wp.vec2], g: int, iy: int, ix: int, half: int, extent_m: float,
               periodic: int, floor_map: FloorMap, m: int):
     """Triangle (iy, ix, half)'s floor footprint for index group g in texels of the M × M map: (q0,
