@@ -212,3 +212,29 @@ def test_upwelling_photons_meet_the_local_surface():
     assert missed.mean() <= 0.005, missed.mean()
     assert np.all(t[missed & found] >= first[missed & found])  # a missed dip, never a crossing too early
     assert found.mean() > 0.5
+
+
+def test_small_angle_mode_honours_the_floor_albedo():
+    """``optics.scattering = "small_angle"`` takes its scattered light's mean from the walk, so it
+    has the walk's boundaries: still water in ``turbid_harbor`` over a 3 m Lambertian floor of
+    albedo 0.5, the sun 40° from the zenith, the surface reflecting upwelling light. Its map is
+    uniform (the transfer of a uniform map), and its Ed(D)/F0 is PythonicDISORT's with both
+    boundaries within 1 % or three standard errors (eight seeds of the walk), above the black
+    floor's."""
+    overrides = {"floor.depth_m": 3.0, "sun.elevation_deg": 50.0, "optics.phase_function": "petzold",
+                 "optics.scattering": "small_angle", "floor.albedo": 0.5, "optics.mc_samples": 16}
+    ratios = []
+    for seed in range(8):
+        scene = wc.load_scene(None, {**BASE, **overrides, "optics.mc_seed": 3000 + seed})
+        r = wc.render(scene, device="cpu")
+        floor = r.floor_irradiance.astype(np.float64)
+        np.testing.assert_allclose(floor.min(axis=(1, 2)), floor.max(axis=(1, 2)), rtol=1e-4)
+        area = scene.config.water.extent_m**2
+        ratios.append(floor.mean(axis=(1, 2)) * area / np.asarray(r.transmitted_flux_w_nm))
+    ratios = np.array(ratios)
+    mean, se = ratios.mean(axis=0), ratios.std(axis=0, ddof=1) / math.sqrt(len(ratios))
+    optics = spectra.water_optics(scene.config.optics, spectra.bins_for(scene.config.optics))
+    for band in range(3):
+        ref = disort_ratio(scene, optics, band, 0.5, True)["ed"]
+        assert abs(mean[band] - ref) <= max(0.01 * ref, 3.0 * se[band]), (band, mean[band], ref, se[band])
+        assert ref > disort_ratio(scene, optics, band, 0.0, True)["ed"]
