@@ -48,9 +48,10 @@ def trapezoid_mean(maps: list[np.ndarray]) -> np.ndarray:
     return sum(w * m for w, m in zip(weights, maps)) / weights.sum()
 
 
-def field_window(zenith: float, quick: bool):
-    """The renderer of the field set-up's 256² × 8 m window (``BEFORE``) at a sun zenith with the
-    paper's diffuse share, its config, its texel and its collector [m]."""
+def field_window(zenith: float, quick: bool, setup: dict | None = None):
+    """The renderer of the field set-up's 256² × 8 m window (``BEFORE``; ``setup``: config overrides
+    in its place) at a sun zenith with the paper's diffuse share, its config, its texel and its
+    collector [m]."""
     import warpcaustics as wc
     from warpcaustics.batch.field import diffuse_fraction
 
@@ -58,16 +59,17 @@ def field_window(zenith: float, quick: bool):
                  "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
     if quick:
         overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
-    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**BEFORE, **overrides})
+    setup = BEFORE if setup is None else setup
+    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**overrides, **setup})
     cfg = scene.config
     texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
     return wc.Renderer(scene, device="cpu"), cfg, texel, cfg.stats.collector_mm * 1e-3
 
 
-def measure(zeniths, windows, dt_s: float, frames: int, quick: bool) -> list[dict]:
+def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, setup: dict | None = None) -> list[dict]:
     rows = []
     for zenith in zeniths:
-        renderer, cfg, texel, collector = field_window(zenith, quick)
+        renderer, cfg, texel, collector = field_window(zenith, quick, setup)
         start = time.perf_counter()
         inst, integ = [], {w: [] for w in windows}
         for f in range(frames):
@@ -148,7 +150,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--dt", type=float, default=1.0 / 120.0, help="spacing of the averaged maps [s]")
     parser.add_argument("--series", type=float, default=0.0, metavar="SECONDS",
                         help="instead: point time series at 6 Hz over SECONDS against the spatial CV")
+    parser.add_argument("--configured", action="store_true",
+                        help="the config as it is (not the set-up before issue 27, BEFORE)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a config override on top (repeatable), e.g. water.resolution=2048")
     args = parser.parse_args(argv)
+    from warpcaustics.config import parse_override
+
+    setup = {**({} if args.configured else BEFORE), **dict(parse_override(text) for text in args.set)}
     if args.quick:
         measure([20.0], [1.0 / 6.0], 1.0 / 24.0, 1, True)
         time_series(20.0, 1.0, 6.0, 4, True)
@@ -157,7 +166,8 @@ def main(argv: list[str] | None = None) -> int:
         for zenith in args.zeniths.split(","):
             time_series(float(zenith), args.series, 6.0, 8, False)
         return 0
-    measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False)
+    measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False,
+            setup)
     return 0
 
 
