@@ -12,6 +12,8 @@ the spatial CV of the instantaneous map against that of the map averaged over th
 average is the trapezoid rule over maps ``dt`` apart (``stats.integrate_series``'s piecewise-linear
 series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 0.5 s apart, pooled.
 ``--quick``: 64² surface, one zenith, one frame, T = 1/6 s at dt = 1/24 s (keeps the script running).
+``--configured`` starts from the config as it is instead of ``BEFORE``, ``--set KEY=VALUE`` changes
+it further (converged cells: ``--set water.extent_m=8.0 --set water.resolution=2048``).
 
 ``--series SECONDS``: the buoy's own statistic instead — E(t) sampled at 6 Hz for SECONDS at 8 × 8
 points of the window, its CV per point (median, 10th and 90th percentiles, and all samples pooled)
