@@ -1,15 +1,19 @@
-"""The crest-shading march (``sun_visibility``) against its step-by-step baseline, same run:
+"""Crest shading: the sweep and the march with blocks against the step-by-step march, same run:
 ``python -m benchmarks.shading [--quick] [--device cpu]``.
 
-Every light direction of a frame (the sun's disk, each sky direction) marches from every surface
-vertex towards the light in half-cell steps until the ray clears the highest crest; at a low sun on
-a fine grid that is hundreds of lookups per vertex (N³ work at a fixed patch size), and the field
-comparisons' sky passes were most of their frames. The kernel now steps over whole blocks of
-cells (64 and 8 on a side) where the ray already runs above the block's highest vertex. The
-baseline is the march as it was, kept here (``stepwise_visibility``; ``tests/test_shading.py``
-checks the two agree to the bit). Sea: ``configs/field/gernez2009.toml``'s (Elfouhaily, 5 m/s) on
-8 m at N², as the field budget's fine rows; the blocks are built once a frame and timed with the
-march. Median of a few calls after a warm-up, device synchronised.
+Every light direction of a frame (the sun's disk, each sky direction) needs the crests' shading of
+every surface vertex. The march goes from every vertex towards the light in half-cell steps until
+the ray clears the highest crest: at a low sun on a fine grid that is hundreds of lookups per
+vertex (N³ work at a fixed patch size), and the field comparisons' sky passes were most of their
+frames. Its kernel steps over whole blocks of cells (64 and 8 on a side) where the ray already runs
+above the block's highest vertex (``march``; walled water still marches); periodic seas are now
+shaded by a sweep down the lines of a lattice aligned with the light's azimuth, a few lookups per
+vertex at any sun (``sweep``, ``kernels/optics/horizon.py``). The baseline is the march as it was,
+kept here (``stepwise_visibility``; ``tests/test_shading.py`` checks the march with blocks agrees with
+it to the bit, ``tests/test_horizon.py`` that the sweep is as close to the surface's shading). Sea:
+``configs/field/gernez2009.toml``'s (Elfouhaily, 5 m/s) on 8 m at N², as the field budget's fine
+rows; the blocks are built once a frame and timed with the march, the sweep's lattice allocated
+once. Median of a few calls after a warm-up, device synchronised.
 """
 
 from __future__ import annotations
@@ -80,20 +84,27 @@ def field_surface(n: int, device: str):
 
 
 def measure(n: int, zenith: float, device: str, repeats: int) -> dict:
-    """One row: the pass with blocks (built inside, as a caller without a frame's blocks does)
-    against the step-by-step baseline, on the field sea at n² over 8 m."""
-    from warpcaustics.optics.refraction import height_blocks, sun_visibility
+    """One row: the sweep and the march with blocks (built inside, as a caller without a frame's
+    blocks does) against the step-by-step baseline, on the field sea at n² over 8 m."""
+    from warpcaustics.optics import refraction
 
-    surface, (_, highest) = field_surface(n, device)
+    surface, (lowest, highest) = field_surface(n, device)
     d = direction(zenith)
-    sides = {"blocks": (lambda: sun_visibility(surface, d, highest, device), 1),
+    lattice = refraction.horizon_buffer(n, device)
+    sweep = refraction.sweep_visibility
+    sides = {"sweep": (lambda: sweep(surface, d, lowest, highest, device, horizon=lattice), 1),
+             "blocks": (lambda: refraction.march_visibility(surface, d, highest, device), 1),
              "stepwise": (lambda: stepwise(surface, d, highest, device), 1),
-             "build": (lambda: height_blocks(surface, device), 1)}
-    same = bool(np.array_equal(sides["blocks"][0]().numpy(), sides["stepwise"][0]().numpy()))
+             "build": (lambda: refraction.height_blocks(surface, device), 1)}
+    march = sides["blocks"][0]().numpy()
+    same = bool(np.array_equal(march, sides["stepwise"][0]().numpy()))
+    differ = float(np.mean(sides["sweep"][0]().numpy() != march))
     times = {k: float(np.median(v)) for k, v in interleaved_times(sides, repeats, device).items()}
-    return {"water_n": n, "extent_m": 8.0, "sun_zenith_deg": zenith, "blocks_s": times["blocks"],
-            "stepwise_s": times["stepwise"], "build_s": times["build"], "same_visibility": same,
-            "speedup": times["stepwise"] / times["blocks"]}
+    return {"water_n": n, "extent_m": 8.0, "sun_zenith_deg": zenith, "sweep_s": times["sweep"],
+            "blocks_s": times["blocks"], "stepwise_s": times["stepwise"], "build_s": times["build"],
+            "same_visibility": same, "sweep_differs": differ, "speedup": times["stepwise"] / times["blocks"],
+            "sweep_vs_blocks": times["blocks"] / times["sweep"],
+            "sweep_vs_stepwise": times["stepwise"] / times["sweep"]}
 
 
 def run(quick: bool, device: str) -> dict:
@@ -106,11 +117,14 @@ def run(quick: bool, device: str) -> dict:
             results.append(row)
             print(f"shading      field sea N={n:5d} over 8 m | sun {zenith:4.0f}° from the zenith | stepwise "
                   f"{row['stepwise_s'] * 1e3:9.1f} ms | blocks {row['blocks_s'] * 1e3:8.1f} ms (their build "
-                  f"{row['build_s'] * 1e3:6.1f} ms) | speed-up {row['speedup']:5.1f}x | "
-                  f"same: {row['same_visibility']}", flush=True)
-    return {"benchmark": "shading_blocks_vs_stepwise", **device_record(device), "repeats": repeats,
-            "timing": "median wall time of one visibility pass (blocks built inside), device synchronised",
-            "results": results}
+                  f"{row['build_s'] * 1e3:6.1f} ms, same: {row['same_visibility']}) | sweep "
+                  f"{row['sweep_s'] * 1e3:8.1f} ms ({row['sweep_differs']:.2%} of vertices differ from the "
+                  f"march) | sweep {row['sweep_vs_blocks']:5.1f}x the blocks, "
+                  f"{row['sweep_vs_stepwise']:5.1f}x stepwise",
+                  flush=True)
+    return {"benchmark": "shading_sweep_and_blocks_vs_stepwise", **device_record(device), "repeats": repeats,
+            "timing": "median wall time of one visibility pass (blocks built inside, the sweep's lattice "
+                      "allocated once), device synchronised", "results": results}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -2,13 +2,14 @@
 (``kernels/optics/refract.py``): the same visibility, to the bit, as the step-by-step march it
 replaced (kept in ``benchmarks/shading.py`` as the benchmark's baseline), on periodic seas (a
 choppy one), on grids that are not a multiple of the blocks and in a walled pool, at every sun from
-the zenith to grazing."""
+the zenith to grazing. (Periodic seas are shaded by the sweep, ``tests/test_horizon.py``; the march
+shades walled water and is the sweep's baseline.)"""
 
 import numpy as np
 import pytest
 
 import warpcaustics as wc
-from warpcaustics.optics.refraction import height_blocks, height_range, sun_visibility
+from warpcaustics.optics.refraction import height_blocks, height_range, march_visibility
 from warpcaustics.pipeline import Renderer
 
 from benchmarks.shading import direction, stepwise
@@ -34,7 +35,7 @@ def test_blocks_give_the_stepwise_visibility_to_the_bit(name, device):
     for zenith in (0.0, 30.0, 60.0, 75.0, 84.0, 88.0):
         for azimuth in (0.0, 30.0, 90.0, 135.0, 250.0):
             d = direction(zenith, azimuth)
-            fast = sun_visibility(surface, d, highest, device, blocks=blocks).numpy()
+            fast = march_visibility(surface, d, highest, device, blocks=blocks).numpy()
             np.testing.assert_array_equal(fast, stepwise(surface, d, highest, device).numpy(),
                                           err_msg=f"{name}: zenith {zenith}°, azimuth {azimuth}°")
             shaded += int((fast == 0.0).sum())

@@ -19,10 +19,16 @@ from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch,
 from warpcaustics.config import Scattering, SkySampling
 from warpcaustics.errors import WarpcausticsError
 from warpcaustics.optics import spectra
-from warpcaustics.optics.refraction import height_blocks, height_range, sun_visibility
+from warpcaustics.optics.refraction import (
+    height_blocks,
+    height_range,
+    horizon_buffer,
+    horizon_bytes,
+    sun_visibility,
+)
 from warpcaustics.result import RenderResult
 from warpcaustics.scene import Scene
-from warpcaustics.water import make_water, water_bytes
+from warpcaustics.water import WATER_MODELS, make_water, water_bytes
 
 __all__ = ["RenderResult", "Renderer", "render", "scene_bytes"]
 
@@ -42,7 +48,8 @@ def scene_bytes(scene: Scene, device: str = "cuda") -> int:
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
     stage = METHODS[cfg.caustics.method].bytes_needed(scene, k, groups)
-    return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, n, keeps_sky_shading(cfg))
+    shading = horizon_bytes(n) if WATER_MODELS[cfg.water.model].periodic else 0  # the sweep's lattice
+    return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, n, keeps_sky_shading(cfg)) + shading
 
 
 HOST_BYTES_PER_PIXEL = 200
@@ -89,6 +96,7 @@ class Renderer:
             self.water = make_water(cfg, self.device, scene.heights, scene.floor_relief)
             n = scene.water_resolution
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
+            self.horizon = horizon_buffer(n, self.device) if self.water.periodic else None
             self.light = Lighting.prepare(scene, self.device, keep_sky_shading=keeps_sky_shading(cfg))
             self.method = METHODS[cfg.caustics.method](scene, self.water, self.light, self.device)
 
@@ -133,13 +141,13 @@ class Renderer:
                 f"z = {lowest:.3f} m at t = {time_s:g} s, the floor z = {self.method.floor_top_z:.3f} m; "
                 "make the floor deeper or the waves lower")
         with watch.stage("shading"):
-            blocks = height_blocks(surface, dev)
+            blocks = None if surface.periodic else height_blocks(surface, dev)  # the march's, on walled water
             visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible,
-                                     blocks=blocks)
+                                     blocks=blocks, lowest_m=lowest, horizon=self.horizon)
         if cfg.sky.sampling is SkySampling.HALVES:  # the config check ensures a sky
             self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
-                      watch=watch, height_blocks=blocks)
+                      watch=watch, height_blocks=blocks, horizon=self.horizon)
         self.method.check_frame(frame)
         out = self.method.render(frame)
         check_finite(out, time_s)

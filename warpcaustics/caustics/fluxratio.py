@@ -277,7 +277,8 @@ class FluxRatioStage(CausticStage):
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
                 visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out,
-                                         blocks=frame.height_blocks)
+                                         blocks=frame.height_blocks, lowest_m=frame.lowest,
+                                         horizon=frame.horizon)
             read = separate or n == count - 1 or (halves and n == count // 2 - 1)  # this map is read next
             floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
                                         irradiance=irradiance, bands=read)

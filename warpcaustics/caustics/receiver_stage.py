@@ -285,7 +285,8 @@ class ReceiverStage(CausticStage):
             if from_sky:
                 with watch.stage("sky"):
                     seen = sun_visibility(frame.surface, direction, frame.highest, self.device,
-                                          out=self.light.sky_visible, blocks=frame.height_blocks)
+                                          out=self.light.sky_visible, blocks=frame.height_blocks,
+                                          lowest_m=frame.lowest, horizon=frame.horizon)
             else:
                 seen = frame.visible  # crests shade by the sun's centre
             # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are

@@ -135,8 +135,11 @@ class Frame:
     highest: float
     watch: Stopwatch
     height_blocks: tuple | None = None
-    """The surface's :func:`~warpcaustics.optics.refraction.height_blocks`, built once for the
-    frame's light directions (None: each shading pass builds its own)."""
+    """A walled surface's :func:`~warpcaustics.optics.refraction.height_blocks`, built once for the
+    frame's light directions (None: each shading pass builds its own, if it marches)."""
+    horizon: wp.array2d | None = None
+    """A periodic surface's :func:`~warpcaustics.optics.refraction.horizon_buffer`, which every
+    light direction's sweep reuses (None: each allocates its own)."""
 
 
 @dataclass

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
 
+from warpcaustics.kernels.optics import horizon as horizon_kernels
 from warpcaustics.kernels.optics import refract as refract_kernels
 from warpcaustics.water import Surface
 
@@ -62,11 +64,81 @@ def height_blocks(surface: Surface, device: str) -> tuple[wp.array2d, wp.array2d
     return blocks[0], blocks[1]
 
 
+def horizon_side(n: int) -> int:
+    """Lattice lines (and points per line, less two) that :func:`sweep_visibility` needs at most for
+    an N² surface: the patch turned by 45° at half a cell, with margins."""
+    return int(math.ceil(2.0 * math.sqrt(2.0) * n)) + 6
+
+
+def horizon_buffer(n: int, device: str) -> wp.array2d:
+    """The sweep's lattice for an N² surface (float32, ``horizon_side`` lines of ``horizon_side`` + 2
+    points; 8 N² floats and more: reused by every light direction of a frame)."""
+    side = horizon_side(n)
+    return wp.empty((side, side + 2), dtype=wp.float32, device=device)
+
+
+def horizon_bytes(n: int) -> int:
+    """Device memory of :func:`horizon_buffer` [bytes]."""
+    side = horizon_side(n)
+    return 4 * (side + 2) * side
+
+
 def sun_visibility(surface: Surface, sun_dir: np.ndarray, highest_m: float, device: str,
-                   out: wp.array2d | None = None, blocks: tuple[wp.array2d, wp.array2d] | None = None
-                   ) -> wp.array2d:
-    """(N, N) 1 where a vertex sees the sun, 0 where a crest of the surface hides it. ``blocks``:
-    this surface's :func:`height_blocks` (built here if not given)."""
+                   out: wp.array2d | None = None, blocks: tuple[wp.array2d, wp.array2d] | None = None, *,
+                   lowest_m: float | None = None, horizon: wp.array2d | None = None) -> wp.array2d:
+    """(N, N) 1 where a vertex sees the sun, 0 where a crest of the surface hides it: on a periodic
+    surface by :func:`sweep_visibility` (``lowest_m``: the surface's lowest height, read back here if
+    not given; ``horizon``: its :func:`horizon_buffer`, allocated here if not given), on a walled one
+    by :func:`march_visibility` (``blocks``: its :func:`height_blocks`, built here if not given)."""
+    d = np.asarray(sun_dir, np.float64)
+    if surface.periodic and d[2] > 1e-6:
+        if lowest_m is None:
+            lowest_m, _ = height_range(surface, device)
+        return sweep_visibility(surface, d, lowest_m, highest_m, device, out=out, horizon=horizon)
+    return march_visibility(surface, d, highest_m, device, out=out, blocks=blocks)
+
+
+def sweep_visibility(surface: Surface, sun_dir: np.ndarray, lowest_m: float, highest_m: float, device: str,
+                     out: wp.array2d | None = None, horizon: wp.array2d | None = None) -> wp.array2d:
+    """(N, N) crest shading of a periodic surface by one sweep down each line of a lattice aligned
+    with the light's azimuth (``kernels/optics/horizon.py``): the march's test of the same half-cell
+    points along the ray, each vertex reading the highest of them from the lattice (bilinear), so
+    its answer differs from the march's only where a crest grazes the ray to within the lattice's
+    interpolation. Light from above the horizon (``sun_dir[2]`` > 0)."""
+    n = surface.resolution
+    out = out if out is not None else wp.empty((n, n), dtype=wp.float32, device=device)
+    d = np.asarray(sun_dir, np.float64)
+    horizontal = math.hypot(d[0], d[1])
+    if horizontal < 1e-6:
+        out.fill_(1.0)  # light from the zenith: a height field cannot shade itself
+        return out
+    horizon = horizon if horizon is not None else horizon_buffer(n, device)
+    extent = float(surface.extent_m)
+    along = d[:2] / horizontal
+    spacing = 0.5 * extent / n
+    rise = spacing * d[2] / horizontal
+    half = 0.5 * extent * (abs(along[0]) + abs(along[1])) + 2.0 * spacing
+    lines = int(math.ceil(2.0 * half / spacing)) + 1
+    # each line starts where a crest could no longer reach a ray from the lowest vertex
+    steps = lines + 2 + int(math.ceil((highest_m - lowest_m) / rise)) + 2
+    heights = out  # the visibility is written over the heights once the sweep has read them
+    wp.launch(horizon_kernels.surface_heights, dim=(n, n), inputs=[surface.positions], outputs=[heights],
+              device=device)
+    lattice = [extent, wp.vec2(*along), wp.vec2(-along[1], along[0]), -half, spacing, rise]
+    wp.launch(horizon_kernels.horizon_sweep, dim=lines, inputs=[heights, *lattice, steps], outputs=[horizon],
+              device=device)
+    wp.launch(horizon_kernels.horizon_visibility, dim=(n, n), inputs=[surface.positions, *lattice, horizon],
+              outputs=[out], device=device)
+    return out
+
+
+def march_visibility(surface: Surface, sun_dir: np.ndarray, highest_m: float, device: str,
+                     out: wp.array2d | None = None, blocks: tuple[wp.array2d, wp.array2d] | None = None
+                     ) -> wp.array2d:
+    """(N, N) crest shading by a march from every vertex towards the light in half-cell steps,
+    stepping over blocks of cells its ray clears (``blocks``: the surface's :func:`height_blocks`,
+    built here if not given); walled surfaces, whose rays leave over the rim, and the baseline of
+    :func:`sweep_visibility`."""
     n = surface.resolution
     out = out if out is not None else wp.empty((n, n), dtype=wp.float32, device=device)
     coarse, fine = blocks if blocks is not None else height_blocks(surface, device)

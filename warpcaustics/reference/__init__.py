@@ -17,15 +17,17 @@ import numpy as np
 from warpcaustics.reference.floor import (
     floor_caustics,
     fresnel_transmittance,
+    march_visibility,
     refract,
     refract_to_floor,
     subtriangle_centroids,
     sun_visibility,
+    sweep_visibility,
     triangles,
 )
 
-__all__ = ["fresnel_transmittance", "floor_caustics", "refract", "refract_to_floor", "relative_l1",
-           "subtriangle_centroids", "sun_visibility", "triangles"]
+__all__ = ["fresnel_transmittance", "floor_caustics", "march_visibility", "refract", "refract_to_floor",
+           "relative_l1", "subtriangle_centroids", "sun_visibility", "sweep_visibility", "triangles"]
 
 
 def relative_l1(reference: np.ndarray, other: np.ndarray) -> float:

@@ -38,10 +38,68 @@ def refract(d: np.ndarray, n: np.ndarray, eta: float) -> np.ndarray:
 
 
 def sun_visibility(positions, sun_dir, extent_m):
-    """(N, N) 1 where a vertex sees the sun over the periodic height field, 0 where shaded.
+    """(N, N) 1 where a vertex sees the sun over the periodic height field, 0 where shaded: the
+    sweep, as the kernels shade a periodic surface (:func:`sweep_visibility`)."""
+    if np.asarray(sun_dir, np.float64)[2] <= 1e-6:
+        return march_visibility(positions, sun_dir, extent_m)
+    return sweep_visibility(positions, sun_dir, extent_m)
 
-    The same half-cell march towards the sun as the kernel, for all vertices at once.
-    """
+
+def _bilinear_heights(z: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Periodic bilinear heights of cell-centre heights ``z`` (N, N) at cell coordinates (u, v)."""
+    n = z.shape[0]
+    i0, j0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
+    tu, tv = u - i0, v - j0
+    return ((1 - tv) * ((1 - tu) * z[j0 % n, i0 % n] + tu * z[j0 % n, (i0 + 1) % n])
+            + tv * ((1 - tu) * z[(j0 + 1) % n, i0 % n] + tu * z[(j0 + 1) % n, (i0 + 1) % n]))
+
+
+def sweep_visibility(positions, sun_dir, extent_m):
+    """(N, N) crest shading by the sweep of ``kernels/optics/horizon.py`` in float64: on a lattice
+    aligned with the light's azimuth, half a cell apart both ways and covering the patch turned to
+    it, F(x) = max(h(x), F(x + δâ) − δk) swept down every line from where no crest can reach a ray,
+    then each vertex shaded where F(p + δâ) − δk (bilinear in the lattice) rises above it."""
+    positions = np.asarray(positions, np.float64)
+    n = positions.shape[0]
+    s = np.asarray(sun_dir, np.float64)
+    horizontal = np.hypot(s[0], s[1])
+    if horizontal < 1e-6:
+        return np.ones((n, n))
+    z = positions[..., 2]
+    along = s[:2] / horizontal
+    across = np.array([-along[1], along[0]])
+    spacing = 0.5 * extent_m / n
+    rise = spacing * s[2] / horizontal
+    half = 0.5 * extent_m * (abs(along[0]) + abs(along[1])) + 2.0 * spacing
+    lines = int(np.ceil(2.0 * half / spacing)) + 1
+    stored = lines + 2
+    steps = stored + int(np.ceil((z.max() - z.min()) / rise)) + 2
+    r = -half + np.arange(lines) * spacing
+    best = np.full(lines, -np.inf)
+    horizon = np.empty((stored, lines))
+    for i in range(steps - 1, -1, -1):
+        x = (-half + i * spacing) * along[0] + r * across[0] + 0.5 * extent_m
+        y = (-half + i * spacing) * along[1] + r * across[1] + 0.5 * extent_m
+        h = _bilinear_heights(z, x * n / extent_m - 0.5, y * n / extent_m - 0.5)
+        best = np.maximum(best, h - i * rise)
+        if i < stored:
+            horizon[i] = best + i * rise
+    x = positions[..., 0] - extent_m * np.floor((positions[..., 0] + 0.5 * extent_m) / extent_m)
+    y = positions[..., 1] - extent_m * np.floor((positions[..., 1] + 0.5 * extent_m) / extent_m)
+    u = (x * along[0] + y * along[1] + spacing + half) / spacing
+    v = (x * across[0] + y * across[1] + half) / spacing
+    i0 = np.clip(np.floor(u).astype(np.int64), 0, stored - 2)
+    j0 = np.clip(np.floor(v).astype(np.int64), 0, lines - 2)
+    tu, tv = u - i0, v - j0
+    highest = ((1 - tu) * ((1 - tv) * horizon[i0, j0] + tv * horizon[i0, j0 + 1])
+               + tu * ((1 - tv) * horizon[i0 + 1, j0] + tv * horizon[i0 + 1, j0 + 1]))
+    return np.where(highest - rise > z + 1e-4 * extent_m / n, 0.0, 1.0)
+
+
+def march_visibility(positions, sun_dir, extent_m, step_cells=0.5):
+    """(N, N) crest shading by the half-cell march towards the sun of ``kernels/optics/refract.py``
+    (walled surfaces, and the sweep's baseline), for all vertices at once; ``step_cells``: the
+    horizontal step in cells (finer: the bilinear surface's own shading, to that step)."""
     n = positions.shape[0]
     s = np.asarray(sun_dir, np.float64)
     horizontal = np.hypot(s[0], s[1])
@@ -50,16 +108,12 @@ def sun_visibility(positions, sun_dir, extent_m):
         return visible
     z = positions[..., 2]
     cell = extent_m / n
-    step = 0.5 * cell / horizontal
+    step = step_cells * cell / horizontal
     steps = np.ceil((z.max() - z) / (s[2] * step)).astype(np.int64) + 1
     for i in range(1, int(steps.max()) + 1):
         q = positions + (i * step) * s
-        u = (q[..., 0] + 0.5 * extent_m) * n / extent_m - 0.5
-        v = (q[..., 1] + 0.5 * extent_m) * n / extent_m - 0.5
-        i0, j0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
-        tu, tv = u - i0, v - j0
-        h = ((1 - tv) * ((1 - tu) * z[j0 % n, i0 % n] + tu * z[j0 % n, (i0 + 1) % n])
-             + tv * ((1 - tu) * z[(j0 + 1) % n, i0 % n] + tu * z[(j0 + 1) % n, (i0 + 1) % n]))
+        h = _bilinear_heights(z, (q[..., 0] + 0.5 * extent_m) * n / extent_m - 0.5,
+                              (q[..., 1] + 0.5 * extent_m) * n / extent_m - 0.5)
         visible[(i <= steps) & (h > q[..., 2] + 1e-4 * cell)] = 0.0
     return visible
 
