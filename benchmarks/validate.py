@@ -95,7 +95,7 @@ def main() -> int:
     a_perp = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]) @ s_dir
     beam = r.sun_irradiance[0] * 64.0 * s_dir[2]
     vis64 = reference.sun_visibility(r.surface_positions.astype(np.float64), s_dir, 8.0)
-    print(f"shaded vertices {1 - renderer.visible.numpy().mean():.1%} (float64 march disagrees on "
+    print(f"shaded vertices {1 - renderer.visible.numpy().mean():.1%} (the float64 sweep disagrees on "
           f"{np.mean(renderer.visible.numpy() != vis64):.2%}); sun-facing area / beam section "
           f"{np.maximum(a_perp, 0).sum() / (64.0 * s_dir[2]):.3f}; floor flux / beam flux "
           f"{r.floor_flux_w_nm[0] / beam:.3f}")
