@@ -28,9 +28,11 @@ SCENE = ROOT / "configs/field/gernez2009.toml"
 ZENITHS = (20.0, 50.0, 80.0)
 SQRT_WINDS = (1.2, 2.4, 3.6)
 
-BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform"}
+BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform",
+          "water.extent_m": 32.0, "water.resolution": 1024}
 """The set-up the budget starts from: configs/field/gernez2009.toml as it was before issue 27 (a
-JONSWAP sea, a uniform sky); every row but the last changes one thing on top of it."""
+JONSWAP sea, a uniform sky, 1024² cells over 32 m); every row but the last changes one thing on top
+of it."""
 
 ROWS: dict[str, tuple[dict | None, str]] = {
     "baseline": ({}, "the set-up before issue 27: JONSWAP, uniform sky, small-angle scattering (Petzold)"),

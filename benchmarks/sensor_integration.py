@@ -50,10 +50,10 @@ def trapezoid_mean(maps: list[np.ndarray]) -> np.ndarray:
     return sum(w * m for w, m in zip(weights, maps)) / weights.sum()
 
 
-def field_window(zenith: float, quick: bool, setup: dict | None = None):
-    """The renderer of the field set-up's 256² × 8 m window (``BEFORE``; ``setup``: config overrides
-    in its place) at a sun zenith with the paper's diffuse share, its config, its texel and its
-    collector [m]."""
+def field_window(zenith: float, quick: bool, start: dict | None = None, extra: dict | None = None):
+    """The renderer of the field set-up's 256² × 8 m window (``start``: the set-up, ``BEFORE`` if
+    None; ``extra``: overrides on top of the window) at a sun zenith with the paper's diffuse share,
+    its config, its texel and its collector [m]."""
     import warpcaustics as wc
     from warpcaustics.batch.field import diffuse_fraction
 
@@ -61,17 +61,18 @@ def field_window(zenith: float, quick: bool, setup: dict | None = None):
                  "sun.elevation_deg": 90.0 - zenith, "sky.diffuse_fraction": diffuse_fraction(zenith)}
     if quick:
         overrides.update({"caustics.map_resolution": 64, "sun.disk_samples": 2, "sky.directions": 2})
-    setup = BEFORE if setup is None else setup
-    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**overrides, **setup})
+    start = BEFORE if start is None else start
+    scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**start, **overrides, **(extra or {})})
     cfg = scene.config
     texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
     return wc.Renderer(scene, device="cpu"), cfg, texel, cfg.stats.collector_mm * 1e-3
 
 
-def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, setup: dict | None = None) -> list[dict]:
+def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, start: dict | None = None,
+            extra: dict | None = None) -> list[dict]:
     rows = []
     for zenith in zeniths:
-        renderer, cfg, texel, collector = field_window(zenith, quick, setup)
+        renderer, cfg, texel, collector = field_window(zenith, quick, start, extra)
         start = time.perf_counter()
         inst, integ = [], {w: [] for w in windows}
         for f in range(frames):
@@ -159,7 +160,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from warpcaustics.config import parse_override
 
-    setup = {**({} if args.configured else BEFORE), **dict(parse_override(text) for text in args.set)}
+    start = {} if args.configured else BEFORE
+    extra = dict(parse_override(text) for text in args.set)
     if args.quick:
         measure([20.0], [1.0 / 6.0], 1.0 / 24.0, 1, True)
         time_series(20.0, 1.0, 6.0, 4, True)
@@ -169,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:
             time_series(float(zenith), args.series, 6.0, 8, False)
         return 0
     measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False,
-            setup)
+            start, extra)
     return 0
 
 

@@ -62,7 +62,8 @@ def resolution_table(n: int) -> list[dict]:
         extent = cell_cm / 100.0 * 1024
         row = {"cell_cm": cell_cm * 1024 / n, "extent_m": extent}
         for spectrum in ("jonswap", "elfouhaily"):
-            cfg = wc.load_scene(field, {"water.spectrum": spectrum, "water.extent_m": extent}).config
+            cfg = wc.load_scene(field, {"water.spectrum": spectrum, "water.extent_m": extent,
+                                        "water.resolution": 1024}).config
             k = wavenumbers(n, extent)
             kx, ky = np.meshgrid(k, k)
             dk = 2.0 * np.pi / extent
@@ -129,7 +130,7 @@ def run(quick: bool, device: str) -> dict:
     from benchmarks.run import interleaved_times
 
     field = ROOT / "configs/field/gernez2009.toml"
-    scenes = {s: wc.load_scene(field, {"water.spectrum": s, "water.resolution": n})
+    scenes = {s: wc.load_scene(field, {"water.spectrum": s, "water.resolution": n, "water.extent_m": 32.0})
               for s in ("jonswap", "elfouhaily")}
     oceans = {s: FFTOcean.from_config(scene.config, device) for s, scene in scenes.items()}
     clock = itertools.count(1)
