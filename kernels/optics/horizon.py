@@ -21,6 +21,19 @@ from warpcaustics.kernels.geometry import bilerp
 wp.set_module_options({"enable_backward": False})
 
 
+@wp.struct
+class Lattice:
+    """The sweep's lattice for one light direction: points start + iδ along ``along`` (the light's
+    horizontal direction) and start + jδ along ``across``, about the patch's centre; ``rise`` = δk."""
+
+    extent_m: float
+    along: wp.vec2
+    across: wp.vec2
+    start: float
+    spacing: float
+    rise: float
+
+
 @wp.kernel
 def surface_heights(positions: wp.array2d[wp.vec3], heights: wp.array2d[wp.float32]):
     """heights[iy, ix] = the vertex's height: the sweep's lookups read 4 bytes a vertex, not 12."""
@@ -29,17 +42,8 @@ def surface_heights(positions: wp.array2d[wp.vec3], heights: wp.array2d[wp.float
 
 
 @wp.kernel
-def horizon_sweep(
-    heights: wp.array2d[wp.float32],
-    extent_m: float,
-    along: wp.vec2,
-    across: wp.vec2,
-    start: float,
-    spacing: float,
-    rise: float,
-    steps: int,
-    horizon: wp.array2d[wp.float32],
-):
+def horizon_sweep(heights: wp.array2d[wp.float32], lattice: Lattice, steps: int,
+                  horizon: wp.array2d[wp.float32]):
     """Line j of the lattice (its points at start + iδ along ``along``, start + jδ along ``across``):
     horizon[j, i] = F at its point i (a line's points side by side, where one thread writes them),
     for the points the array holds, by the recurrence swept from point ``steps`` − 1 down to 0 (the
@@ -49,12 +53,17 @@ def horizon_sweep(
     step (no accumulation either)."""
     j = wp.tid()
     n = heights.shape[0]
+    extent_m = lattice.extent_m
+    along = lattice.along
+    across = lattice.across
+    start = lattice.start
+    rise = lattice.rise
     scale = float(n) / extent_m
-    r = start + float(j) * spacing
+    r = start + float(j) * lattice.spacing
     u0 = (start * along[0] + r * across[0] + 0.5 * extent_m) * scale - 0.5  # cell coordinates of point 0
     v0 = (start * along[1] + r * across[1] + 0.5 * extent_m) * scale - 0.5
-    du = spacing * along[0] * scale
-    dv = spacing * along[1] * scale
+    du = lattice.spacing * along[0] * scale
+    dv = lattice.spacing * along[1] * scale
     stored = horizon.shape[1]
     best = float(-1.0e30)
     for k in range(steps):
@@ -82,21 +91,17 @@ def horizon_sweep(
 
 
 @wp.kernel
-def horizon_visibility(
-    positions: wp.array2d[wp.vec3],
-    extent_m: float,
-    along: wp.vec2,
-    across: wp.vec2,
-    start: float,
-    spacing: float,
-    rise: float,
-    horizon: wp.array2d[wp.float32],
-    visible: wp.array2d[wp.float32],
-):
+def horizon_visibility(positions: wp.array2d[wp.vec3], lattice: Lattice, horizon: wp.array2d[wp.float32],
+                       visible: wp.array2d[wp.float32]):
     """1 where vertex (iy, ix) sees the light, 0 where the highest point ahead, M = F(p + δâ) − δk
     (bilinear in the lattice, p wrapped into the patch), rises above it by more than the march's
     tolerance (1e-4 of a cell)."""
     iy, ix = wp.tid()
+    extent_m = lattice.extent_m
+    along = lattice.along
+    across = lattice.across
+    spacing = lattice.spacing
+    start = lattice.start
     p = positions[iy, ix]
     x = p[0] - extent_m * wp.floor((p[0] + 0.5 * extent_m) / extent_m)
     y = p[1] - extent_m * wp.floor((p[1] + 0.5 * extent_m) / extent_m)
@@ -109,4 +114,4 @@ def horizon_visibility(
     highest = bilerp(horizon[j0, i0], horizon[j0, i0 + 1], horizon[j0 + 1, i0], horizon[j0 + 1, i0 + 1],
                      tu, tv)
     cell = extent_m / float(positions.shape[0])
-    visible[iy, ix] = wp.where(highest - rise > p[2] + 1.0e-4 * cell, 0.0, 1.0)
+    visible[iy, ix] = wp.where(highest - lattice.rise > p[2] + 1.0e-4 * cell, 0.0, 1.0)

@@ -124,10 +124,12 @@ def sweep_visibility(surface: Surface, sun_dir: np.ndarray, lowest_m: float, hig
     heights = out  # the visibility is written over the heights once the sweep has read them
     wp.launch(horizon_kernels.surface_heights, dim=(n, n), inputs=[surface.positions], outputs=[heights],
               device=device)
-    lattice = [extent, wp.vec2(*along), wp.vec2(-along[1], along[0]), -half, spacing, rise]
-    wp.launch(horizon_kernels.horizon_sweep, dim=lines, inputs=[heights, *lattice, steps], outputs=[horizon],
+    lattice = horizon_kernels.Lattice()
+    lattice.extent_m, lattice.start, lattice.spacing, lattice.rise = extent, -half, spacing, rise
+    lattice.along, lattice.across = wp.vec2(*along), wp.vec2(-along[1], along[0])
+    wp.launch(horizon_kernels.horizon_sweep, dim=lines, inputs=[heights, lattice, steps], outputs=[horizon],
               device=device)
-    wp.launch(horizon_kernels.horizon_visibility, dim=(n, n), inputs=[surface.positions, *lattice, horizon],
+    wp.launch(horizon_kernels.horizon_visibility, dim=(n, n), inputs=[surface.positions, lattice, horizon],
               outputs=[out], device=device)
     return out
 
