@@ -52,7 +52,11 @@ ROWS: dict[str, tuple[dict | None, str]] = {
     "choppy": ({"water.choppiness": 1.0}, "Lagrangian (choppy) displacement, λ = 1"),
     "spreading_s2": ({"water.spreading_s": 2.0}, "broad cos-2s spreading, s = 2 (default 10)"),
     "fetch_200km": ({"water.fetch_m": 200000.0}, "fetch 200 km (near fully developed; default 20 km)"),
-    "configured": (None, "configs/field/gernez2009.toml as it is now: Elfouhaily's sea, the CIE clear sky"),
+    "elfouhaily_cie_clear": ({"water.spectrum": "elfouhaily", "sky.model": "cie_clear"},
+                             "Elfouhaily's sea and the CIE clear sky together, on 3.1 cm cells (the config "
+                             "until 2026-12-05)"),
+    "configured": (None, "configs/field/gernez2009.toml as it is now: Elfouhaily's sea, the CIE clear sky, "
+                         "3.9 mm cells (2048² over 8 m)"),
 }
 """name → (overrides on top of ``BEFORE``, or None: the config as it is; what it changes). The field
 command sets the sun, the sky's share and the wind at each point."""

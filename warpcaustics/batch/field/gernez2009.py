@@ -55,7 +55,7 @@ QUICK_OVERRIDES = {
     "sky.directions": 2,
 }
 """``--quick``: a coarse version of every task, to check the command end to end in seconds (CI,
-tests). Its CVs are not a comparison: the surface cells (0.5 m) are far too coarse to focus."""
+tests). Its CVs are not a comparison: the surface cells (12.5 cm) are far too coarse to focus."""
 
 
 POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s")
