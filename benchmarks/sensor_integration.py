@@ -4,11 +4,12 @@
 Gernez & Antoine (2009) sampled at 6 Hz and did not publish their integration time; a sensor that
 integrates over T reads the running mean of E(t) over T, and the brightest flashes are the
 briefest, so integration lowers the CV. This measures by how much, on the field set-up
-(``configs/field/gernez2009.toml``: 3.1 cm cells, 510 nm, small-angle scattering, a 1 m window
-through the 8 mm collector) on a 256² × 8 m window of that sea (the same cells; the 32 m patch
-only adds longer waves, which focus below 3 m), at the paper's diffuse share for each sun zenith:
-the spatial CV of the instantaneous map against that of the map averaged over the last T = 1/6 s
-(the 6 Hz sampling interval, the longest an integrating sensor at 6 Hz can have) and 1/12 s. The
+(``configs/field/gernez2009.toml`` before issue 27, ``BEFORE``: 3.1 cm cells, 510 nm, small-angle
+scattering, a 1 m window through the 8 mm collector) on a 256² × 8 m window of that sea (the same
+cells; the 32 m patch only adds longer waves, which focus below 3 m), at the paper's diffuse share
+for each sun zenith: the spatial CV of the instantaneous map against that of the map averaged over
+the last T = 1/6 s (the 6 Hz sampling interval, the longest an integrating sensor at 6 Hz can have)
+and 1/12 s. The
 average is the trapezoid rule over maps ``dt`` apart (``stats.integrate_series``'s piecewise-linear
 series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 0.5 s apart, pooled.
 ``--quick``: 64² surface, one zenith, one frame, T = 1/6 s at dt = 1/24 s (keeps the script running).

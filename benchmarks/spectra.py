@@ -1,7 +1,8 @@
 """The Elfouhaily et al. (1997) spectrum against JONSWAP: the ocean's set-up and its frames.
 
 ``python -m benchmarks.spectra`` (part of ``python -m benchmarks.run``; ``--quick``: 256²): the field
-set-up's 1024² sea over 32 m (``configs/field/gernez2009.toml``'s water) built with ``water.spectrum =
+set-up's 1024² sea over 32 m (``configs/field/gernez2009.toml``'s water on the grid it had until
+2026-12-05, pinned here) built with ``water.spectrum =
 "jonswap"`` (the baseline) and ``"elfouhaily"``: the time to build the ocean (the spectrum on the
 grid in float64 numpy and h̃0: once per render) and one surface step (h̃(t), the inverse FFTs and the
 assembly: every frame), median of ``repeats`` rounds timed in turn, one core. The step is the same
