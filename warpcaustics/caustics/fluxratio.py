@@ -14,7 +14,7 @@ from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutp
 from warpcaustics.config import FloorShape, Scattering, SkySampling
 from warpcaustics.kernels.caustics import coverage as cover_kernels
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
-from warpcaustics.optics.refraction import Refracted, refract_to_floor, sun_visibility
+from warpcaustics.optics.refraction import Refracted, refract_to_floor
 from warpcaustics.scene.receivers import albedo_spectrum
 from warpcaustics.water import Surface
 
@@ -276,9 +276,7 @@ class FluxRatioStage(CausticStage):
             direction, irradiance = light.sky_directions[i], light.sky_irradiance_per_dir[i]
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
-                visible = sun_visibility(frame.surface, direction, frame.highest, self.device, out=out,
-                                         blocks=frame.height_blocks, lowest_m=frame.lowest,
-                                         horizon=frame.horizon)
+                visible = frame.shade(direction, self.device, out)
             read = separate or n == count - 1 or (halves and n == count // 2 - 1)  # this map is read next
             floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
                                         irradiance=irradiance, bands=read)

@@ -15,7 +15,7 @@ from warpcaustics.config import SkyModel
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.kernels.caustics.bounces import Optics
 from warpcaustics.optics.phase import PhaseFunction
-from warpcaustics.optics.refraction import still_water_refraction, sun_visibility
+from warpcaustics.optics.refraction import still_water_refraction
 from warpcaustics.scene.above import AboveWaterCamera, above_camera_bytes
 from warpcaustics.scene.camera import UnderwaterCamera, camera_bytes
 from warpcaustics.scene.receivers import (
@@ -284,9 +284,7 @@ class ReceiverStage(CausticStage):
         for direction, irradiance, from_sky in self.light.passes():
             if from_sky:
                 with watch.stage("sky"):
-                    seen = sun_visibility(frame.surface, direction, frame.highest, self.device,
-                                          out=self.light.sky_visible, blocks=frame.height_blocks,
-                                          lowest_m=frame.lowest, horizon=frame.horizon)
+                    seen = frame.shade(direction, self.device, self.light.sky_visible)
             else:
                 seen = frame.visible  # crests shade by the sun's centre
             # a sky pass's work is timed as "sky", as the flux-ratio map's and the grids' are

@@ -17,6 +17,7 @@ import warp as wp
 
 from warpcaustics.config import SkyModel
 from warpcaustics.optics import spectra
+from warpcaustics.optics.refraction import sun_visibility
 
 
 class Stopwatch:
@@ -140,6 +141,12 @@ class Frame:
     horizon: wp.array2d | None = None
     """A periodic surface's :func:`~warpcaustics.optics.refraction.horizon_buffer`, which every
     light direction's sweep reuses (None: each allocates its own)."""
+
+    def shade(self, direction: np.ndarray, device: str, out: wp.array2d) -> wp.array2d:
+        """(N, N) the crests' shading of this frame's surface from ``direction`` (towards the light)
+        into ``out``, with the frame's height range and shading aids."""
+        return sun_visibility(self.surface, direction, self.highest, device, out=out,
+                              blocks=self.height_blocks, lowest_m=self.lowest, horizon=self.horizon)
 
 
 @dataclass
