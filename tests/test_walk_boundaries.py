@@ -20,9 +20,10 @@ import warp as wp
 
 import warpcaustics as wc
 from warpcaustics.caustics.multiple import MultipleScattering, balance
+from warpcaustics.config import PhaseFunctionKind
 from warpcaustics.kernels.caustics import multiple as mc_kernels
 from warpcaustics.optics import spectra
-from warpcaustics.optics.phase import PhaseFunction, petzold_table
+from warpcaustics.optics.phase import PhaseFunction, phase_quadrature
 
 pytest.importorskip("PythonicDISORT")
 from warpcaustics.reference.disort import floor_irradiance, hg_moments, table_moments  # noqa: E402
@@ -74,8 +75,7 @@ def walk_ratio(overrides: dict, albedo: float, fresnel: bool, seeds: int, sample
 
 @functools.cache
 def petzold_moments(station: str) -> np.ndarray:
-    theta, p, cone, _ = petzold_table(station)
-    return table_moments(theta, p, cone, 300)
+    return table_moments(*phase_quadrature(PhaseFunctionKind.PETZOLD, None, station), 300)
 
 
 def disort_ratio(scene, optics, band: int, albedo: float, fresnel: bool) -> dict:

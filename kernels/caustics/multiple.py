@@ -79,26 +79,26 @@ class Walk:
 
 
 @wp.func
-def sample_cosine(table: wp.array[wp.float32], u: float) -> float:
-    """cos θ of a scattering angle drawn from the phase function: θ by linear interpolation in the
+def sample_angle(table: wp.array[wp.float32], u: float) -> float:
+    """θ [rad] of a scattering angle drawn from the phase function, by linear interpolation in the
     inverse cumulative table (θ at equally spaced probabilities)."""
     n = table.shape[0] - 1
     x = u * float(n)
     i = wp.min(int(x), n - 1)
     t = x - float(i)
-    return wp.cos((1.0 - t) * table[i] + t * table[i + 1])
+    return (1.0 - t) * table[i] + t * table[i + 1]
 
 
 @wp.func
-def turn(d: wp.vec3, cos_theta: float, phi: float) -> wp.vec3:
-    """``d`` turned by the polar angle θ (given by its cosine) at azimuth φ about itself."""
+def turn(d: wp.vec3, theta: float, phi: float) -> wp.vec3:
+    """``d`` turned by the polar angle ``theta`` at azimuth φ about itself (sin θ and cos θ from θ
+    itself, so that the forward peak's angles below float32's ~0.02° in cos θ still turn)."""
     helper = wp.vec3(1.0, 0.0, 0.0)
     if wp.abs(d[0]) > 0.9:
         helper = wp.vec3(0.0, 1.0, 0.0)
     u = wp.normalize(wp.cross(d, helper))
     v = wp.cross(d, u)
-    sin_theta = wp.sqrt(wp.max(1.0 - cos_theta * cos_theta, 0.0))
-    return wp.normalize(cos_theta * d + sin_theta * (wp.cos(phi) * u + wp.sin(phi) * v))
+    return wp.normalize(wp.cos(theta) * d + wp.sin(theta) * (wp.cos(phi) * u + wp.sin(phi) * v))
 
 
 SURFACE_STEPS_PER_CELL = wp.constant(2.0)
@@ -316,7 +316,7 @@ def random_walk(
             if event < walk.max_events:
                 wp.atomic_add(tallies, b, ABSORBED, wp.float64(weight * (1.0 - albedo)))
                 weight = weight * albedo
-                d = turn(d, sample_cosine(inverse_cdf, wp.randf(state)), 2.0 * wp.pi * wp.randf(state))
+                d = turn(d, sample_angle(inverse_cdf, wp.randf(state)), 2.0 * wp.pi * wp.randf(state))
         direct = False
         if event == walk.max_events:
             wp.atomic_add(tallies, b, TRUNCATED, wp.float64(weight))

@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import Config
+from warpcaustics.config import Config, OpticsConfig
 from warpcaustics.kernels.caustics import multiple as mc_kernels
-from warpcaustics.optics.phase import PhaseFunction
+from warpcaustics.optics.phase import quadrature_for
 from warpcaustics.water import Surface
 
 TALLY_NAMES = ("transmitted", "floor", "escaped", "absorbed", "unscattered", "truncated", "roulette",
@@ -45,15 +45,14 @@ SKY_STREAM = 0x5851F42D
 sun's."""
 
 
-def inverse_cdf_table(phase: PhaseFunction, device: str, nodes: int = 2049) -> np.ndarray:
+def inverse_cdf_table(optics: OpticsConfig, nodes: int = 2049) -> np.ndarray:
     """θ [rad] at ``nodes`` equally spaced probabilities of the phase function's cumulative
-    distribution P(θ) = 2π ∫₀^θ p sinθ' dθ' (the device's own p, on a grid dense near 0 for
-    forward peaks; normalised by its total, which is 1 to the table's accuracy)."""
-    theta = np.concatenate([[0.0], np.geomspace(1e-5, np.pi, 20000)])
-    p = phase.evaluate(np.cos(theta), device).astype(np.float64)
-    integrand = 2.0 * np.pi * p * np.sin(theta)
-    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (integrand[1:] + integrand[:-1]) * np.diff(theta))])
-    cdf /= cdf[-1]
+    distribution P(θ) = 2π ∫₀^θ p sinθ' dθ', from its float64 quadrature
+    (:func:`~warpcaustics.optics.phase.quadrature_for`: the power-law cone of Petzold's tables
+    included, which a float32 cos θ could not resolve)."""
+    theta, weight = quadrature_for(optics)
+    cdf = np.cumsum(weight) - 0.5 * weight
+    cdf /= weight.sum()
     return np.interp(np.linspace(0.0, 1.0, nodes), cdf, theta)
 
 
@@ -110,7 +109,7 @@ class MultipleScattering:
 
         self.absorption = arr(absorption_per_m)
         self.scattering = arr(scattering_per_m)
-        self.inverse_cdf = arr(inverse_cdf_table(PhaseFunction.from_optics(cfg.optics, device), device))
+        self.inverse_cdf = arr(inverse_cdf_table(cfg.optics))
         self.floor_albedo = arr(np.zeros(k) if floor_albedo is None else np.broadcast_to(floor_albedo, (k,)))
         self.texels = wp.zeros((m, m, k), dtype=wp.float32, device=device)
         self.tallies = wp.zeros((k, mc_kernels.TALLIES), dtype=wp.float64, device=device)

@@ -33,41 +33,28 @@ import functools
 import numpy as np
 
 from warpcaustics.config import OpticsConfig, PhaseFunctionKind
-from warpcaustics.optics.phase import mean_cosine, petzold_table, solid_angle_weights, table_on_grid
+from warpcaustics.optics.phase import phase_quadrature
 
 SPREAD_NODES = 2000
 """Points of the G(x) table, log-spaced in x = q s from 1e-3 to 1e7 (rad)."""
 
 
-def phase_on_grid(kind: PhaseFunctionKind, hg_g: float | None, station: str) -> tuple[np.ndarray, np.ndarray]:
-    """(θ [rad], p(θ) [1/sr]) of a phase function on a float64 grid dense near 0°: Henyey–Greenstein
-    in closed form (g: ``hg_g``, or the station's mean cosine, as ``optics.hg_g``), or Petzold's
-    table with ln p linear in θ and its forward cone, as on the device."""
-    theta_t, p_t, cone, _ = petzold_table(station)
-    grid = np.concatenate([np.linspace(0.0, 1e-4, 201)[:-1], np.geomspace(1e-4, np.pi, 60000)])
-    if kind is PhaseFunctionKind.HENYEY_GREENSTEIN:
-        g = hg_g if hg_g is not None else mean_cosine(theta_t, p_t, cone)
-        mu = np.cos(grid)
-        return grid, (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * mu) ** 1.5)
-    return grid, table_on_grid(theta_t, p_t, cone, grid)
-
-
-def phase_hankel(theta: np.ndarray, p: np.ndarray, nu: np.ndarray) -> np.ndarray:
-    """p̃(ν) = 2π ∫ p(θ) J₀(ν θ) sin θ dθ (trapezoid on the given grid), 1 at ν = 0 for a normalised p."""
+def phase_hankel(theta: np.ndarray, weight: np.ndarray, nu: np.ndarray) -> np.ndarray:
+    """p̃(ν) = 2π ∫ p(θ) J₀(ν θ) sin θ dθ on a quadrature (θ, w) of the phase function
+    (:func:`~warpcaustics.optics.phase.phase_quadrature`), 1 at ν = 0."""
     from scipy.special import j0
 
-    weight = solid_angle_weights(theta, p)
     out = np.empty(len(nu))
     for i in range(0, len(nu), 64):  # (64, grid) blocks keep memory small
         out[i : i + 64] = j0(np.outer(nu[i : i + 64], theta)) @ weight
     return out / weight.sum()
 
 
-def spread_from_phase(theta: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(x, G(x)) on the table's nodes for a phase function given on a grid: p̃ by
+def spread_from_phase(theta: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x, G(x)) on the table's nodes for a phase function given by a quadrature (θ, w): p̃ by
     :func:`phase_hankel`, its running integral by trapezoids, G(0) = 1."""
     x = np.concatenate([[0.0], np.geomspace(1e-3, 1e7, SPREAD_NODES)])
-    pt = phase_hankel(theta, p, x)
+    pt = phase_hankel(theta, weight, x)
     cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (pt[1:] + pt[:-1]) * np.diff(x))])
     g = np.empty_like(x)
     g[0] = 1.0
@@ -77,7 +64,7 @@ def spread_from_phase(theta: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.
 
 @functools.cache
 def _spread_table(kind: PhaseFunctionKind, hg_g: float | None, station: str) -> tuple[np.ndarray, np.ndarray]:
-    return spread_from_phase(*phase_on_grid(kind, hg_g, station))
+    return spread_from_phase(*phase_quadrature(kind, hg_g, station))
 
 
 def spread_table(optics: OpticsConfig) -> tuple[np.ndarray, np.ndarray]:

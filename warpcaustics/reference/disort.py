@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from warpcaustics.optics.phase import solid_angle_weights, table_on_grid
 from warpcaustics.reference.floor import fresnel_transmittance
 
 
@@ -34,18 +33,11 @@ def hg_moments(g: float, count: int) -> np.ndarray:
     return float(g) ** np.arange(count, dtype=np.float64)
 
 
-def table_moments(theta: np.ndarray, p: np.ndarray, cone_p: float, count: int) -> np.ndarray:
-    """Legendre moments χ_l = 2π ∫ p(θ) P_l(cos θ) sin θ dθ (l < count) of a tabulated phase function
-    [1/sr] with ln p linear in θ between the table's angles (as the device interpolates it) and the
-    constant ``cone_p`` below its first angle; float64 quadrature on a grid dense near 0, the
-    moments divided by χ_0 (1 to the table's accuracy)."""
-    theta = np.asarray(theta, np.float64)
-    cone = np.linspace(0.0, theta[0], 2001)
-    body = theta[0] + np.geomspace(1e-9, np.pi - theta[0], 400000)
-    grid = np.concatenate([cone, body[body < np.pi], [np.pi]])
-    # trapezoid weights of 2π p sinθ dθ, then P_l(cos θ) by Bonnet's recurrence
-    weight = solid_angle_weights(grid, table_on_grid(theta, p, cone_p, grid))
-    mu = np.cos(grid)
+def table_moments(theta: np.ndarray, weight: np.ndarray, count: int) -> np.ndarray:
+    """Legendre moments χ_l = 2π ∫ p(θ) P_l(cos θ) sin θ dθ (l < count) of a phase function given by
+    its float64 quadrature (θ, w) (:func:`~warpcaustics.optics.phase.phase_quadrature`: the walk's),
+    divided by χ_0 (1 to the quadrature's accuracy); P_l(cos θ) by Bonnet's recurrence."""
+    mu = np.cos(np.asarray(theta, np.float64))
     moments = np.empty(count)
     p_prev, p_cur = np.ones_like(mu), mu
     moments[0] = weight.sum()
