@@ -254,3 +254,18 @@ def test_ray_executor_gives_the_local_results(tmp_path):
         assert {k: v for k, v in row.items() if k != "render_s"} == {
             k: v for k, v in on_ray[task_id].items() if k != "render_s"
         }
+
+
+def test_workers_get_one_blas_thread_unless_the_user_chose(monkeypatch):
+    """While the local pool runs, the variables that size numpy's BLAS thread pool read 1 for the
+    workers it spawns, except one the user set; afterwards the environment is as it was."""
+    from warpcaustics.batch.executors import NUMERIC_THREADS, one_blas_thread_per_worker
+
+    for var in NUMERIC_THREADS:
+        monkeypatch.delenv(var, raising=False)
+    monkeypatch.setenv("MKL_NUM_THREADS", "3")
+    with one_blas_thread_per_worker():
+        assert os.environ["OPENBLAS_NUM_THREADS"] == "1" and os.environ["OMP_NUM_THREADS"] == "1"
+        assert os.environ["MKL_NUM_THREADS"] == "3"
+    assert "OPENBLAS_NUM_THREADS" not in os.environ and "OMP_NUM_THREADS" not in os.environ
+    assert os.environ["MKL_NUM_THREADS"] == "3"
