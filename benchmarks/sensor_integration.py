@@ -74,7 +74,7 @@ def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, start: dict
     rows = []
     for zenith in zeniths:
         renderer, cfg, texel, collector = field_window(zenith, quick, start, extra)
-        start = time.perf_counter()
+        began = time.perf_counter()
         inst, integ = [], {w: [] for w in windows}
         for f in range(frames):
             t_end = 1.0 + 0.5 * f
@@ -90,7 +90,7 @@ def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, start: dict
         for w in windows:
             a = np.array(integ[w])
             row[f"cv_integrated_{w:.4f}s"] = float(a.std() / a.mean())
-        row["seconds"] = time.perf_counter() - start
+        row["seconds"] = time.perf_counter() - began
         rows.append(row)
         _print(row)
     return rows

@@ -118,8 +118,7 @@ def phase_quadrature(kind: PhaseFunctionKind, g: float | None, station: str) -> 
     nodes = np.concatenate([np.geomspace(cone.theta0 * 10.0**-CONE_DECADES, cone.theta0, 20000)[:-1],
                             np.geomspace(cone.theta0, np.pi, 60000)])
     if kind is PhaseFunctionKind.HENYEY_GREENSTEIN:
-        if g is None:
-            g = mean_cosine(*phase_quadrature(PhaseFunctionKind.PETZOLD, None, station))
+        g = station_mean_cosine(station) if g is None else g
         p = (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * np.cos(nodes)) ** 1.5)
         below = 2.0 * np.pi * p[0] * (1.0 - np.cos(nodes[0]))
     else:
@@ -131,6 +130,12 @@ def phase_quadrature(kind: PhaseFunctionKind, g: float | None, station: str) -> 
 def mean_cosine(theta: np.ndarray, weight: np.ndarray) -> float:
     """∫ cos θ p dΩ / ∫ p dΩ of a :func:`phase_quadrature`."""
     return float(weight @ np.cos(theta) / weight.sum())
+
+
+def station_mean_cosine(station: str) -> float:
+    """The mean cosine of a Petzold station's phase function, cone included: Henyey–Greenstein's
+    default g."""
+    return mean_cosine(*phase_quadrature(PhaseFunctionKind.PETZOLD, None, station))
 
 
 def quadrature_for(optics: OpticsConfig) -> tuple[np.ndarray, np.ndarray]:
@@ -154,9 +159,7 @@ class PhaseFunction:
     @classmethod
     def from_optics(cls, optics: OpticsConfig, device: str) -> PhaseFunction:
         theta, p, cone = petzold_table(optics.petzold_station.value)
-        g = optics.hg_g
-        if g is None:
-            g = mean_cosine(*phase_quadrature(PhaseFunctionKind.PETZOLD, None, optics.petzold_station.value))
+        g = optics.hg_g if optics.hg_g is not None else station_mean_cosine(optics.petzold_station.value)
         kind = 0 if optics.phase_function is PhaseFunctionKind.HENYEY_GREENSTEIN else 1
         return cls(kind, float(g), wp.array(theta.astype(np.float32), dtype=wp.float32, device=device),
                    wp.array(np.log(p).astype(np.float32), dtype=wp.float32, device=device), cone.mean)
