@@ -215,6 +215,61 @@ def test_darecki_bad_input_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+WIND = ROOT / "configs/field/darecki2011_wind.toml"
+
+
+def test_darecki_wind_config_holds_the_middle_of_the_records_ranges():
+    """configs/field/darecki2011_wind.toml: Fig. 13b's six bands and collector, the middle of its
+    sun, depth and c(555) ranges (the water's c(555) found again from its chlorophyll to 0.5 %)."""
+    import warpcaustics as wc
+    from warpcaustics.batch.field import darecki2011, darecki2011_wind
+
+    rec = darecki2011_wind.record()
+    cfg = wc.load_scene(WIND).config
+    assert cfg.optics.wavelengths.list_nm == tuple(float(w) for w in rec.wavelengths_nm)
+    assert cfg.stats.collector_mm == rec.collector_mm
+    assert 90.0 - cfg.sun.elevation_deg == pytest.approx(np.mean(rec.sun_zenith_deg))
+    assert cfg.floor.depth_m == pytest.approx(np.mean(rec.depth_m))
+    middle = float(np.mean(rec.beam_attenuation_555))
+    assert darecki2011.beam_attenuation(cfg, 555.0) == pytest.approx(middle, rel=5e-3)
+    assert darecki2011.chlorophyll_for(cfg, middle) == pytest.approx(cfg.optics.chlorophyll_mg_m3, rel=1e-3)
+
+
+def test_darecki_wind_command_on_still_water_measures_no_fluctuation(tmp_path):
+    """The wind-series command end to end (--quick, the calmest and windiest days): under still
+    water the CV is 0 in every band, beside the record's values in the record's order."""
+    pytest.importorskip("matplotlib")
+    from warpcaustics.batch.field import darecki2011_wind
+
+    flat = tmp_path / "flat.toml"
+    flat.write_text(WIND.read_text().replace('model = "fft"', 'model = "flat"'))
+    out = tmp_path / "o"
+    assert main(["field", "darecki2011_wind", str(flat), "--out", str(out), "--quick", "--frames", "1",
+                 "--device", "cpu", "--quiet"]) == 0
+    rows = list(csv.DictReader((out / "darecki2011_wind.csv").open()))
+    rec = darecki2011_wind.record()
+    assert [(float(r["wind_m_s"]), float(r["wavelength_nm"])) for r in rows] == [
+        (u, float(w)) for u in (rec.wind_m_s[0], rec.wind_m_s[-1]) for w in rec.wavelengths_nm]
+    assert all(float(r["model_cv"]) < 1e-5 for r in rows)
+    assert [float(r["measured_cv"]) for r in rows[-6:]] == pytest.approx(rec.cv[-1].tolist(), abs=1e-4)
+    assert (out / "darecki2011_wind.png").stat().st_size > 0
+
+
+def test_darecki_wind_bad_input_is_one_line(tmp_path, capsys):
+    with pytest.raises(ConfigError, match=r"--winds: 4 is not a measured wind \[m/s\]; the record holds 3.9"):
+        field.run_darecki2011_wind(WIND, tmp_path / "o", winds=(4.0,), quick=True)
+    with pytest.raises(ConfigError, match="--set water.wind_speed_m_s"):
+        field.run_darecki2011_wind(WIND, tmp_path / "o", overrides={"water.wind_speed_m_s": 2.0}, quick=True)
+    with pytest.raises(ConfigError, match=r"optics.wavelengths = \[410.0, 443.0"):
+        field.run_darecki2011_wind(WIND, tmp_path / "o", overrides={"optics.wavelengths": [443.0]},
+                                   quick=True)
+    assert main(["field", "darecki2011_wind", str(WIND), "--out", str(tmp_path / "o"), "--depths", "1"]) == 2
+    assert "--depths is not a flag of darecki2011_wind (its point flags: --winds)" in capsys.readouterr().err
+    assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"), "--winds", "3.9"]) == 2
+    assert "--winds is not a flag of darecki2011" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
 def test_frames_are_the_interval_apart(monkeypatch, capsys, tmp_path):
     """--frame-interval sets the seconds between a point's frames (each data set's default without
     it); zero, negative or not finite is a one-line error before anything renders."""

@@ -106,7 +106,8 @@ def _parser() -> argparse.ArgumentParser:
                                       "Darecki et al. 2011)",
                         description="Render SCENE at the conditions of a field data set (a resumable sweep "
                                     "into DIR), and write the model against the measurements as CSV and PNG.")
-    fd.add_argument("dataset", choices=["gernez2009", "darecki2011"], help="the field data set")
+    fd.add_argument("dataset", choices=["gernez2009", "darecki2011", "darecki2011_wind"],
+                    help="the field data set")
     fd.add_argument("scene", metavar="SCENE",
                     help="the scene of its conditions, e.g. configs/field/gernez2009.toml")
     fd.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
@@ -119,9 +120,12 @@ def _parser() -> argparse.ArgumentParser:
                     help="gernez2009: only these measured √wind classes [√(m/s)], comma-separated")
     fd.add_argument("--depths", metavar="LIST",
                     help="darecki2011: only these measured depths [m], comma-separated (default all)")
+    fd.add_argument("--winds", metavar="LIST",
+                    help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
-                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 5); "
+                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 and "
+                         "darecki2011_wind 5); "
                          "frames further apart than the waves' periods are independent samples")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)
@@ -160,10 +164,11 @@ def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
 
 def _field(args: argparse.Namespace) -> int:
     """``warpcaustics field``: each data set takes its own point flags; another's is an error."""
-    from warpcaustics.batch.field import run_darecki2011, run_gernez2009
+    from warpcaustics.batch.field import run_darecki2011, run_darecki2011_wind, run_gernez2009
 
-    own = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011": ("depths",)}[args.dataset]
-    for name in ("series", "zeniths", "sqrt_winds", "depths"):
+    own = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011": ("depths",),
+           "darecki2011_wind": ("winds",)}[args.dataset]
+    for name in ("series", "zeniths", "sqrt_winds", "depths", "winds"):
         if name not in own and getattr(args, name) is not None:
             raise ConfigError(f"--{name.replace('_', '-')} is not a flag of {args.dataset} "
                               f"(its point flags: {', '.join('--' + n.replace('_', '-') for n in own)})")
@@ -175,8 +180,10 @@ def _field(args: argparse.Namespace) -> int:
         paths = run_gernez2009(args.scene, args.out, series=tuple((args.series or "zenith,wind").split(",")),
                                zeniths=_floats(args.zeniths, "--zeniths"),
                                sqrt_winds=_floats(args.sqrt_winds, "--sqrt-winds"), **common)
-    else:
+    elif args.dataset == "darecki2011":
         paths = run_darecki2011(args.scene, args.out, depths=_floats(args.depths, "--depths"), **common)
+    else:
+        paths = run_darecki2011_wind(args.scene, args.out, winds=_floats(args.winds, "--winds"), **common)
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0
 

@@ -5,12 +5,15 @@ data set registered by name (``warpcaustics field NAME SCENE --out DIR``):
   8 mm collector (Gernez & Antoine 2009, BOUSSOLE).
 - ``darecki2011`` (:mod:`.darecki2011`): CV against depth, 0.86-9.58 m, at 443/532/670 nm,
   2.5 mm collector (Darecki, Stramski & Sokolski 2011, Santa Barbara Channel).
+- ``darecki2011_wind`` (:mod:`.darecki2011_wind`): CV against wind, 3.9-10.3 m/s, at about 1 m and
+  six bands, 410-670 nm (the same paper's Fig. 13b).
 
 Each renders its points as one resumable sweep (:mod:`.common`) and writes a CSV and a figure.
 """
 
 from warpcaustics.batch.field.common import pooled_statistics
 from warpcaustics.batch.field.darecki2011 import run_darecki2011
+from warpcaustics.batch.field.darecki2011_wind import run_darecki2011_wind
 from warpcaustics.batch.field.gernez2009 import (
     POINT_KEYS,
     QUICK_OVERRIDES,
@@ -23,11 +26,13 @@ from warpcaustics.batch.field.gernez2009 import (
     select_points,
 )
 
-DATASETS = {"gernez2009": run_gernez2009, "darecki2011": run_darecki2011}
+DATASETS = {"gernez2009": run_gernez2009, "darecki2011": run_darecki2011,
+            "darecki2011_wind": run_darecki2011_wind}
 """name → the function that runs its comparison."""
 
 __all__ = [
     "DATASETS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction", "direct_transmission",
-    "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011", "run_gernez2009",
+    "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011", "run_darecki2011_wind",
+    "run_gernez2009",
     "select_points",
 ]

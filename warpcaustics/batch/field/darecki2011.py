@@ -65,19 +65,21 @@ def beam_attenuation(config, wavelength_nm: float) -> float:
     return float(o.absorption_per_m[0] + o.scattering_per_m[0])
 
 
-def select_depths(depths_m: np.ndarray, wanted: tuple[float, ...] | None) -> list[float]:
-    """The record's depths at ``wanted`` (None: all); one the record lacks is an error."""
-    have = [float(d) for d in depths_m]
+def select_measured(have_values: np.ndarray, wanted: tuple[float, ...] | None, flag: str,
+                    what: str) -> list[float]:
+    """The record's values (depths, winds) at ``wanted`` (None: all); one the record lacks is an
+    error naming ``flag``."""
+    have = [float(d) for d in have_values]
     if wanted is None:
         return have
     for d in wanted:
         if not any(abs(d - h) < 1e-6 for h in have):
-            raise ConfigError(f"--depths: {d:g} is not a measured depth; the record holds "
+            raise ConfigError(f"{flag}: {d:g} is not a measured {what}; the record holds "
                               + ", ".join(f"{h:g}" for h in have))
     return [h for h in have if any(abs(d - h) < 1e-6 for d in wanted)]
 
 
-def _check_scene(config, rec) -> None:
+def check_scene(config, rec) -> None:
     """One band at each of the record's wavelengths, per-band statistics, a stateless sea."""
     listed = tuple(config.optics.wavelengths.list_nm)
     wanted = tuple(float(w) for w in rec.wavelengths_nm)
@@ -120,9 +122,9 @@ def run_darecki2011(
     scene_path = Path(scene).resolve()
     fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
     base = load_scene(scene_path, fixed)
-    _check_scene(base.config, rec)
+    check_scene(base.config, rec)
     pyplot(PLOT_NEEDS)  # before the sweep, not after it
-    chosen = select_depths(rec.depth_m, depths)
+    chosen = select_measured(rec.depth_m, depths, "--depths", "depth")
     if quick:
         chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
     variants = [{"floor.depth_m": d} for d in chosen]
@@ -132,29 +134,35 @@ def run_darecki2011(
     rows = []
     for depth in chosen:
         k = int(np.argmin(np.abs(rec.depth_m - depth)))
-        stats = frame_statistics_of(sweep, out, {"floor.depth_m": depth})
-        for j, nm in enumerate(rec.wavelengths_nm):
-            band = [s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats]
-            _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
-            continuum = continuous_sky(band)
+        for j, band in enumerate(band_statistics(sweep, out, {"floor.depth_m": depth}, rec.wavelengths_nm)):
             measured = float(rec.cv[k, j])
-            rows.append({
-                "depth_m": depth,
-                "wavelength_nm": float(nm),
-                "measured_cv": round(measured, 4),
-                "model_cv": round(cv, 4),
-                "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
-                "model_over_measured": round(cv / measured, 3),
-                "model_cv_continuous_sky": continuum,
-                "frames": len(band),
-                "model_c555_per_m": round(c555, 4),
-                "measured_c555_per_m": float(rec.beam_attenuation_555),
-            })
+            rows.append({"depth_m": depth, "wavelength_nm": float(rec.wavelengths_nm[j]),
+                         "measured_cv": round(measured, 4), **band_row(band, measured),
+                         "model_c555_per_m": round(c555, 4),
+                         "measured_c555_per_m": float(rec.beam_attenuation_555)})
     out = Path(out)
     paths = {"csv": out / "darecki2011.csv", "png": out / "darecki2011.png"}
     write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
     return paths
+
+
+def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list[list[dict]]:
+    """Per band of ``wavelengths_nm``, the statistics of every frame rendered at ``point``."""
+    stats = frame_statistics_of(sweep, out, point)
+    return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
+
+
+def band_row(band: list[dict], measured: float) -> dict:
+    """One band's frames pooled, beside the measured CV: the columns every Darecki row shares."""
+    _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
+    return {
+        "model_cv": round(cv, 4),
+        "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
+        "model_over_measured": round(cv / measured, 3),
+        "model_cv_continuous_sky": continuous_sky(band),
+        "frames": len(band),
+    }
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:
