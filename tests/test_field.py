@@ -270,6 +270,22 @@ def test_darecki_wind_bad_input_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+def test_the_command_offers_every_registered_data_set_with_its_point_flags():
+    """``warpcaustics field``'s choices are the registry's data sets, and each one's point flags are
+    keywords of its function and flags of the command."""
+    import inspect
+
+    from warpcaustics import cli
+
+    assert cli.FIELD_DATASETS == tuple(field.DATASETS) == tuple(field.POINT_FLAGS)
+    for name, run in field.DATASETS.items():
+        for flag in field.POINT_FLAGS[name]:
+            assert flag in inspect.signature(run).parameters
+            args = cli._parser().parse_args(["field", name, "s.toml", "--out", "o",
+                                             "--" + flag.replace("_", "-"), "1"])
+            assert getattr(args, flag) == "1"
+
+
 def test_frames_are_the_interval_apart(monkeypatch, capsys, tmp_path):
     """--frame-interval sets the seconds between a point's frames (each data set's default without
     it); zero, negative or not finite is a one-line error before anything renders."""

@@ -12,6 +12,10 @@ from warpcaustics import __version__
 from warpcaustics.batch.compare import FLOOR_METHODS
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
+FIELD_DATASETS = ("gernez2009", "darecki2011", "darecki2011_wind")
+"""The names of ``warpcaustics.batch.field.DATASETS``, spelled here because importing that package
+costs 0.7 s (scipy) at every start of the command (tests/test_field.py checks that they agree)."""
+
 EXIT_USER_ERROR = 2
 
 
@@ -106,8 +110,7 @@ def _parser() -> argparse.ArgumentParser:
                                       "Darecki et al. 2011)",
                         description="Render SCENE at the conditions of a field data set (a resumable sweep "
                                     "into DIR), and write the model against the measurements as CSV and PNG.")
-    fd.add_argument("dataset", choices=["gernez2009", "darecki2011", "darecki2011_wind"],
-                    help="the field data set")
+    fd.add_argument("dataset", choices=list(FIELD_DATASETS), help="the field data set")
     fd.add_argument("scene", metavar="SCENE",
                     help="the scene of its conditions, e.g. configs/field/gernez2009.toml")
     fd.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
@@ -164,26 +167,24 @@ def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
 
 def _field(args: argparse.Namespace) -> int:
     """``warpcaustics field``: each data set takes its own point flags; another's is an error."""
-    from warpcaustics.batch.field import run_darecki2011, run_darecki2011_wind, run_gernez2009
+    from warpcaustics.batch.field import DATASETS, POINT_FLAGS
 
-    own = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011": ("depths",),
-           "darecki2011_wind": ("winds",)}[args.dataset]
-    for name in ("series", "zeniths", "sqrt_winds", "depths", "winds"):
+    own = POINT_FLAGS[args.dataset]
+    for name in sorted({flag for flags in POINT_FLAGS.values() for flag in flags}):
         if name not in own and getattr(args, name) is not None:
             raise ConfigError(f"--{name.replace('_', '-')} is not a flag of {args.dataset} "
                               f"(its point flags: {', '.join('--' + n.replace('_', '-') for n in own)})")
+    points = {}
+    for name in own:
+        text = getattr(args, name)
+        if text is not None:  # else the data set's own default: all its points
+            flag = "--" + name.replace("_", "-")
+            points[name] = tuple(text.split(",")) if name == "series" else _floats(text, flag)
     common = dict(frames=args.frames, workers=args.workers, device=args.device, quick=args.quick,
                   quiet=args.quiet, force=args.force, overrides=_overrides(args))
     if args.frame_interval is not None:  # else each data set's own default
         common["frame_interval_s"] = args.frame_interval
-    if args.dataset == "gernez2009":
-        paths = run_gernez2009(args.scene, args.out, series=tuple((args.series or "zenith,wind").split(",")),
-                               zeniths=_floats(args.zeniths, "--zeniths"),
-                               sqrt_winds=_floats(args.sqrt_winds, "--sqrt-winds"), **common)
-    elif args.dataset == "darecki2011":
-        paths = run_darecki2011(args.scene, args.out, depths=_floats(args.depths, "--depths"), **common)
-    else:
-        paths = run_darecki2011_wind(args.scene, args.out, winds=_floats(args.winds, "--winds"), **common)
+    paths = DATASETS[args.dataset](args.scene, args.out, **points, **common)
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0
 

@@ -30,9 +30,13 @@ DATASETS = {"gernez2009": run_gernez2009, "darecki2011": run_darecki2011,
             "darecki2011_wind": run_darecki2011_wind}
 """name → the function that runs its comparison."""
 
+POINT_FLAGS = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011": ("depths",),
+               "darecki2011_wind": ("winds",)}
+"""name → the keywords of its function that choose which of the record's points to render
+(``warpcaustics field``'s flags of the same names); each is a tuple, None for all."""
+
 __all__ = [
-    "DATASETS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction", "direct_transmission",
-    "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011", "run_darecki2011_wind",
-    "run_gernez2009",
-    "select_points",
+    "DATASETS", "POINT_FLAGS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction",
+    "direct_transmission", "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011",
+    "run_darecki2011_wind", "run_gernez2009", "select_points",
 ]
