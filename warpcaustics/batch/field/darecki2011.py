@@ -114,27 +114,15 @@ def run_darecki2011(
     ``frame_interval_s`` apart, by default 5 s, longer than the peak waves' period (2.6 s at the
     record's wind): each frame is a new realisation of the largest scales, which decide the CV at
     depth (docs/validation.md)."""
-    from warpcaustics.scene import load_scene
-
-    times = check_frames(frames, frame_interval_s)
-    check_overrides(overrides, POINT_KEYS, "--depths")
     rec = record()
-    scene_path = Path(scene).resolve()
-    fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
-    base = load_scene(scene_path, fixed)
-    check_scene(base.config, rec)
-    pyplot(PLOT_NEEDS)  # before the sweep, not after it
-    chosen = select_measured(rec.depth_m, depths, "--depths", "depth")
-    if quick:
-        chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
-    variants = [{"floor.depth_m": d} for d in chosen]
-    sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
-                          quiet=quiet, force=force)
-    c555 = beam_attenuation(base.config, 555.0)
+    config, points = render_record(
+        scene, out, rec, POINT_KEYS[0], rec.depth_m, depths, ("--depths", "depth"), frames=frames,
+        frame_interval_s=frame_interval_s, workers=workers, device=device, quick=quick, quiet=quiet,
+        force=force, overrides=overrides)
+    c555 = beam_attenuation(config, 555.0)
     rows = []
-    for depth in chosen:
-        k = int(np.argmin(np.abs(rec.depth_m - depth)))
-        for j, band in enumerate(band_statistics(sweep, out, {"floor.depth_m": depth}, rec.wavelengths_nm)):
+    for depth, k, bands in points:
+        for j, band in enumerate(bands):
             measured = float(rec.cv[k, j])
             rows.append({"depth_m": depth, "wavelength_nm": float(rec.wavelengths_nm[j]),
                          "measured_cv": round(measured, 4), **band_row(band, measured),
@@ -145,6 +133,34 @@ def run_darecki2011(
     write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
     return paths
+
+
+def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.ndarray,
+                  wanted: tuple[float, ...] | None, flag: tuple[str, str], *, frames: int,
+                  frame_interval_s: float, workers: int, device: str | None, quick: bool, quiet: bool,
+                  force: bool, overrides: dict | None):
+    """What every Darecki comparison shares: SCENE checked against the record ``rec``, rendered with
+    config ``key`` at each of the record's values ``have`` (or those ``wanted``; ``flag``: the
+    command's flag choosing them and what they are) as one resumable sweep, ``frames`` frames
+    ``frame_interval_s`` apart. Returns the scene's config and, per value, (value, its index in
+    ``have``, per band of the record the statistics of every frame)."""
+    from warpcaustics.scene import load_scene
+
+    times = check_frames(frames, frame_interval_s)
+    check_overrides(overrides, (key,), flag[0])
+    scene_path = Path(scene).resolve()
+    fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
+    base = load_scene(scene_path, fixed)
+    check_scene(base.config, rec)
+    pyplot(PLOT_NEEDS)  # before the sweep, not after it
+    chosen = select_measured(have, wanted, *flag)
+    if quick:
+        chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
+    sweep = render_points(scene_path, fixed, [{key: v} for v in chosen], times, out, workers=workers,
+                          device=device, quiet=quiet, force=force)
+    points = [(v, int(np.argmin(np.abs(have - v))), band_statistics(sweep, out, {key: v}, rec.wavelengths_nm))
+              for v in chosen]
+    return base.config, points
 
 
 def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list[list[dict]]:

@@ -20,16 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from warpcaustics.batch.field.common import check_frames, check_overrides, render_points
-from warpcaustics.batch.field.darecki2011 import (
-    PLOT_NEEDS,
-    QUICK_OVERRIDES,
-    band_row,
-    band_statistics,
-    beam_attenuation,
-    check_scene,
-    select_measured,
-)
+from warpcaustics.batch.field.darecki2011 import PLOT_NEEDS, band_row, beam_attenuation, render_record
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 POINT_KEYS = ("water.wind_speed_m_s",)
@@ -60,33 +51,20 @@ def run_darecki2011_wind(
     ``out``, pool each wind's frames per band and write ``darecki2011_wind.csv`` and
     ``darecki2011_wind.png``. The frames are ``frame_interval_s`` apart (5 s: longer than the peak
     waves' period, so each frame samples the largest scales anew)."""
-    from warpcaustics.scene import load_scene
-
-    times = check_frames(frames, frame_interval_s)
-    check_overrides(overrides, POINT_KEYS, "--winds")
     rec = record()
-    scene_path = Path(scene).resolve()
-    fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
-    base = load_scene(scene_path, fixed)
-    check_scene(base.config, rec)
-    pyplot(PLOT_NEEDS)  # before the sweep, not after it
-    chosen = select_measured(rec.wind_m_s, winds, "--winds", "wind [m/s]")
-    if quick:
-        chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
-    variants = [{"water.wind_speed_m_s": u} for u in chosen]
-    sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
-                          quiet=quiet, force=force)
-    c555 = beam_attenuation(base.config, 555.0)
+    config, points = render_record(
+        scene, out, rec, POINT_KEYS[0], rec.wind_m_s, winds, ("--winds", "wind [m/s]"), frames=frames,
+        frame_interval_s=frame_interval_s, workers=workers, device=device, quick=quick, quiet=quiet,
+        force=force, overrides=overrides)
+    c555 = beam_attenuation(config, 555.0)
     rows = []
-    for wind in chosen:
-        k = int(np.argmin(np.abs(rec.wind_m_s - wind)))
-        point = {"water.wind_speed_m_s": wind}
-        for j, band in enumerate(band_statistics(sweep, out, point, rec.wavelengths_nm)):
+    for wind, k, bands in points:
+        for j, band in enumerate(bands):
             measured = float(rec.cv[k, j])
             rows.append({"wind_m_s": wind, "day": rec.days[k], "wavelength_nm": float(rec.wavelengths_nm[j]),
                          "measured_cv": round(measured, 4), **band_row(band, measured),
-                         "model_depth_m": base.config.floor.depth_m,
-                         "model_sun_zenith_deg": round(90.0 - base.config.sun.elevation_deg, 3),
+                         "model_depth_m": config.floor.depth_m,
+                         "model_sun_zenith_deg": round(90.0 - config.sun.elevation_deg, 3),
                          "model_c555_per_m": round(c555, 4),
                          "measured_c555_per_m": "-".join(f"{c:g}" for c in rec.beam_attenuation_555)})
     out = Path(out)
