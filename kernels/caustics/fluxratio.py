@@ -129,6 +129,14 @@ def texel_of(x: float, m: int, periodic: int) -> int:
     return int(wrap_coord(x, m))
 
 
+@wp.func
+def reaching(transmittance: wp.array3d[wp.float32], path_m: wp.array3d[wp.float32], g: int, x: int, y: int,
+             c: float) -> float:
+    """T exp(−c l) of vertex (y, x) for index group g: the share of its ray's light that enters and
+    reaches the floor."""
+    return transmittance[g, y, x] * wp.exp(-c * path_m[g, y, x])
+
+
 @wp.kernel
 def triangle_flux(
     positions: wp.array2d[wp.vec3],
@@ -143,8 +151,9 @@ def triangle_flux(
     flux_w_nm: wp.array4d[wp.float32],
     entering_m2: wp.array4d[wp.float32],
 ):
-    """Flux [W nm^-1] that triangle (iy, ix, half) delivers to the floor at every wavelength k,
-    and its share of the light that enters the water (before attenuation).
+    """Flux [W nm^-1] that each triangle (iy, ix, half) of quad (iy, ix) delivers to the floor at every
+    wavelength k, and its share of the light that enters the water (before attenuation); one thread
+    per quad, whose four corners serve both halves.
 
     ``flux_w_nm`` is (Q, Q, 2, K) with Q quads per side (N periodic, N+1 walled): a triangle's
     wavelengths are contiguous for the deposit.
@@ -153,28 +162,34 @@ def triangle_flux(
     projected perpendicular to the sun (0 for triangles facing away from it);
     ``entering_m2`` (G, Q, Q, 2): ``A_perp * mean_i(T_i)`` per index group, the flux entering the
     water through the triangle per unit irradiance [m²] (no K axis: the host multiplies by E(k)).
+    Half 0 has corners (0,0), (1,0), (1,1), half 1 (0,0), (1,1), (0,1) (:func:`quad_corner`).
     """
-    iy, ix, half = wp.tid()
+    iy, ix = wp.tid()
     n = positions.shape[0]
-    x0, y0, s0 = quad_corner(ix, iy, half, 0, n, extent_m, periodic)
-    x1, y1, s1 = quad_corner(ix, iy, half, 1, n, extent_m, periodic)
-    x2, y2, s2 = quad_corner(ix, iy, half, 2, n, extent_m, periodic)
-    p0 = lift(positions[y0, x0], s0)
-    p1 = lift(positions[y1, x1], s1)
-    p2 = lift(positions[y2, x2], s2)
-    a_perp = wp.max(0.5 * wp.dot(wp.cross(p1 - p0, p2 - p0), sun_dir), 0.0)
+    xa, ya, sa = grid_corner(ix, iy, 0, 0, n, extent_m, periodic)
+    xb, yb, sb = grid_corner(ix, iy, 1, 0, n, extent_m, periodic)
+    xc, yc, sc = grid_corner(ix, iy, 1, 1, n, extent_m, periodic)
+    xd, yd, sd = grid_corner(ix, iy, 0, 1, n, extent_m, periodic)
+    pa = lift(positions[ya, xa], sa)
+    pb = lift(positions[yb, xb], sb)
+    pc = lift(positions[yc, xc], sc)
+    pd = lift(positions[yd, xd], sd)
+    a_perp0 = wp.max(0.5 * wp.dot(wp.cross(pb - pa, pc - pa), sun_dir), 0.0)
+    a_perp1 = wp.max(0.5 * wp.dot(wp.cross(pc - pa, pd - pa), sun_dir), 0.0)
     for k in range(sun_irradiance.shape[0]):
         g = k / wavelengths_per_group
         c = attenuation_per_m[k]
-        mean_t = (
-            transmittance[g, y0, x0] * wp.exp(-c * path_m[g, y0, x0])
-            + transmittance[g, y1, x1] * wp.exp(-c * path_m[g, y1, x1])
-            + transmittance[g, y2, x2] * wp.exp(-c * path_m[g, y2, x2])
-        ) / 3.0
-        flux_w_nm[iy, ix, half, k] = sun_irradiance[k] * a_perp * mean_t
+        ea = reaching(transmittance, path_m, g, xa, ya, c)
+        ec = reaching(transmittance, path_m, g, xc, yc, c)
+        mean_t0 = (ea + reaching(transmittance, path_m, g, xb, yb, c) + ec) / 3.0
+        mean_t1 = (ea + ec + reaching(transmittance, path_m, g, xd, yd, c)) / 3.0
+        flux_w_nm[iy, ix, 0, k] = sun_irradiance[k] * a_perp0 * mean_t0
+        flux_w_nm[iy, ix, 1, k] = sun_irradiance[k] * a_perp1 * mean_t1
         if k % wavelengths_per_group == 0:
-            mean_t0 = (transmittance[g, y0, x0] + transmittance[g, y1, x1] + transmittance[g, y2, x2]) / 3.0
-            entering_m2[g, iy, ix, half] = a_perp * mean_t0
+            ta = transmittance[g, ya, xa]
+            tc = transmittance[g, yc, xc]
+            entering_m2[g, iy, ix, 0] = a_perp0 * ((ta + transmittance[g, yb, xb] + tc) / 3.0)
+            entering_m2[g, iy, ix, 1] = a_perp1 * ((ta + tc + transmittance[g, yd, xd]) / 3.0)
 
 
 @wp.struct

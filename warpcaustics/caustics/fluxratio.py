@@ -106,7 +106,7 @@ class FloorCaustics:
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
         per_group = self.sun_irradiance.shape[0] // refracted.hit_xy.shape[0]
-        wp.launch(floor_kernels.triangle_flux, dim=(quads, quads, 2),
+        wp.launch(floor_kernels.triangle_flux, dim=(quads, quads),
                   inputs=[surface.positions, refracted.path_m, refracted.transmittance,
                           wp.vec3(*np.asarray(sun_dir, np.float32)),
                           self.last_irradiance,
