@@ -12,6 +12,7 @@ from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
 from warpcaustics.config import FloorShape, Scattering, SkySampling
+from warpcaustics.kernels.caustics import coarse as coarse_kernels
 from warpcaustics.kernels.caustics import coverage as cover_kernels
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
 from warpcaustics.optics.refraction import Refracted, refract_to_floor
@@ -31,14 +32,43 @@ def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     return refraction + triangle_flux + 3 * k * m * m * 4 + k * m * 8
 
 
+COARSE_TEXELS_PER_WINDOW = 8
+"""A window's side in coarse texels of the whole patch's map, where the surface's cells allow: the
+small-angle transfer takes the scales above two coarse texels from the whole patch, those below
+from the window."""
+
+CELLS_PER_COARSE_TEXEL = 2
+"""Surface cells a coarse texel spans at least (a power of two): each quad's light goes to the
+coarse map as one point, so a texel must hold several, and a whole number of them keeps the map of
+still water exactly uniform."""
+
+
+def coarse_resolution(cfg, periodic: bool) -> int:
+    """Coarse texels a side of the whole patch's map that the small-angle transfer of a floor-map
+    window needs (0: none; the map is the whole patch, or the sea is not periodic): N / r for N cells
+    a side, r the largest power of two with r cells within a window's 1/COARSE_TEXELS_PER_WINDOW,
+    and at least CELLS_PER_COARSE_TEXEL."""
+    side, _ = cfg.map_window
+    extent = float(cfg.water.extent_m)
+    if not periodic or side >= extent:
+        return 0
+    n = cfg.water.resolution
+    cells = side / COARSE_TEXELS_PER_WINDOW / (extent / n)
+    r = max(CELLS_PER_COARSE_TEXEL, 2 ** int(np.floor(np.log2(max(cells, 1.0)))))
+    return max(1, n // r)
+
+
 class FloorCaustics:
     """Owns the floor stage's device buffers, reused from frame to frame."""
 
     def __init__(self, n: int, map_resolution: int, sun_irradiance: np.ndarray,
                  attenuation_per_m: np.ndarray, device: str, *, periodic: bool = True,
-                 window: tuple[float, tuple[float, float]] | None = None, groups: int = 1):
+                 window: tuple[float, tuple[float, float]] | None = None, groups: int = 1,
+                 coarse_resolution: int = 0):
         """``window``: (side W [m], centre (x, y) [m]) of a floor-map window; None: the whole patch.
-        ``groups``: refractive-index groups (K with dispersion, else 1)."""
+        ``groups``: refractive-index groups (K with dispersion, else 1). ``coarse_resolution`` > 0:
+        also the whole periodic patch's light on that many coarse texels a side
+        (:meth:`coarse_irradiance`), for the small-angle transfer's large scales."""
         k = len(sun_irradiance)
         m = map_resolution
         self.device = device
@@ -73,6 +103,13 @@ class FloorCaustics:
         self.reach = wp.zeros((groups if cull else 1, blocks, blocks), dtype=wp.int32, device=device)
         """Per index group and block of REACH_CELLS² quads, 1 if its footprints may reach the window
         (a window of a periodic sea; else unused)."""
+        self.coarse = None
+        """(Mc, Mc, K) float64: the runs' flux [W nm⁻¹] by footprint centroid on the whole patch's
+        coarse texels (``kernels/caustics/coarse.py``), or None."""
+        if coarse_resolution:
+            if not periodic:
+                raise ValueError("a coarse map of the whole patch needs a periodic sea")
+            self.coarse = wp.zeros((coarse_resolution, coarse_resolution, k), dtype=wp.float64, device=device)
 
     def floor_map(self, extent_m: float) -> floor_kernels.FloorMap:
         """Where the M×M map lies: the whole patch of side ``extent_m``, or the window. On a
@@ -113,6 +150,13 @@ class FloorCaustics:
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux, self.entering], device=self.device)
+        if self.coarse is not None:
+            if clear:
+                self.coarse.zero_()
+            wp.launch(coarse_kernels.splat_quads, dim=(refracted.hit_xy.shape[0], quads, quads),
+                      inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
+                              self.coarse.shape[0] / float(surface.extent_m)],
+                      outputs=[self.coarse], device=self.device)
         return self.deposit(surface, refracted, clear=clear, bands=bands)
 
     def deposit(self, surface: Surface, refracted: Refracted, *, clear: bool = True,
@@ -140,6 +184,12 @@ class FloorCaustics:
             wp.launch(cover_kernels.cover_to_bands, dim=(m, k), inputs=[self.cover, self.carry, self.texels],
                       outputs=[self.irradiance], device=self.device)
         return self.irradiance
+
+    def coarse_irradiance(self, extent_m: float) -> np.ndarray:
+        """(K, Mc, Mc) the whole patch's irradiance on the coarse texels [W m⁻² nm⁻¹] since the last
+        clearing run, texel (i, j) centred at −L/2 + (i + ½) L/Mc (L = ``extent_m``)."""
+        mc = self.coarse.shape[0]
+        return np.moveaxis(self.coarse.numpy(), -1, 0) * (mc / extent_m) ** 2
 
     def entering_flux(self) -> np.ndarray:
         """(K,) flux the last :meth:`run`'s triangles let into the water, before attenuation
@@ -176,20 +226,25 @@ class FluxRatioStage(CausticStage):
                                                light.sun_irradiance, light.optics.absorption_per_m,
                                                light.optics.scattering_per_m, device,
                                                floor_albedo=floor_albedo, **sky)
+        coarse = 0
         if cfg.optics.scattering is Scattering.SMALL_ANGLE:
             self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
                                                     light.optics.scattering_per_m)
+            coarse = coarse_resolution(cfg, water.periodic)
         disk_share = light.sun_irradiance / len(light.sun_directions)
         self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
                                    device, periodic=water.periodic, window=window,
-                                   groups=len(light.group_ior))
+                                   groups=len(light.group_ior), coarse_resolution=coarse)
 
     @classmethod
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
         cfg = scene.config
         m = cfg.caustics.map_resolution
         walk = k * m * m * 4 if cfg.optics.scattering is not Scattering.SINGLE else 0  # the walk's texels
-        return floor_bytes(scene.water_resolution, m, k, groups) + walk
+        coarse = 0
+        if cfg.optics.scattering is Scattering.SMALL_ANGLE:
+            coarse = k * coarse_resolution(cfg, cfg.water.periodic) ** 2 * 8
+        return floor_bytes(scene.water_resolution, m, k, groups) + walk + coarse
 
     def render(self, frame: Frame) -> StageOutput:
         floor, transmitted, extra, single = self.flux_ratio(frame)
@@ -219,7 +274,8 @@ class FluxRatioStage(CausticStage):
             self.small_angle.reset(frame.surface.positions.numpy()[..., 2])
             with watch.stage("small_angle"):  # the disk's directions share one transfer, its centre's
                 centre = np.mean(self.light.sun_directions, axis=0)
-                self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1])
+                self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1],
+                                     coarse=self._coarse(frame))
         single_sky = None
         if self.light.sky_directions is not None:
             sky_np, sky_flux, even = self._sky(frame)
@@ -286,10 +342,17 @@ class FluxRatioStage(CausticStage):
                 total = one if total is None else total + one
                 with frame.watch.stage("small_angle"):
                     group = SKY_GROUPS[i % 2] if halves else "sky"
-                    self.small_angle.add(one, direction, flux[1], group=group)
+                    self.small_angle.add(one, direction, flux[1], group=group, coarse=self._coarse(frame))
             if halves and n == count // 2 - 1:  # the last of the even-numbered directions
                 even = total.copy() if separate else floor.numpy().copy()
         return (floor.numpy().copy() if total is None else total), transmitted, even
+
+    def _coarse(self, frame: Frame) -> np.ndarray | None:
+        """The whole patch's light on coarse texels since the last clearing pass (K, Mc, Mc), or None
+        where the map is the whole patch."""
+        if self.floor.coarse is None:
+            return None
+        return self.floor.coarse_irradiance(float(frame.surface.extent_m))
 
     def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
                  irradiance: wp.array | None = None, bands: bool = True) -> tuple[wp.array3d, np.ndarray]:

@@ -57,37 +57,72 @@ class SmallAngleScattering:
         down = np.array([horizontal[0] * sin_w, horizontal[1] * sin_w, -cos_w])
         return down, self.depth_m / cos_w
 
-    def local_paths(self, down: np.ndarray) -> np.ndarray:
-        """(M, M) the path [m] through the water of the light reaching each texel: from the surface
-        where it entered (the height there, bilinear, at the still-water refraction's offset) down
-        the beam to the floor."""
+    def local_paths(self, down: np.ndarray, x: np.ndarray | None = None, y: np.ndarray | None = None
+                    ) -> np.ndarray:
+        """The path [m] through the water of the light reaching each texel (x, y) [m] (default: the
+        map's): from the surface where it entered (the height there, bilinear, at the still-water
+        refraction's offset) down the beam to the floor."""
+        if x is None:
+            x, y = self.texel_x, self.texel_y
         cos_w = -down[2]
         offset = self.depth_m / cos_w  # along the beam, back to the mean level
-        x = self.texel_x - down[0] * offset
-        y = self.texel_y - down[1] * offset
-        height = periodic_bilinear(self.heights, self.extent_m, x, y)
+        height = periodic_bilinear(self.heights, self.extent_m, x - down[0] * offset, y - down[1] * offset)
         return (self.depth_m + height) / cos_w
 
+    def lost(self, down: np.ndarray, path: float, x: np.ndarray | None = None, y: np.ndarray | None = None
+             ) -> np.ndarray:
+        """(K, …) e^{b s(x)} − 1 over e^{b s̄} − 1 at the texels (x, y) (default: the map's): the light
+        each texel's ray lost to scattering on its own path, relative to the mean path's."""
+        local = self.local_paths(down, x, y)
+        return np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]
+
+    def coarse_centres(self, mc: int) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) [m] of the whole patch's Mc × Mc coarse texel centres, [iy, ix]."""
+        centres = (np.arange(mc) + 0.5) * self.extent_m / mc - 0.5 * self.extent_m
+        return np.meshgrid(centres, centres)
+
+    def transfer(self, single: np.ndarray, lost: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
+                 path: float) -> tuple[np.ndarray, np.ndarray]:
+        """(the pass's scattered light on the map (K, M, M), the weighting of its k = 0 term over the
+        patch (K,)). Without ``coarse`` the map is the whole periodic patch, or a window taken as
+        periodic. With ``coarse`` (K, Mc, Mc), the whole patch's single-scattering light on coarse
+        texels, a window's scattered light is that of the whole patch at the large scales, bilinear
+        from the coarse texels, plus the window's own detail beyond them taken as periodic:
+        B*C + B_w*(S_w − C_w), C_w the coarse map at the window's texels (B the transfer)."""
+        weighted = single * lost
+        on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
+        if coarse is None:
+            weighting = np.divide(weighted.mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
+                                  where=on_map > 0)
+            return scattered_light(weighted, self.texel_m, self.optics, path, self.b, down), weighting
+        mc = coarse.shape[-1]
+        weighted_c = coarse * self.lost(down, path, *self.coarse_centres(mc))
+        far = scattered_light(weighted_c, self.extent_m / mc, self.optics, path, self.b, down)
+
+        def at_map(a: np.ndarray) -> np.ndarray:
+            return np.stack([periodic_bilinear(one, self.extent_m, self.texel_x, self.texel_y) for one in a])
+
+        near = scattered_light(weighted - at_map(weighted_c), self.texel_m, self.optics, path, self.b, down)
+        whole = coarse.mean(axis=(1, 2))
+        weighting = np.divide(weighted_c.mean(axis=(1, 2)), whole, out=np.ones_like(whole), where=whole > 0)
+        return at_map(far) + near, weighting
+
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
-            group: str = "sun") -> None:
+            group: str = "sun", coarse: np.ndarray | None = None) -> None:
         """One pass: its single-scattering map (K, M, M) [W m⁻² nm⁻¹], the direction of its light
-        (towards it), the flux its map holds over the whole patch (K,) [W nm⁻¹], and the group its
-        scattered light is reported in (``sun``; ``sky_even`` and ``sky``, the sky's two halves). The
-        light each texel's ray lost to scattering on its own path, S (e^{b s(x)} − 1), is what the
-        transfer spreads, normalised to the mean path's e^{b s̄} − 1 that the transfer's own k = 0
-        term carries."""
+        (towards it), the flux its map holds over the whole patch (K,) [W nm⁻¹], the group its
+        scattered light is reported in (``sun``; ``sky_even`` and ``sky``, the sky's two halves), and
+        for a window of a periodic sea the whole patch's single-scattering light on coarse texels
+        (K, Mc, Mc) (:meth:`transfer`). The light each texel's ray lost to scattering on its own path,
+        S (e^{b s(x)} − 1), is what the transfer spreads, normalised to the mean path's e^{b s̄} − 1
+        that the transfer's own k = 0 term carries."""
         down, path = self.beam(direction)
-        local = self.local_paths(down)
-        lost = np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]
-        part = scattered_light(single * lost, self.texel_m, self.optics, path, self.b, down)
+        part, weighting = self.transfer(single, self.lost(down, path), coarse, down, path)
         self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
         mean = np.asarray(delivered_flux, np.float64) / self.area
         self.single_mean += mean
-        # the transfer's k = 0 term over the patch: the map's weighting by the local paths, measured
-        # on the map (the whole patch, or a window standing for it)
-        on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
-        weighting = np.divide((single * lost).mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
-                              where=on_map > 0)
+        # the transfer's k = 0 term over the patch: its weighting by the local paths, measured on the
+        # whole patch (coarse), or on the map (the whole patch, or a window standing for it)
         self.transferred_mean += mean * weighting * np.expm1(self.b * path)
         self.paths.append(path)
 
