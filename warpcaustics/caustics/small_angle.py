@@ -18,7 +18,7 @@ import numpy as np
 
 from warpcaustics.config import Config
 from warpcaustics.optics.small_angle import scattered_light
-from warpcaustics.scene.receivers import periodic_bilinear
+from warpcaustics.scene.receivers import bilinear_at, bilinear_weights, periodic_bilinear
 
 
 class SmallAngleScattering:
@@ -37,6 +37,8 @@ class SmallAngleScattering:
         self.extent_m = float(cfg.water.extent_m)
         self.area = self.extent_m**2
         self.heights = None
+        self.at_map = None
+        """(Mc, the corners and weights of the map's texels on an Mc × Mc coarse map of the patch)."""
 
     def reset(self, heights: np.ndarray) -> None:
         """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
@@ -96,16 +98,15 @@ class SmallAngleScattering:
                                   where=on_map > 0)
             return scattered_light(weighted, self.texel_m, self.optics, path, self.b, down), weighting
         mc = coarse.shape[-1]
+        if self.at_map is None or self.at_map[0] != mc:
+            self.at_map = mc, bilinear_weights(mc, self.extent_m, self.texel_x, self.texel_y)
         weighted_c = coarse * self.lost(down, path, *self.coarse_centres(mc))
         far = scattered_light(weighted_c, self.extent_m / mc, self.optics, path, self.b, down)
-
-        def at_map(a: np.ndarray) -> np.ndarray:
-            return np.stack([periodic_bilinear(one, self.extent_m, self.texel_x, self.texel_y) for one in a])
-
-        near = scattered_light(weighted - at_map(weighted_c), self.texel_m, self.optics, path, self.b, down)
+        near = scattered_light(weighted - bilinear_at(weighted_c, self.at_map[1]), self.texel_m, self.optics,
+                               path, self.b, down)
         whole = coarse.mean(axis=(1, 2))
         weighting = np.divide(weighted_c.mean(axis=(1, 2)), whole, out=np.ones_like(whole), where=whole > 0)
-        return at_map(far) + near, weighting
+        return bilinear_at(far, self.at_map[1]) + near, weighting
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
             group: str = "sun", coarse: np.ndarray | None = None) -> None:
