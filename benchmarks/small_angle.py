@@ -6,7 +6,10 @@ and 16 sky directions, a 1 m window of 512² texels, 510 nm) rendered with ``opt
 "single"`` and ``"small_angle"`` (the scattered light of each pass by the small-angle transfer, its
 mean from a random walk at one photon per cell), warm frames, median of ``repeats``, one core. Prints
 the time of each and their ratio; the record says where the small-angle time goes (the walk, the
-transfer's FFTs, the sky's per-direction read-backs).
+transfer's FFTs, the sky's per-direction read-backs). A third frame, ``small_angle`` with the window
+taken whole as periodic (as before 2026-12-05: no coarse map of the patch), gives the cost of the
+window's large scales from the whole patch (each pass's quads splatted on a coarse map, its FFT
+transfer and the bilinear read at the window's texels).
 """
 
 from __future__ import annotations
@@ -25,11 +28,20 @@ def run(quick: bool, device: str) -> dict:
 
     repeats = 2 if quick else 3
     overrides = {"optics.mc_samples": 1, "floor.albedo": 0.0, **(QUICK if quick else FULL)}
+    from warpcaustics.caustics import fluxratio
+
     times, stages = {}, {}
-    for mode in ("single", "small_angle"):
+    for mode, scattering in (("single", "single"), ("small_angle", "small_angle"),
+                             ("periodic_window", "small_angle")):
         scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml",
-                              {**BEFORE, **overrides, "optics.scattering": mode})
-        renderer = wc.Renderer(scene, device=device)
+                              {**BEFORE, **overrides, "optics.scattering": scattering})
+        coarse = fluxratio.coarse_resolution
+        if mode == "periodic_window":  # the baseline: no coarse map, the window taken whole as periodic
+            fluxratio.coarse_resolution = lambda cfg, periodic: 0
+        try:
+            renderer = wc.Renderer(scene, device=device)
+        finally:
+            fluxratio.coarse_resolution = coarse
         renderer.render(0.0)  # warm-up (and the phase function's spread table)
         times[mode] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
         result = renderer.render(0.5)
@@ -37,9 +49,12 @@ def run(quick: bool, device: str) -> dict:
     n = scene.config.water.resolution
     row = {"water_n": n, "map": scene.config.caustics.map_resolution, "single_s": times["single"],
            "small_angle_s": times["small_angle"], "ratio": times["small_angle"] / times["single"],
-           "stages_s": stages}
+           "periodic_window_s": times["periodic_window"],
+           "coarse_ratio": times["small_angle"] / times["periodic_window"],
+           "coarse_texels": fluxratio.coarse_resolution(scene.config, True), "stages_s": stages}
     print(f"small_angle  field frame N={n} | single {times['single']:.2f} s | small_angle "
-          f"{times['small_angle']:.2f} s | ×{row['ratio']:.2f}", flush=True)
+          f"{times['small_angle']:.2f} s | ×{row['ratio']:.2f} | the window periodic (no coarse map) "
+          f"{times['periodic_window']:.2f} s: the coarse map ×{row['coarse_ratio']:.2f}", flush=True)
     return {"benchmark": "small_angle_scattering", **device_record(device), "repeats": repeats,
             "results": [row]}
 
