@@ -104,8 +104,8 @@ class FloorCaustics:
         """Per index group and block of REACH_CELLS² quads, 1 if its footprints may reach the window
         (a window of a periodic sea; else unused)."""
         self.coarse = None
-        """(Mc, Mc, K) float64: the runs' flux [W nm⁻¹] by footprint centroid on the whole patch's
-        coarse texels (``kernels/caustics/coarse.py``), or None."""
+        """(Mc, Mc, K) float64: the runs' flux [W nm⁻¹] at each quad's mean floor hit, on the whole
+        patch's coarse texels (``kernels/caustics/coarse.py``), or None."""
         if coarse_resolution:
             if not periodic:
                 raise ValueError("a coarse map of the whole patch needs a periodic sea")
