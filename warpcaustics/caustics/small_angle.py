@@ -18,7 +18,24 @@ import numpy as np
 
 from warpcaustics.config import Config
 from warpcaustics.optics.small_angle import scattered_light
-from warpcaustics.scene.receivers import bilinear_at, bilinear_weights, periodic_bilinear
+from warpcaustics.scene.receivers import periodic_bilinear
+
+
+def axis_weights(n: int, extent_m: float, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the grid indices used, (len(coords), used) weights): linear interpolation along one axis of a
+    periodic grid of N cell-centre samples over ``extent_m`` at ``coords`` [m] (as
+    :func:`~warpcaustics.scene.receivers.periodic_bilinear` does per axis)."""
+    u = (np.asarray(coords, np.float64) + 0.5 * extent_m) * n / extent_m - 0.5
+    i0 = np.floor(u).astype(np.int64)
+    t = u - i0
+    i0 = i0 % n
+    i1 = (i0 + 1) % n
+    used = np.unique(np.concatenate([i0, i1]))
+    weights = np.zeros((len(u), len(used)))
+    at = np.arange(len(u))
+    np.add.at(weights, (at, np.searchsorted(used, i0)), 1.0 - t)
+    np.add.at(weights, (at, np.searchsorted(used, i1)), t)
+    return used, weights
 
 
 class SmallAngleScattering:
@@ -99,14 +116,22 @@ class SmallAngleScattering:
             return scattered_light(weighted, self.texel_m, self.optics, path, self.b, down), weighting
         mc = coarse.shape[-1]
         if self.at_map is None or self.at_map[0] != mc:
-            self.at_map = mc, bilinear_weights(mc, self.extent_m, self.texel_x, self.texel_y)
+            self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
+                           axis_weights(mc, self.extent_m, self.texel_x[0]))
         weighted_c = coarse * self.lost(down, path, *self.coarse_centres(mc))
         far = scattered_light(weighted_c, self.extent_m / mc, self.optics, path, self.b, down)
-        near = scattered_light(weighted - bilinear_at(weighted_c, self.at_map[1]), self.texel_m, self.optics,
-                               path, self.b, down)
+        near = scattered_light(weighted - self.on_map(weighted_c), self.texel_m, self.optics, path, self.b,
+                               down)
         whole = coarse.mean(axis=(1, 2))
         weighting = np.divide(weighted_c.mean(axis=(1, 2)), whole, out=np.ones_like(whole), where=whole > 0)
-        return bilinear_at(far, self.at_map[1]) + near, weighting
+        return self.on_map(far) + near, weighting
+
+    def on_map(self, a: np.ndarray) -> np.ndarray:
+        """(K, M, M) the coarse map ``a`` (K, Mc, Mc) read bilinearly at the map's texels, periodic:
+        separable, as the map's texels are a grid (the rows and columns it needs, then one matrix
+        product per axis)."""
+        _, (rows, wy), (cols, wx) = self.at_map
+        return wy @ a[:, rows][:, :, cols] @ wx.T
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
             group: str = "sun", coarse: np.ndarray | None = None) -> None:

@@ -61,26 +61,15 @@ def floor_relief_height(
 
 def periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Bilinear interpolation of cell-centre samples h[iy, ix] over the patch, wrapping at its edges."""
-    return bilinear_at(h, bilinear_weights(h.shape[0], extent_m, x, y))
-
-
-def bilinear_weights(n: int, extent_m: float, x: np.ndarray, y: np.ndarray) -> tuple:
-    """The corners and weights of :func:`periodic_bilinear` on an N × N grid at (x, y) [m], for
-    :func:`bilinear_at` to reuse on many grids of that size."""
+    n = h.shape[0]
     u = (x + 0.5 * extent_m) * n / extent_m - 0.5
     v = (y + 0.5 * extent_m) * n / extent_m - 0.5
     i0 = np.floor(u).astype(np.int64)
     j0 = np.floor(v).astype(np.int64)
     tu, tv = u - i0, v - j0
     i0, j0 = i0 % n, j0 % n
-    return i0, j0, (i0 + 1) % n, (j0 + 1) % n, tu, tv
-
-
-def bilinear_at(h: np.ndarray, weights: tuple) -> np.ndarray:
-    """:func:`periodic_bilinear` of h[..., iy, ix] (any leading axes) with :func:`bilinear_weights`."""
-    i0, j0, i1, j1, tu, tv = weights
-    return ((1 - tv) * ((1 - tu) * h[..., j0, i0] + tu * h[..., j0, i1])
-            + tv * ((1 - tu) * h[..., j1, i0] + tu * h[..., j1, i1]))
+    i1, j1 = (i0 + 1) % n, (j0 + 1) % n
+    return (1 - tv) * ((1 - tu) * h[j0, i0] + tu * h[j0, i1]) + tv * ((1 - tu) * h[j1, i0] + tu * h[j1, i1])
 
 
 def load_floor_relief(name: str, base_dir: Path) -> np.ndarray:
