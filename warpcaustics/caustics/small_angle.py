@@ -55,7 +55,8 @@ class SmallAngleScattering:
         self.area = self.extent_m**2
         self.heights = None
         self.at_map = None
-        """(Mc, the corners and weights of the map's texels on an Mc × Mc coarse map of the patch)."""
+        """(Mc, (rows, weights), (columns, weights)): where the map's texels lie on an Mc × Mc coarse
+        map of the patch (:func:`axis_weights` per axis)."""
 
     def reset(self, heights: np.ndarray) -> None:
         """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
@@ -103,11 +104,11 @@ class SmallAngleScattering:
     def transfer(self, single: np.ndarray, lost: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
                  path: float) -> tuple[np.ndarray, np.ndarray]:
         """(the pass's scattered light on the map (K, M, M), the weighting of its k = 0 term over the
-        patch (K,)). Without ``coarse`` the map is the whole periodic patch, or a window taken as
-        periodic. With ``coarse`` (K, Mc, Mc), the whole patch's single-scattering light on coarse
-        texels, a window's scattered light is that of the whole patch at the large scales, bilinear
-        from the coarse texels, plus the window's own detail beyond them taken as periodic:
-        B*C + B_w*(S_w − C_w), C_w the coarse map at the window's texels (B the transfer)."""
+        patch (K,)). Without ``coarse`` the map is the whole periodic patch. With ``coarse`` (K, Mc,
+        Mc), the whole patch's single-scattering light on coarse texels beside a window, the window's
+        scattered light is the whole patch's at the large scales, read bilinearly from the coarse
+        texels, plus the window's own detail beyond them taken as periodic: B*C + B_w*(S_w − C_w),
+        C_w the coarse map at the window's texels (B the transfer)."""
         weighted = single * lost
         on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
         if coarse is None:
