@@ -38,11 +38,11 @@ def splat_quads(
     if carries_flux(flux_w_nm, iy, ix, 0, k_begin, wavelengths_per_group) == 0:
         if carries_flux(flux_w_nm, iy, ix, 1, k_begin, wavelengths_per_group) == 0:
             return
-    x1, y0, s10 = grid_corner(ix, iy, 1, 0, n, extent_m, 1)
-    x1, y1, s11 = grid_corner(ix, iy, 1, 1, n, extent_m, 1)
-    x0, y1, s01 = grid_corner(ix, iy, 0, 1, n, extent_m, 1)
-    centre = 0.25 * (hit_xy[g, iy, ix] + hit_xy[g, y0, x1] + s10 + hit_xy[g, y1, x1] + s11
-                     + hit_xy[g, y1, x0] + s01)
+    xb, yb, sb = grid_corner(ix, iy, 1, 0, n, extent_m, 1)  # corner (0, 0) is (ix, iy) itself
+    xc, yc, sc = grid_corner(ix, iy, 1, 1, n, extent_m, 1)
+    xd, yd, sd = grid_corner(ix, iy, 0, 1, n, extent_m, 1)
+    centre = 0.25 * (hit_xy[g, iy, ix] + hit_xy[g, yb, xb] + sb + hit_xy[g, yc, xc] + sc
+                     + hit_xy[g, yd, xd] + sd)
     m = coarse.shape[0]
     c = (centre + wp.vec2(0.5 * extent_m, 0.5 * extent_m)) * coarse_scale - wp.vec2(0.5, 0.5)
     fx = wp.floor(c[0])

@@ -55,8 +55,8 @@ class SmallAngleScattering:
         self.area = self.extent_m**2
         self.heights = None
         self.at_map = None
-        """(Mc, (rows, weights), (columns, weights)): where the map's texels lie on an Mc × Mc coarse
-        map of the patch (:func:`axis_weights` per axis)."""
+        """(Mc, (rows, weights), (columns, weights), (x, y) of the coarse texels' centres): where the
+        map's texels lie on an Mc × Mc coarse map of the patch (:func:`axis_weights` per axis)."""
 
     def reset(self, heights: np.ndarray) -> None:
         """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
@@ -110,16 +110,16 @@ class SmallAngleScattering:
         texels, plus the window's own detail beyond them taken as periodic: B*C + B_w*(S_w − C_w),
         C_w the coarse map at the window's texels (B the transfer)."""
         weighted = single * lost
-        on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
         if coarse is None:
+            on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
             weighting = np.divide(weighted.mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
                                   where=on_map > 0)
             return scattered_light(weighted, self.texel_m, self.optics, path, self.b, down), weighting
         mc = coarse.shape[-1]
         if self.at_map is None or self.at_map[0] != mc:
             self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
-                           axis_weights(mc, self.extent_m, self.texel_x[0]))
-        weighted_c = coarse * self.lost(down, path, *self.coarse_centres(mc))
+                           axis_weights(mc, self.extent_m, self.texel_x[0]), self.coarse_centres(mc))
+        weighted_c = coarse * self.lost(down, path, *self.at_map[3])
         far = scattered_light(weighted_c, self.extent_m / mc, self.optics, path, self.b, down)
         near = scattered_light(weighted - self.on_map(weighted_c), self.texel_m, self.optics, path, self.b,
                                down)
@@ -131,7 +131,7 @@ class SmallAngleScattering:
         """(K, M, M) the coarse map ``a`` (K, Mc, Mc) read bilinearly at the map's texels, periodic:
         separable, as the map's texels are a grid (the rows and columns it needs, then one matrix
         product per axis)."""
-        _, (rows, wy), (cols, wx) = self.at_map
+        _, (rows, wy), (cols, wx), _ = self.at_map
         return wy @ a[:, rows][:, :, cols] @ wx.T
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
