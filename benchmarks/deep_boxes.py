@@ -6,7 +6,8 @@ Darecki et al. (2011)'s conditions at their deepest depth (``configs/field/darec
 long, kept; the short ones, which do not change the CV down there, dropped), a point sun and no
 sky, the whole patch's floor map on 25 cm texels. The spatial spread of the map's means over boxes
 1, 2 and 4 m across (the field comparison's 2 m window is such a box) by single scattering (the
-unscattered pattern), by the small-angle transfer (``optics.scattering = "small_angle"``), and by
+unscattered pattern), by the small-angle transfer (``optics.scattering = "small_angle"``, with
+either ``optics.beam_spread``), and by
 the random walk (``"multiple"``, 64 photons per cell, which scatters at every angle and lengthens
 its paths as it does), with the walk's photon noise taken out by the covariance of two seeds.
 Prints each relative standard deviation and the small-angle map's over the walk's. About two
@@ -52,23 +53,27 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     import warpcaustics as wc
 
-    def floor(mode: str, seed: int = 1) -> np.ndarray:
+    def floor(mode: str, seed: int = 1, spread: str = "wells") -> np.ndarray:
         scene = wc.load_scene(ROOT / "configs/field/darecki2011.toml",
-                              {**SCENE, "optics.scattering": mode, "optics.mc_seed": seed})
+                              {**SCENE, "optics.scattering": mode, "optics.mc_seed": seed,
+                               "optics.beam_spread": spread})
         return wc.render(scene, time_s=args.time, device="cpu").floor_irradiance
 
     start = time.perf_counter()
-    single, small = floor("single"), floor("small_angle")
+    single = floor("single")
+    small = {spread: floor("small_angle", spread=spread) for spread in ("wells", "walk")}
     walks = [floor("multiple", seed) for seed in (1, 2)]
     np.set_printoptions(precision=4, suppress=True)
     print(f"9.58 m, 512² over 32 m, 25 cm texels; rows of each array: the config's bands "
           f"({time.perf_counter() - start:.0f} s)")
     for box in (1.0, 2.0, 4.0):
-        s_single, s_small = box_spread([single], box), box_spread([small], box)
+        s_single = box_spread([single], box)
         s_walk = box_spread(walks, box)
         noise = np.sqrt(np.maximum(box_spread(walks[:1], box) ** 2 - s_walk**2, 0.0))
-        print(f"{box:g} m boxes: single {s_single}  small_angle {s_small}  walk {s_walk} "
-              f"(one walk's noise {noise})  small_angle / walk {s_small / s_walk}")
+        print(f"{box:g} m boxes: single {s_single}  walk {s_walk} (one walk's noise {noise})")
+        for spread, a in small.items():
+            s_small = box_spread([a], box)
+            print(f"    small_angle ({spread} spread) {s_small}  small_angle / walk {s_small / s_walk}")
     return 0
 
 

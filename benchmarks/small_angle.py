@@ -9,12 +9,16 @@ the time of each and their ratio; the record says where the small-angle time goe
 transfer's FFTs, the sky's per-direction read-backs). A third frame, ``small_angle`` with the window
 taken whole as periodic (as before 2026-12-05: no coarse map of the patch), gives the cost of the
 window's large scales from the whole patch (each pass's quads splatted on a coarse map, its FFT
-transfer and the bilinear read at the window's texels).
+transfer and the bilinear read at the window's texels). A fourth, ``small_angle`` with
+``optics.beam_spread = "walk"`` (the column's beam spread function from a walk of a pencil beam per
+light direction instead of Wells's closed form), is timed warm like the others — its walks and
+multipliers are kept from the first frame — and its first frame, which walks them, is reported too.
 """
 
 from __future__ import annotations
 
 import sys
+import time
 
 from benchmarks.field_budget import BEFORE  # the field set-up as these figures were measured
 from benchmarks.run import ROOT, device_record, median_time
@@ -31,10 +35,13 @@ def run(quick: bool, device: str) -> dict:
     from warpcaustics.caustics import fluxratio
 
     times, stages = {}, {}
+    first = {}
     for mode, scattering in (("single", "single"), ("small_angle", "small_angle"),
-                             ("periodic_window", "small_angle")):
+                             ("periodic_window", "small_angle"), ("walked_spread", "small_angle")):
+        spread = "walk" if mode == "walked_spread" else "wells"
         scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml",
-                              {**BEFORE, **overrides, "optics.scattering": scattering})
+                              {**BEFORE, **overrides, "optics.scattering": scattering,
+                               "optics.beam_spread": spread})
         coarse = fluxratio.coarse_resolution
         if mode == "periodic_window":  # the baseline: no coarse map, the window taken whole as periodic
             fluxratio.coarse_resolution = lambda cfg, periodic: 0
@@ -42,7 +49,9 @@ def run(quick: bool, device: str) -> dict:
             renderer = wc.Renderer(scene, device=device)
         finally:
             fluxratio.coarse_resolution = coarse
-        renderer.render(0.0)  # warm-up (and the phase function's spread table)
+        start = time.perf_counter()
+        renderer.render(0.0)  # warm-up (and the phase function's spread table, or the walked spreads)
+        first[mode] = time.perf_counter() - start
         times[mode] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
         result = renderer.render(0.5)
         stages[mode] = {k: round(v, 4) for k, v in result.timings_s.items()}
@@ -51,10 +60,15 @@ def run(quick: bool, device: str) -> dict:
            "small_angle_s": times["small_angle"], "ratio": times["small_angle"] / times["single"],
            "periodic_window_s": times["periodic_window"],
            "coarse_ratio": times["small_angle"] / times["periodic_window"],
-           "coarse_texels": fluxratio.coarse_resolution(scene.config, True), "stages_s": stages}
+           "coarse_texels": fluxratio.coarse_resolution(scene.config, True),
+           "walked_spread_s": times["walked_spread"],
+           "walked_spread_ratio": times["walked_spread"] / times["small_angle"],
+           "first_frame_s": {k: round(v, 2) for k, v in first.items()}, "stages_s": stages}
     print(f"small_angle  field frame N={n} | single {times['single']:.2f} s | small_angle "
           f"{times['small_angle']:.2f} s | ×{row['ratio']:.2f} | the window periodic (no coarse map) "
-          f"{times['periodic_window']:.2f} s: the coarse map ×{row['coarse_ratio']:.2f}", flush=True)
+          f"{times['periodic_window']:.2f} s: the coarse map ×{row['coarse_ratio']:.2f} | walked spread "
+          f"{times['walked_spread']:.2f} s (×{row['walked_spread_ratio']:.2f} of Wells's; first frame "
+          f"{first['walked_spread']:.1f} s against {first['small_angle']:.1f} s)", flush=True)
     return {"benchmark": "small_angle_scattering", **device_record(device), "repeats": repeats,
             "results": [row]}
 

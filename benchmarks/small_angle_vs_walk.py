@@ -31,6 +31,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 GEOMETRIES = ((3.0, "henyey_greenstein"), (6.0, "petzold"))
+SPREADS = ("wells", "walk")
+"""The two ``optics.beam_spread`` transfers of the small-angle mode."""
 
 
 def cross_power(maps: list[np.ndarray], m: int, band_power, fluctuations) -> tuple[np.ndarray, np.ndarray]:
@@ -75,17 +77,18 @@ def main(argv: list[str] | None = None) -> int:
                                 for s in seeds], m, band_power, fluctuations)
         single0 = floor({**bare, "optics.scattering": "single"})
         surface = band_power(np.abs(fluctuations(single0)) ** 2, m) / walk0
-        small = band_power(np.abs(fluctuations(floor({**base, "optics.scattering": "small_angle"}))) ** 2, m)
-        ratio = small / walk
-        left = ratio / surface
         print(f"\n{depth:g} m, {phase}, {args.seeds} seeds ({time.perf_counter() - start:.0f} s)")
         print("walk noise (one pair's relative sd):\n", noise)
         print("surface factor (single / walk, no water):\n", surface)
-        print("small_angle / walk:\n", ratio)
-        print("small_angle / walk over the surface factor:\n", left)
-        print("... its difference from 1 in units of the walk's noise of the averaged pairs:\n",
-              (left - 1.0) / (noise / np.sqrt(args.seeds / 2)))
-        print(f"range over the surface factor: {left.min():.3f}–{left.max():.3f}")
+        for spread in SPREADS:
+            mode = {**base, "optics.scattering": "small_angle", "optics.beam_spread": spread}
+            ratio = band_power(np.abs(fluctuations(floor(mode))) ** 2, m) / walk
+            left = ratio / surface
+            print(f"small_angle ({spread}) / walk:\n", ratio)
+            print(f"small_angle ({spread}) / walk over the surface factor:\n", left)
+            print("... its difference from 1 in units of the walk's noise of the averaged pairs:\n",
+                  (left - 1.0) / (noise / np.sqrt(args.seeds / 2)))
+            print(f"range over the surface factor ({spread}): {left.min():.3f}–{left.max():.3f}")
     return 0
 
 

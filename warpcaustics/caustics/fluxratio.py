@@ -229,6 +229,7 @@ class FluxRatioStage(CausticStage):
         coarse = 0
         if cfg.optics.scattering is Scattering.SMALL_ANGLE:
             self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
+                                                    light.optics.absorption_per_m,
                                                     light.optics.scattering_per_m)
             coarse = coarse_resolution(cfg, water.periodic)
         disk_share = light.sun_irradiance / len(light.sun_directions)

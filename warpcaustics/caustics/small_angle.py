@@ -12,12 +12,14 @@ and the amount of the walk, free of the walk's noise.
 
 from __future__ import annotations
 
+import collections
 import math
 
 import numpy as np
 
-from warpcaustics.config import Config
-from warpcaustics.optics.small_angle import scattered_light
+from warpcaustics.config import BeamSpread, Config
+from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
+from warpcaustics.optics.small_angle import transferred, wells_multiplier
 from warpcaustics.scene.receivers import periodic_bilinear
 
 
@@ -38,13 +40,21 @@ def axis_weights(n: int, extent_m: float, coords: np.ndarray) -> tuple[np.ndarra
     return used, weights
 
 
+MULTIPLIER_CACHE_BYTES = 1 << 29
+"""The most memory the walked spread's multipliers keep between frames (512 MiB)."""
+
+
 class SmallAngleScattering:
     """Collects the passes of one frame (:meth:`add`) and returns the scattered light (:meth:`finish`)."""
 
-    def __init__(self, cfg: Config, ior: float, scattering_per_m: np.ndarray):
+    SPREAD_STREAM = 0x1B873593
+    """Added to ``optics.mc_seed`` for the beam spread functions' walks."""
+
+    def __init__(self, cfg: Config, ior: float, absorption_per_m: np.ndarray, scattering_per_m: np.ndarray):
         self.optics = cfg.optics
         self.depth_m = float(cfg.floor.depth_m)
         self.ior = float(ior)
+        self.a = np.asarray(absorption_per_m, np.float64)
         self.b = np.asarray(scattering_per_m, np.float64)
         m = cfg.caustics.map_resolution
         side, centre = cfg.map_window
@@ -55,6 +65,8 @@ class SmallAngleScattering:
         self.area = self.extent_m**2
         self.heights = None
         self.at_map = None
+        self.multipliers = collections.OrderedDict()
+        """The walked spread's multipliers by (beam, texel, M), least recently used first."""
         """(Mc, (rows, weights), (columns, weights), (x, y) of the coarse texels' centres): where the
         map's texels lie on an Mc × Mc coarse map of the patch (:func:`axis_weights` per axis)."""
 
@@ -96,6 +108,40 @@ class SmallAngleScattering:
         local = self.local_paths(down, x, y)
         return np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]
 
+    def multiplier(self, texel_m: float, m: int, down: np.ndarray, path: float):
+        """The transfer's multiplier of a map's spectrum on an M × M periodic grid of ``texel_m``
+        texels for the beam ``down`` with mean path ``path``: a function of the band, and its k = 0
+        values (K,) — Wells's closed form, or the walked beam spread function
+        (``optics.beam_spread``), whose walks and multipliers are kept for the next frame (the sun's,
+        and a fixed sky's directions: up to ``MULTIPLIER_CACHE_BYTES``)."""
+        wells = wells_multiplier(self.optics, texel_m, m, path, self.b, down)
+        if self.optics.beam_spread is BeamSpread.WELLS:
+            return wells
+        key = (*np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
+        if key in self.multipliers:
+            self.multipliers.move_to_end(key)
+            table, at_zero = self.multipliers[key]
+            return (lambda band: table[band]), at_zero
+        o = self.optics
+        sample = column_spread(o.phase_function, o.hg_g, o.petzold_station.value, tuple(self.a.tolist()),
+                               tuple(self.b.tolist()), round(float(-down[2]), 9), self.depth_m, self.ior,
+                               o.beam_spread_photons, (o.mc_seed + self.SPREAD_STREAM) % 2**31)
+        horizontal = math.hypot(down[0], down[1])
+        azimuth = (down[0] / horizontal, down[1] / horizontal) if horizontal > 1e-12 else (1.0, 0.0)
+        measured, at_zero = spread_multiplier(sample, azimuth, texel_m, m, self.a + self.b, path, wells[0])
+        table = np.stack([measured(band) for band in range(len(self.b))]).astype(np.complex64)
+        self.multipliers[key] = (table, at_zero)
+        while sum(t.nbytes for t, _ in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
+            self.multipliers.popitem(last=False)
+        return (lambda band: table[band]), at_zero
+
+    def spread(self, single: np.ndarray, texel_m: float, down: np.ndarray, path: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """((K, M, M) the scattered light of the map ``single`` taken as periodic, its transfer's
+        k = 0 values (K,))."""
+        multiplier, at_zero = self.multiplier(texel_m, single.shape[-1], down, path)
+        return transferred(single, multiplier), at_zero
+
     def coarse_centres(self, mc: int) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) [m] of the whole patch's Mc × Mc coarse texel centres, [iy, ix]."""
         centres = (np.arange(mc) + 0.5) * self.extent_m / mc - 0.5 * self.extent_m
@@ -103,29 +149,29 @@ class SmallAngleScattering:
 
     def transfer(self, single: np.ndarray, lost: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
                  path: float) -> tuple[np.ndarray, np.ndarray]:
-        """(the pass's scattered light on the map (K, M, M), the weighting of its k = 0 term over the
-        patch (K,)). Without ``coarse`` the map is the whole periodic patch. With ``coarse`` (K, Mc,
-        Mc), the whole patch's single-scattering light on coarse texels beside a window, the window's
-        scattered light is the whole patch's at the large scales, read bilinearly from the coarse
-        texels, plus the window's own detail beyond them taken as periodic: B*C + B_w*(S_w − C_w),
-        C_w the coarse map at the window's texels (B the transfer)."""
+        """(the pass's scattered light on the map (K, M, M), its transfer's k = 0 term over the patch,
+        weighted by the local paths (K,)). Without ``coarse`` the map is the whole periodic patch.
+        With ``coarse`` (K, Mc, Mc), the whole patch's single-scattering light on coarse texels beside
+        a window, the window's scattered light is the whole patch's at the large scales, read
+        bilinearly from the coarse texels, plus the window's own detail beyond them taken as periodic:
+        B*C + B_w*(S_w − C_w), C_w the coarse map at the window's texels (B the transfer)."""
         weighted = single * lost
         if coarse is None:
             on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
             weighting = np.divide(weighted.mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
                                   where=on_map > 0)
-            return scattered_light(weighted, self.texel_m, self.optics, path, self.b, down), weighting
+            out, at_zero = self.spread(weighted, self.texel_m, down, path)
+            return out, weighting * at_zero
         mc = coarse.shape[-1]
         if self.at_map is None or self.at_map[0] != mc:
             self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
                            axis_weights(mc, self.extent_m, self.texel_x[0]), self.coarse_centres(mc))
         weighted_c = coarse * self.lost(down, path, *self.at_map[3])
-        far = scattered_light(weighted_c, self.extent_m / mc, self.optics, path, self.b, down)
-        near = scattered_light(weighted - self.on_map(weighted_c), self.texel_m, self.optics, path, self.b,
-                               down)
+        far, at_zero = self.spread(weighted_c, self.extent_m / mc, down, path)
+        near, _ = self.spread(weighted - self.on_map(weighted_c), self.texel_m, down, path)
         whole = coarse.mean(axis=(1, 2))
         weighting = np.divide(weighted_c.mean(axis=(1, 2)), whole, out=np.ones_like(whole), where=whole > 0)
-        return self.on_map(far) + near, weighting
+        return self.on_map(far) + near, weighting * at_zero
 
     def on_map(self, a: np.ndarray) -> np.ndarray:
         """(K, M, M) the coarse map ``a`` (K, Mc, Mc) read bilinearly at the map's texels, periodic:
@@ -148,9 +194,9 @@ class SmallAngleScattering:
         self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
         mean = np.asarray(delivered_flux, np.float64) / self.area
         self.single_mean += mean
-        # the transfer's k = 0 term over the patch: its weighting by the local paths, measured on the
+        # the transfer's k = 0 term over the patch, weighted by the local paths, measured on the
         # whole patch (coarse), or on the map (the whole patch, or a window standing for it)
-        self.transferred_mean += mean * weighting * np.expm1(self.b * path)
+        self.transferred_mean += mean * weighting
         self.paths.append(path)
 
     def finish(self, walk_floor_flux: np.ndarray) -> tuple[dict, dict]:

@@ -27,6 +27,7 @@ from warpcaustics.config.fields import PLANNED_VALUES
 from warpcaustics.config.light import SkyConfig, SkyModel, SkySampling, SkySpectrum, SunConfig, SunSpectrum
 from warpcaustics.config.loading import all_keys, config_from_dict, config_to_dict, parse_override, read_toml
 from warpcaustics.config.optics import (
+    BeamSpread,
     JerlovSource,
     OpticsConfig,
     PetzoldStation,
@@ -45,6 +46,7 @@ __all__ = [
     "PLANNED_VALUES",
     "BeamBounds",
     "BeamInterpolation",
+    "BeamSpread",
     "BodyConfig",
     "CameraConfig",
     "CausticsConfig",

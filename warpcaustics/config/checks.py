@@ -7,7 +7,7 @@ import math
 
 from warpcaustics.config.caustics import GREY_METHODS, BeamInterpolation, CausticsMethod, Intersection
 from warpcaustics.config.light import SkyModel, SkySampling, SunSpectrum
-from warpcaustics.config.optics import Scattering
+from warpcaustics.config.optics import BeamSpread, Scattering
 from warpcaustics.config.scene import FloorShape
 from warpcaustics.config.schema import Config
 from warpcaustics.config.water import WaterModel, WaterSpectrum
@@ -153,6 +153,10 @@ def _check_sky(cfg: Config) -> None:
 
 
 def _check_scattering(cfg: Config) -> None:
+    if cfg.optics.beam_spread is BeamSpread.WALK and cfg.optics.scattering is not Scattering.SMALL_ANGLE:
+        raise ConfigError(f"optics.beam_spread = \"walk\" is how optics.scattering = \"small_angle\" "
+                          f"spreads its scattered light (not {cfg.optics.scattering.value!r}); set "
+                          "optics.scattering = \"small_angle\" or leave optics.beam_spread out")
     if cfg.optics.scattering is Scattering.SINGLE:
         return
     needs = []

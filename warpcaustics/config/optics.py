@@ -34,6 +34,11 @@ class Scattering(str, enum.Enum):
     SMALL_ANGLE = "small_angle"
 
 
+class BeamSpread(str, enum.Enum):
+    WELLS = "wells"
+    WALK = "walk"
+
+
 class PhaseFunctionKind(str, enum.Enum):
     HENYEY_GREENSTEIN = "henyey_greenstein"
     PETZOLD = "petzold"
@@ -107,6 +112,13 @@ class OpticsConfig:
     single-scattering map plus its scattered light by the small-angle transfer of the water column
     (Wells 1973), scaled to the random walk's mean — the walk's amount of scattered light without
     its noise (same scenes as ``multiple``)."""
+    beam_spread: BeamSpread = BeamSpread.WELLS
+    """How ``small_angle`` spreads the scattered light (docs/physics.md): ``wells``, Wells (1973)'s
+    closed-form small-angle transfer; ``walk``, the column's beam spread function measured by a
+    random walk of a pencil beam in still water (every scattering's exact geometry, absorption
+    along each photon's own path, light scattered sideways and back, Fresnel at the surface)."""
+    beam_spread_photons: int = field(default=262144, metadata=_range(1024, 2**26))
+    """Photons of each ``walk`` beam spread function (one per light direction, cached) [-]."""
     mc_samples: int = field(default=4, metadata=_range(1, 64))
     """Photons per surface cell side of the ``multiple`` random walk (s² per cell and band) [-]."""
     mc_max_events: int = field(default=64, metadata=_range(1, 10000))

@@ -98,17 +98,33 @@ def forward_path(optics: OpticsConfig, kx: np.ndarray, ky: np.ndarray, path_m: f
     return path_m * spread(optics, q * path_m)
 
 
+def wells_multiplier(optics: OpticsConfig, texel_m: float, m: int, path_m: float,
+                     scattering_per_m: np.ndarray, direction: np.ndarray):
+    """The closed form's multiplier of a single-scattering map's spectrum, e^{b s G(q s)} − 1, on an
+    M × M periodic grid of ``texel_m`` texels (numpy's FFT order): a function of the band giving
+    (M, M), and its k = 0 values (K,) (e^{b s} − 1)."""
+    k = 2.0 * np.pi * np.fft.fftfreq(m, d=texel_m)
+    kx, ky = np.meshgrid(k, k)  # [iy, ix]
+    forward = forward_path(optics, kx, ky, path_m, direction)
+    b = np.asarray(scattering_per_m, np.float64)
+    return (lambda band: np.expm1(b[band] * forward)), np.expm1(b * path_m)
+
+
+def transferred(single: np.ndarray, multiplier) -> np.ndarray:
+    """(K, M, M) F⁻¹[Ŝ × multiplier(band)] per band: the scattered light of a single-scattering map
+    ``single`` (K, M, M) taken as periodic (``multiplier`` as :func:`wells_multiplier` gives it)."""
+    spectrum = np.fft.fft2(np.asarray(single, np.float64), axes=(-2, -1))
+    out = np.empty(single.shape, np.float64)
+    for band in range(len(out)):
+        out[band] = np.fft.ifft2(spectrum[band] * multiplier(band)).real
+    return out
+
+
 def scattered_light(single: np.ndarray, texel_m: float, optics: OpticsConfig, path_m: float,
                     scattering_per_m: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """(K, M, M) the small-angle scattered light of one beam's single-scattering map ``single``
     (K, M, M) [W m⁻² nm⁻¹] on texels of ``texel_m``, the map taken as periodic: F⁻¹[Ŝ (e^{b s G} − 1)]
     per band."""
     m = single.shape[-1]
-    k = 2.0 * np.pi * np.fft.fftfreq(m, d=texel_m)
-    kx, ky = np.meshgrid(k, k)  # [iy, ix]
-    spectrum = np.fft.fft2(np.asarray(single, np.float64), axes=(-2, -1))
-    forward = forward_path(optics, kx, ky, path_m, direction)
-    out = np.empty(single.shape, np.float64)
-    for band, b in enumerate(np.asarray(scattering_per_m, np.float64)):
-        out[band] = np.fft.ifft2(spectrum[band] * np.expm1(b * forward)).real
-    return out
+    multiplier, _ = wells_multiplier(optics, texel_m, m, path_m, scattering_per_m, direction)
+    return transferred(single, multiplier)

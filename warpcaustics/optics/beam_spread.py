@@ -1,0 +1,218 @@
+"""The water column's beam spread function from a random walk: ``optics.beam_spread = "walk"``.
+
+The small-angle transfer (:mod:`warpcaustics.optics.small_angle`) spreads the scattered light by
+Wells (1973)'s closed form, which takes every scattering as small: a ray turned by θ is displaced by
+u θ over the path u left to it (not u tan θ), light scattered sideways or backwards still goes
+forward, and a scattered ray's lengthened path is absorbed as if it were the straight one. Against
+the full random walk on an FFT sea that leaves +4 to +9 % of power at the largest scales and, in the
+strongly absorbed red, −7 to −8 % at 0.5–4 m (docs/physics.md). Here the same transfer is measured
+instead: the beam spread function of Mertens & Replogle (1977) — where the light of a pencil beam
+entering still water lands on the floor — by a Monte Carlo walk of the homogeneous column, with the
+exact geometry of each scattering (the phase function sampled as the random walk of
+``kernels/caustics/multiple.py`` samples it), absorption along each photon's own path, and the flat
+surface's Fresnel reflection of upwelling light (total past the critical angle). Only photons that
+scattered at least once are kept: the unscattered light is the flux-ratio map itself.
+
+One walk serves every band: the photons scatter at the largest b of the bands, b*, and each band
+weights a photon that scattered n times over a path L by (b/b*)ⁿ e^{−(a + b − b*) L} — the ratio of
+the two Poisson processes' likelihoods times the band's absorption — exact in expectation for each
+band's own (a, b). The spread is tallied on a grid finer than the map's over the same period and
+Fourier transformed: the transfer's multiplier of the single-scattering map is H̃(k) e^{c s̄}, with
+H the tallied light per unit of the beam's power (its k = 0 value is the e^{b s̄} − 1 of the closed
+form, corrected for paths and backward light); where the tally is too coarse to resolve a frequency
+it blends into the closed form, which holds there (only small angles reach the fine scales). Its noise is
+that of the photon count: relative 1/√N at every frequency, on light that scattered (2¹⁸ photons:
+0.2 %), much below a map's CV.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from warpcaustics.optics.phase import phase_quadrature
+
+ROULETTE_BELOW = 1e-3
+"""A photon whose largest band weight falls below this plays Russian roulette (survives 1 in 10,
+its weight ×10)."""
+
+MAX_EVENTS = 1000
+"""Scatterings after which a photon is dropped (its light counted as lost; with the roulette above
+none has come near it in the project's waters)."""
+
+
+@dataclass(frozen=True)
+class SpreadSample:
+    """The scattered photons that reached the floor, in the beam's frame: offsets [m] from the
+    unscattered ray's floor point along the beam's horizontal direction and across it, and each
+    one's share of the beam's power per band (K, n)."""
+
+    along: np.ndarray
+    across: np.ndarray
+    weight: np.ndarray
+    photons: int
+    lost: float
+    """Share of the photons' weight dropped at ``MAX_EVENTS`` (every band alike), for the report."""
+
+
+def _turn(d: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """(3, n) unit directions ``d`` turned by polar angles θ at azimuths φ about themselves."""
+    helper = np.where(np.abs(d[0]) > 0.9, 0.0, 1.0)
+    # e1 = normalise(helper_axis × d), helper_axis = x, or y where d is near x
+    hx, hy = helper, 1.0 - helper
+    e1 = np.stack([hy * d[2], -hx * d[2], hx * d[1] - hy * d[0]])
+    e1 /= np.linalg.norm(e1, axis=0)
+    e2 = np.cross(d, e1, axis=0)
+    s, c = np.sin(theta), np.cos(theta)
+    out = c * d + s * (np.cos(phi) * e1 + np.sin(phi) * e2)
+    return out / np.linalg.norm(out, axis=0)
+
+
+def _fresnel_up(mu: np.ndarray, ior: float) -> np.ndarray:
+    """Unpolarised Fresnel reflectance water → air at cos θ = ``mu`` in the water (1 past the
+    critical angle)."""
+    sin_t = ior * np.sqrt(np.maximum(0.0, 1.0 - mu * mu))
+    out = np.ones_like(mu)
+    ok = sin_t < 1.0
+    ci, ct = mu[ok], np.sqrt(1.0 - sin_t[ok] ** 2)
+    rs = (ior * ci - ct) / (ior * ci + ct)
+    rp = (ci - ior * ct) / (ci + ior * ct)
+    out[ok] = 0.5 * (rs * rs + rp * rp)
+    return out
+
+
+def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, scattering: np.ndarray,
+                cos_w: float, depth_m: float, ior: float, photons: int, seed: int, *,
+                fresnel_top: bool = True) -> SpreadSample:
+    """Walk ``photons`` photons of a pencil beam entering still water at the origin, going down at
+    cos θ_w = ``cos_w`` along +x, through water of ``absorption`` and ``scattering`` (K,) [1/m] with
+    the phase function given by its quadrature (θ, w), to the floor at ``depth_m``; upwelling light
+    meets the flat surface (Fresnel, index ``ior``; ``fresnel_top=False``: it leaves). Returns the
+    photons that scattered at least once and reached the floor (:class:`SpreadSample`)."""
+    a = np.asarray(absorption, np.float64)
+    b = np.asarray(scattering, np.float64)
+    b_star = float(b.max())
+    cdf = (np.cumsum(weight) - 0.5 * weight) / weight.sum()  # as the walk's inverse_cdf_table
+    rng = np.random.default_rng(seed)
+    sin_w = np.sqrt(max(0.0, 1.0 - cos_w * cos_w))
+    hit_x = depth_m * sin_w / cos_w  # where the unscattered ray meets the floor
+    pos = np.zeros((3, photons))
+    d = np.tile(np.array([[sin_w], [0.0], [-cos_w]]), (1, photons))
+    events = np.zeros(photons, np.int64)
+    path = np.zeros(photons)
+    factor = np.ones(photons)  # Fresnel reflections and the roulette's boosts, every band alike
+    alive = np.arange(photons)
+    out_idx, out_x, out_y = [], [], []
+    lost = 0.0
+    while alive.size:
+        p, dd = pos[:, alive], d[:, alive]
+        step = -np.log1p(-rng.random(alive.size)) / b_star
+        z_new = p[2] + step * dd[2]
+        floor = (dd[2] < 0) & (z_new <= -depth_m)
+        top = (dd[2] > 0) & (z_new >= 0.0) & ~floor
+        inside = ~(floor | top)
+        t = np.where(floor, (-depth_m - p[2]) / np.where(floor, dd[2], 1.0),
+                     np.where(top, -p[2] / np.where(top, dd[2], 1.0), step))
+        p = p + t * dd
+        path[alive] += t
+        arrived = floor & (events[alive] > 0)
+        out_idx.append(alive[arrived])
+        out_x.append(p[0, arrived] - hit_x)
+        out_y.append(p[1, arrived])
+        # the surface: reflected back down with R (every band alike), the rest leaves
+        factor[alive[top]] *= _fresnel_up(dd[2, top], ior) if fresnel_top else 0.0
+        dd[2, top] = -dd[2, top]
+        p[2, top] = 0.0
+        # scatter the rest
+        n_in = int(inside.sum())
+        if n_in:
+            u = rng.random(n_in)
+            dd[:, inside] = _turn(dd[:, inside], np.interp(u, cdf, theta), 2.0 * np.pi * rng.random(n_in))
+            events[alive[inside]] += 1
+        pos[:, alive], d[:, alive] = p, dd
+        keep = ~floor
+        alive = alive[keep]
+        # Russian roulette on the largest band weight
+        w_max = factor[alive] * np.max(_band_weights(a, b, b_star, events[alive], path[alive]), axis=0)
+        low = w_max < ROULETTE_BELOW
+        if low.any():
+            survive = rng.random(int(low.sum())) < 0.1
+            low_idx = alive[low]
+            factor[low_idx[survive]] *= 10.0
+            alive = np.concatenate([alive[~low], low_idx[survive]])
+        over = events[alive] >= MAX_EVENTS
+        if over.any():
+            lost += float(factor[alive[over]].sum())
+            alive = alive[~over]
+    idx = np.concatenate(out_idx)
+    w = factor[idx] * _band_weights(a, b, b_star, events[idx], path[idx]) / photons
+    return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, lost / photons)
+
+
+def _band_weights(a: np.ndarray, b: np.ndarray, b_star: float, events: np.ndarray, path: np.ndarray
+                  ) -> np.ndarray:
+    """(K, n) each band's weight of photons walked at b*: (b/b*)ⁿ e^{−(a + b − b*) L}."""
+    log_ratio = np.log(np.maximum(b, 1e-300) / b_star)
+    return np.exp(log_ratio[:, None] * events[None, :] - (a + b - b_star)[:, None] * path[None, :])
+
+
+@functools.lru_cache(maxsize=48)
+def column_spread(kind, hg_g, station, absorption: tuple, scattering: tuple, cos_w: float, depth_m: float,
+                  ior: float, photons: int, seed: int) -> SpreadSample:
+    """:func:`walk_column` for a phase function named as the config names it, cached: the sun's
+    passes and a fixed sky's directions walk once per process."""
+    theta, weight = phase_quadrature(kind, hg_g, station)
+    return walk_column(theta, weight, np.asarray(absorption), np.asarray(scattering), cos_w, depth_m, ior,
+                       photons, seed)
+
+
+OVERSAMPLE = 8
+"""The spread is tallied on texels this many times finer than the map's (the tally at most
+``TALLY_MAX`` across), so that its nearest-texel tally resolves the map's frequencies."""
+
+TALLY_MAX = 1024
+
+EXACT_BELOW = 1 / 16
+"""Up to this frequency [cycles per tally texel] the tally's spectrum is taken as it is (its nearest-
+texel response, sinc, is within 0.7 % of 1); above it the multiplier blends, by ``BLEND_TO``, into
+Wells's closed form — the fine scales, which only small angles reach, where the closed form holds."""
+
+BLEND_TO = 1 / 8
+
+
+def spread_multiplier(sample: SpreadSample, azimuth: tuple[float, float], texel_m: float, m: int,
+                      extinction: np.ndarray, path_m: float, fine):
+    """The transfer's multiplier of the single-scattering map's spectrum on an M × M periodic grid of
+    ``texel_m`` texels (numpy's FFT order), as :func:`~warpcaustics.optics.small_angle.wells_multiplier`
+    gives its own: a function of the band giving (M, M), and its k = 0 values (K,). The spread is
+    tallied at the nearest texel of a grid ``OVERSAMPLE`` times finer over the same period (at most
+    ``TALLY_MAX`` across), Fourier transformed and taken at the map's frequencies, times e^{c s̄}
+    (``extinction`` c (K,), the mean path ``path_m``) so that it multiplies a map already attenuated
+    by e^{−c s̄}; past ``EXACT_BELOW`` of the tally's texels it blends into ``fine`` (a function of the
+    band, Wells's multiplier on the same grid). ``azimuth``: the beam's horizontal direction (unit x,
+    y) on the floor."""
+    ax, ay = azimuth
+    x = sample.along * ax - sample.across * ay
+    y = sample.along * ay + sample.across * ax
+    r = max(1, min(OVERSAMPLE, TALLY_MAX // m))
+    mt, tally_texel = m * r, texel_m / r
+    flat = ((np.rint(y / tally_texel).astype(np.int64) % mt) * mt
+            + np.rint(x / tally_texel).astype(np.int64) % mt)
+    j = np.fft.fftfreq(m, 1.0 / m).astype(np.int64)  # the map's frequencies, in cycles per period
+    ft = np.abs(j) / mt  # [cycles per tally texel]
+    blend = np.clip((BLEND_TO - ft) / (BLEND_TO - EXACT_BELOW), 0.0, 1.0)
+    blend = 0.5 - 0.5 * np.cos(np.pi * blend)
+    weight = blend[:, None] * blend[None, :]  # [iy, ix]
+    gain = np.exp(np.asarray(extinction, np.float64) * path_m)
+    rows = j % mt
+
+    def multiplier(band: int) -> np.ndarray:
+        tally = np.bincount(flat, weights=sample.weight[band], minlength=mt * mt).reshape(mt, mt)
+        measured = np.fft.fft2(tally)[np.ix_(rows, rows)] * gain[band]
+        if weight.min() == 1.0:
+            return measured
+        return weight * measured + (1.0 - weight) * fine(band)
+
+    return multiplier, sample.weight.sum(axis=1) * gain
