@@ -41,7 +41,7 @@ def axis_weights(n: int, extent_m: float, coords: np.ndarray) -> tuple[np.ndarra
 
 
 MULTIPLIER_CACHE_BYTES = 1 << 29
-"""The most memory the walked spread's multipliers keep between frames (512 MiB)."""
+"""The most memory the transfer's multipliers keep between frames (512 MiB)."""
 
 
 class SmallAngleScattering:
@@ -66,7 +66,8 @@ class SmallAngleScattering:
         self.heights = None
         self.at_map = None
         self.multipliers = collections.OrderedDict()
-        """The walked spread's multipliers by (beam, texel, M), least recently used first."""
+        """The transfer's multipliers by (spread, beam, texel, M): (by band, k = 0 values, bytes),
+        least recently used first."""
         """(Mc, (rows, weights), (columns, weights), (x, y) of the coarse texels' centres): where the
         map's texels lie on an Mc × Mc coarse map of the patch (:func:`axis_weights` per axis)."""
 
@@ -112,28 +113,32 @@ class SmallAngleScattering:
         """The transfer's multiplier of a map's spectrum on an M × M periodic grid of ``texel_m``
         texels for the beam ``down`` with mean path ``path``: a function of the band, and its k = 0
         values (K,) — Wells's closed form, or the walked beam spread function
-        (``optics.beam_spread``), whose walks and multipliers are kept for the next frame (the sun's,
-        and a fixed sky's directions: up to ``MULTIPLIER_CACHE_BYTES``)."""
-        wells = wells_multiplier(self.optics, texel_m, m, path, self.b, down)
-        if self.optics.beam_spread is BeamSpread.WELLS:
-            return wells
-        key = (*np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
-        if key in self.multipliers:
-            self.multipliers.move_to_end(key)
-            table, at_zero = self.multipliers[key]
-            return (lambda band: table[band]), at_zero
+        (``optics.beam_spread``). Either is kept for the next frame (the sun's and a fixed sky's
+        directions come back), up to ``MULTIPLIER_CACHE_BYTES``."""
+        walked = self.optics.beam_spread is BeamSpread.WALK
+        key = (walked, *np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
+        if key not in self.multipliers:
+            self.multipliers[key] = (self._walked(texel_m, m, down, path) if walked
+                                     else (*wells_multiplier(self.optics, texel_m, m, path, self.b, down),
+                                           8 * m * m))
+            while sum(entry[2] for entry in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
+                self.multipliers.popitem(last=False)
+        self.multipliers.move_to_end(key)
+        function, at_zero, _ = self.multipliers[key]
+        return function, at_zero
+
+    def _walked(self, texel_m: float, m: int, down: np.ndarray, path: float):
+        """(the walked spread's multiplier by band, its k = 0 values, the bytes it holds)."""
         o = self.optics
         sample = column_spread(o.phase_function, o.hg_g, o.petzold_station.value, tuple(self.a.tolist()),
                                tuple(self.b.tolist()), round(float(-down[2]), 9), self.depth_m, self.ior,
                                o.beam_spread_photons, (o.mc_seed + self.SPREAD_STREAM) % 2**31)
         horizontal = math.hypot(down[0], down[1])
         azimuth = (down[0] / horizontal, down[1] / horizontal) if horizontal > 1e-12 else (1.0, 0.0)
-        measured, at_zero = spread_multiplier(sample, azimuth, texel_m, m, self.a + self.b, path, wells[0])
+        fine, _ = wells_multiplier(o, texel_m, m, path, self.b, down)
+        measured, at_zero = spread_multiplier(sample, azimuth, texel_m, m, self.a + self.b, path, fine)
         table = np.stack([measured(band) for band in range(len(self.b))]).astype(np.complex64)
-        self.multipliers[key] = (table, at_zero)
-        while sum(t.nbytes for t, _ in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
-            self.multipliers.popitem(last=False)
-        return (lambda band: table[band]), at_zero
+        return (lambda band: table[band]), at_zero, table.nbytes
 
     def spread(self, single: np.ndarray, texel_m: float, down: np.ndarray, path: float
                   ) -> tuple[np.ndarray, np.ndarray]:

@@ -47,7 +47,7 @@ none has come near it in the project's waters)."""
 class SpreadSample:
     """The scattered photons that reached the floor, in the beam's frame: offsets [m] from the
     unscattered ray's floor point along the beam's horizontal direction and across it, and each
-    one's share of the beam's power per band (K, n)."""
+    one's share of the beam's power per band (K, n), float32."""
 
     along: np.ndarray
     across: np.ndarray
@@ -147,7 +147,7 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
             lost += float(factor[alive[over]].sum())
             alive = alive[~over]
     idx = np.concatenate(out_idx)
-    w = factor[idx] * _band_weights(a, b, b_star, events[idx], path[idx]) / photons
+    w = (factor[idx] * _band_weights(a, b, b_star, events[idx], path[idx]) / photons).astype(np.float32)
     return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, lost / photons)
 
 
@@ -158,11 +158,11 @@ def _band_weights(a: np.ndarray, b: np.ndarray, b_star: float, events: np.ndarra
     return np.exp(log_ratio[:, None] * events[None, :] - (a + b - b_star)[:, None] * path[None, :])
 
 
-@functools.lru_cache(maxsize=48)
+@functools.lru_cache(maxsize=20)
 def column_spread(kind, hg_g, station, absorption: tuple, scattering: tuple, cos_w: float, depth_m: float,
                   ior: float, photons: int, seed: int) -> SpreadSample:
-    """:func:`walk_column` for a phase function named as the config names it, cached: the sun's
-    passes and a fixed sky's directions walk once per process."""
+    """:func:`walk_column` for a phase function named as the config names it, cached (the last 20
+    directions: the multipliers made from them are cached apart, so a fixed sky walks once)."""
     theta, weight = phase_quadrature(kind, hg_g, station)
     return walk_column(theta, weight, np.asarray(absorption), np.asarray(scattering), cos_w, depth_m, ior,
                        photons, seed)
