@@ -62,16 +62,17 @@ def test_small_angle_map_has_the_walks_spatial_spectrum(depth_m, phase):
     in each radial band of spatial frequency (6 bands, 2 cycles per patch to the Nyquist limit)
     against the random walk's — the walk's own photon noise taken out by the cross-spectrum of two
     seeds — in every rgb band. Wells's closed form (``optics.beam_spread = "wells"``) within 20 %
-    everywhere (measured 0.91–1.10). The walked spread (``"walk"``) within 8 % above the two lowest
-    bands (measured 0.98–1.06; ``python -m benchmarks.small_angle_vs_walk`` gives 0.99–1.03 over the
-    two methods' different surfaces with eight seeds, whose noise is 0.4–2.5 % of a band's power for
-    one pair) and within 30 % in the two lowest, scales of 4–16 m carried by a handful of Fourier
-    modes, where both spreads keep more than the walk (eight seeds: Wells +4 to +9 %, walked +5 to
-    +19 %, the 650 nm band at 6 m the most; one pair's noise there is 5–15 %; not explained, see
-    docs/physics.md). Where the spreads differ most — the strongly absorbed 650 nm band at 6 m,
-    0.5–4 m scales (radial bands 3–5) — Wells's keeps too little (measured 0.91–0.92) and the walked
-    one is within 4 % (measured 0.99–1.02). The single-scattering map scaled to the walk's mean
-    misses by more than 2× at the lowest or highest band (measured 2.3–3.1× at 3 m), so the test
+    everywhere (measured 0.92–1.17). The walked spread (``"walk"``, with its derivative by the local
+    path) within 8 % above the two lowest bands (measured 0.93–1.02, the highest band carrying the two
+    methods' different surfaces, flat facets against bilinear normals, 0.93–0.97 without any
+    scattering) and within 25 % in the two lowest, scales of 4–16 m carried by a handful of Fourier
+    modes where one pair of seeds scatters by 5–15 % in the 650 nm band (measured 0.97–1.18).
+    ``python -m benchmarks.small_angle_vs_walk`` measures each spread's own error beyond the walk's
+    noise with eight seeds (walked: 0.97–1.03 over the surfaces' factor, 1.10 in the 650 nm band's
+    lowest at 6 m; Wells's: 0.92–1.09). Where the spreads differ most — the strongly absorbed 650 nm
+    band at 6 m, 0.5–4 m scales (radial bands 3–5) — Wells's keeps too little (measured 0.92) and the
+    walked one is within 4 % (measured 0.98–1.00). The single-scattering map scaled to the walk's
+    mean misses by more than 2× at the lowest or highest band (measured 2.3–3.1× at 3 m), so the test
     tells them apart. The map's mean over the patch is the walk's, by construction (1e-5)."""
     overrides = {**SCENE, "floor.depth_m": depth_m, "optics.phase_function": phase}
     walks = [wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**overrides, "optics.scattering": "multiple",
@@ -92,7 +93,7 @@ def test_small_angle_map_has_the_walks_spatial_spectrum(depth_m, phase):
         assert small.min() >= 0.0
     assert np.all(np.abs(ratios["wells"] - 1.0) < 0.2), ratios
     assert np.all(np.abs(ratios["walk"][:, 2:] - 1.0) < 0.08), ratios
-    assert np.all(np.abs(ratios["walk"][:, :2] - 1.0) < 0.3), ratios
+    assert np.all(np.abs(ratios["walk"][:, :2] - 1.0) < 0.25), ratios
     if depth_m == 6.0:
         red_mid = slice(2, 5)
         assert np.all(np.abs(ratios["walk"][2, red_mid] - 1.0) < 0.04), ratios

@@ -40,6 +40,10 @@ def axis_weights(n: int, extent_m: float, coords: np.ndarray) -> tuple[np.ndarra
     return used, weights
 
 
+DEPTH_STEP = 0.05
+"""The walked spread's derivative by the path comes from central differences: two more walks this
+much (relatively) shallower and deeper."""
+
 MULTIPLIER_CACHE_BYTES = 1 << 29
 """The most memory the transfer's multipliers keep between frames (512 MiB)."""
 
@@ -109,29 +113,44 @@ class SmallAngleScattering:
         local = self.local_paths(down, x, y)
         return np.expm1(self.b[:, None, None] * local) / np.expm1(self.b * path)[:, None, None]
 
-    def multiplier(self, texel_m: float, m: int, down: np.ndarray, path: float):
+    def multiplier(self, texel_m: float, m: int, down: np.ndarray, path: float, derivative: bool = False):
         """The transfer's multiplier of a map's spectrum on an M × M periodic grid of ``texel_m``
         texels for the beam ``down`` with mean path ``path``: a function of the band, and its k = 0
         values (K,) — Wells's closed form, or the walked beam spread function
-        (``optics.beam_spread``). Either is kept for the next frame (the sun's and a fixed sky's
-        directions come back), up to ``MULTIPLIER_CACHE_BYTES``."""
+        (``optics.beam_spread``); with ``derivative`` (walked only) its derivative by the path,
+        from a second walk ``DEPTH_STEP`` deeper. Kept for the next frame (the sun's and a fixed
+        sky's directions come back), up to ``MULTIPLIER_CACHE_BYTES``."""
         walked = self.optics.beam_spread is BeamSpread.WALK
-        key = (walked, *np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
+        key = (walked, derivative, *np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
         if key not in self.multipliers:
-            self.multipliers[key] = (self._walked(texel_m, m, down, path) if walked
-                                     else (*wells_multiplier(self.optics, texel_m, m, path, self.b, down),
-                                           8 * m * m))
-            while sum(entry[2] for entry in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
+            if not walked:
+                entry = (*wells_multiplier(self.optics, texel_m, m, path, self.b, down), 8 * m * m)
+            elif derivative:  # e^{c s̄} ∂H̃/∂s by central differences, + c M: H̃ varies slowly, e^{cs} not
+                at, zero_at, nbytes = self._walked(texel_m, m, down, path, self.depth_m)
+                ends = [self._walked(texel_m, m, down, path * f, self.depth_m * f)
+                        for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP)]
+                c = self.a + self.b
+                shallow, deep = (np.exp(-c * path * (f - 1.0)) for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP))
+                step = 2.0 * DEPTH_STEP * path
+                table = np.stack([(deep[k] * ends[1][0](k) - shallow[k] * ends[0][0](k)) / step + c[k] * at(k)
+                                  for k in range(len(self.b))]).astype(np.complex64)
+                zero = (deep * ends[1][1] - shallow * ends[0][1]) / step + c * zero_at
+                entry = ((lambda band: table[band]), zero, nbytes)
+            else:
+                entry = self._walked(texel_m, m, down, path, self.depth_m)
+            self.multipliers[key] = entry
+            while sum(e[2] for e in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
                 self.multipliers.popitem(last=False)
         self.multipliers.move_to_end(key)
         function, at_zero, _ = self.multipliers[key]
         return function, at_zero
 
-    def _walked(self, texel_m: float, m: int, down: np.ndarray, path: float):
-        """(the walked spread's multiplier by band, its k = 0 values, the bytes it holds)."""
+    def _walked(self, texel_m: float, m: int, down: np.ndarray, path: float, depth_m: float):
+        """(the walked spread's multiplier by band, its k = 0 values, the bytes it holds) for a
+        floor at ``depth_m``, the beam's mean path ``path`` to it."""
         o = self.optics
         sample = column_spread(o.phase_function, o.hg_g, o.petzold_station.value, tuple(self.a.tolist()),
-                               tuple(self.b.tolist()), round(float(-down[2]), 9), self.depth_m, self.ior,
+                               tuple(self.b.tolist()), round(float(-down[2]), 9), depth_m, self.ior,
                                o.beam_spread_photons, (o.mc_seed + self.SPREAD_STREAM) % 2**31)
         horizontal = math.hypot(down[0], down[1])
         azimuth = (down[0] / horizontal, down[1] / horizontal) if horizontal > 1e-12 else (1.0, 0.0)
@@ -140,43 +159,56 @@ class SmallAngleScattering:
         table = np.stack([measured(band) for band in range(len(self.b))]).astype(np.complex64)
         return (lambda band: table[band]), at_zero, table.nbytes
 
-    def spread(self, single: np.ndarray, texel_m: float, down: np.ndarray, path: float
-                  ) -> tuple[np.ndarray, np.ndarray]:
-        """((K, M, M) the scattered light of the map ``single`` taken as periodic, its transfer's
-        k = 0 values (K,))."""
-        multiplier, at_zero = self.multiplier(texel_m, single.shape[-1], down, path)
-        return transferred(single, multiplier), at_zero
-
     def coarse_centres(self, mc: int) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) [m] of the whole patch's Mc × Mc coarse texel centres, [iy, ix]."""
         centres = (np.arange(mc) + 0.5) * self.extent_m / mc - 0.5 * self.extent_m
         return np.meshgrid(centres, centres)
 
-    def transfer(self, single: np.ndarray, lost: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
+    def terms(self, single: np.ndarray, down: np.ndarray, path: float, x=None, y=None) -> list:
+        """[(the map a multiplier acts on (K, M, M), which multiplier: the path's derivative or not)]
+        for the single-scattering map ``single`` at the texels (x, y) (default: the map's). Each
+        texel's light took its own path s(x) (:meth:`local_paths`). Wells's spread weights the map by
+        the light each texel's ray lost to scattering, e^{b s(x)} − 1 over the mean path's (a k = 0
+        correction); the walked spread expands the transfer to first order in s(x) − s̄ at every
+        frequency, S M(k, s̄) + S (s − s̄) ∂M/∂s — a longer path also spreads its light wider (on a
+        sinusoidal sea at 9.58 m the weight alone left the 8 m wave's pattern 15 % too strong)."""
+        if self.optics.beam_spread is BeamSpread.WELLS:
+            return [(single * self.lost(down, path, x, y), False)]
+        longer = self.local_paths(down, x, y) - path
+        return [(single, False), (single * longer, True)]
+
+    def transfer(self, single: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
                  path: float) -> tuple[np.ndarray, np.ndarray]:
-        """(the pass's scattered light on the map (K, M, M), its transfer's k = 0 term over the patch,
-        weighted by the local paths (K,)). Without ``coarse`` the map is the whole periodic patch.
-        With ``coarse`` (K, Mc, Mc), the whole patch's single-scattering light on coarse texels beside
-        a window, the window's scattered light is the whole patch's at the large scales, read
-        bilinearly from the coarse texels, plus the window's own detail beyond them taken as periodic:
-        B*C + B_w*(S_w − C_w), C_w the coarse map at the window's texels (B the transfer)."""
-        weighted = single * lost
+        """(the pass's scattered light on the map (K, M, M), its transfer's k = 0 term over the patch
+        per unit of the pass's mean irradiance (K,)), summed over the :meth:`terms`. Without
+        ``coarse`` the map is the whole periodic patch. With ``coarse`` (K, Mc, Mc), the whole
+        patch's single-scattering light on coarse texels beside a window, the window's scattered light
+        is the whole patch's at the large scales, read bilinearly from the coarse texels, plus the
+        window's own detail beyond them taken as periodic: B*C + B_w*(S_w − C_w), C_w the coarse map
+        at the window's texels (B the transfer)."""
+        out, at_zero = 0.0, 0.0
         if coarse is None:
             on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
-            weighting = np.divide(weighted.mean(axis=(1, 2)), on_map, out=np.ones_like(on_map),
-                                  where=on_map > 0)
-            out, at_zero = self.spread(weighted, self.texel_m, down, path)
-            return out, weighting * at_zero
+            for term, derivative in self.terms(single, down, path):
+                multiplier, zero = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
+                out = out + transferred(term, multiplier)
+                at_zero = at_zero + np.divide(term.mean(axis=(1, 2)), on_map, out=np.zeros_like(on_map),
+                                              where=on_map > 0) * zero
+            return out, at_zero
         mc = coarse.shape[-1]
         if self.at_map is None or self.at_map[0] != mc:
             self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
                            axis_weights(mc, self.extent_m, self.texel_x[0]), self.coarse_centres(mc))
-        weighted_c = coarse * self.lost(down, path, *self.at_map[3])
-        far, at_zero = self.spread(weighted_c, self.extent_m / mc, down, path)
-        near, _ = self.spread(weighted - self.on_map(weighted_c), self.texel_m, down, path)
         whole = coarse.mean(axis=(1, 2))
-        weighting = np.divide(weighted_c.mean(axis=(1, 2)), whole, out=np.ones_like(whole), where=whole > 0)
-        return self.on_map(far) + near, weighting * at_zero
+        for (term, derivative), (term_c, _) in zip(self.terms(single, down, path),
+                                                   self.terms(coarse, down, path, *self.at_map[3])):
+            far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
+            near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
+            out = out + self.on_map(transferred(term_c, far_m)) + transferred(term - self.on_map(term_c),
+                                                                              near_m)
+            at_zero = at_zero + np.divide(term_c.mean(axis=(1, 2)), whole, out=np.zeros_like(whole),
+                                          where=whole > 0) * zero
+        return out, at_zero
 
     def on_map(self, a: np.ndarray) -> np.ndarray:
         """(K, M, M) the coarse map ``a`` (K, Mc, Mc) read bilinearly at the map's texels, periodic:
@@ -195,7 +227,7 @@ class SmallAngleScattering:
         S (e^{b s(x)} − 1), is what the transfer spreads, normalised to the mean path's e^{b s̄} − 1
         that the transfer's own k = 0 term carries."""
         down, path = self.beam(direction)
-        part, weighting = self.transfer(single, self.lost(down, path), coarse, down, path)
+        part, weighting = self.transfer(single, coarse, down, path)
         self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
         mean = np.asarray(delivered_flux, np.float64) / self.area
         self.single_mean += mean

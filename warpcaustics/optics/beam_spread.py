@@ -20,9 +20,18 @@ band's own (a, b). The spread is tallied on a grid finer than the map's over the
 Fourier transformed: the transfer's multiplier of the single-scattering map is H̃(k) e^{c s̄}, with
 H the tallied light per unit of the beam's power (its k = 0 value is the e^{b s̄} − 1 of the closed
 form, corrected for paths and backward light); where the tally is too coarse to resolve a frequency
-it blends into the closed form, which holds there (only small angles reach the fine scales). Its noise is
-that of the photon count: relative 1/√N at every frequency, on light that scattered (2¹⁸ photons:
-0.2 %), much below a map's CV.
+it blends into the closed form, which holds there (only small angles reach the fine scales).
+
+A convolution lands each scattered photon at its ray's unscattered floor point plus the spread's
+offset. Where the surface turns a ray by δ (the focusing), the unscattered point moves by J₀ δ, but
+a photon that scattered moves by its own J δ: the walk carries the derivatives of each photon's path
+by a turn of the entering direction (the scattering's frame turned with the photon), and a photon's
+share of a pattern of wavenumber k is weighted by k̂ᵀ M k̂, M = J J₀⁻¹ (a height field focuses along
+its gradient, so the displacement of a pattern of wavenumber k is along k; M = 1 for a photon that never
+turned; a turned ray's light fans out further, 1.03–1.07 on average in Darecki's water). With the
+path's derivative of the transfer (:class:`~warpcaustics.caustics.small_angle.SmallAngleScattering`)
+this is the scattered light to first order in the surface's slopes and heights: on a sinusoidal sea
+at 9.58 m it matches an independent Monte Carlo to its noise (``tests/test_beam_spread.py``).
 """
 
 from __future__ import annotations
@@ -55,6 +64,10 @@ class SpreadSample:
     photons: int
     lost: float
     """Share of the photons' weight dropped at ``MAX_EVENTS`` (every band alike), for the report."""
+    memory: np.ndarray | None = None
+    """(4, n) each photon's focusing memory M (row-major, beam frame): how its landing moves when
+    the unscattered ray's landing moves by ξ is M ξ (the identity for a photon that never turned;
+    a photon turned by θ keeps about cos θ of the ray's direction change after the turn)."""
 
 
 def _turn(d: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
@@ -100,38 +113,57 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
     hit_x = depth_m * sin_w / cos_w  # where the unscattered ray meets the floor
     pos = np.zeros((3, photons))
     d = np.tile(np.array([[sin_w], [0.0], [-cos_w]]), (1, photons))
+    # tangents: the position's and direction's derivatives by a turn of the entering direction in
+    # the beam's vertical plane (0) and across it (1)
+    t_pos = np.zeros((2, 3, photons))
+    t_dir = np.zeros((2, 3, photons))
+    t_dir[0] = np.array([[cos_w], [0.0], [sin_w]])
+    t_dir[1, 1] = 1.0
     events = np.zeros(photons, np.int64)
     path = np.zeros(photons)
     factor = np.ones(photons)  # Fresnel reflections and the roulette's boosts, every band alike
     alive = np.arange(photons)
-    out_idx, out_x, out_y = [], [], []
+    out_idx, out_x, out_y, out_j = [], [], [], []
     lost = 0.0
     while alive.size:
         p, dd = pos[:, alive], d[:, alive]
+        tp, td = t_pos[:, :, alive], t_dir[:, :, alive]
         step = -np.log1p(-rng.random(alive.size)) / b_star
         z_new = p[2] + step * dd[2]
         floor = (dd[2] < 0) & (z_new <= -depth_m)
         top = (dd[2] > 0) & (z_new >= 0.0) & ~floor
         inside = ~(floor | top)
-        t = np.where(floor, (-depth_m - p[2]) / np.where(floor, dd[2], 1.0),
-                     np.where(top, -p[2] / np.where(top, dd[2], 1.0), step))
+        dz = np.where(inside, 1.0, dd[2])
+        t = np.where(floor, (-depth_m - p[2]) / dz, np.where(top, -p[2] / dz, step))
+        # a step to a plane ends on it however the direction turns: its length moves with the tangent
+        dt = np.where(inside, 0.0, -(tp[:, 2] + t * td[:, 2]) / dz)
+        tp = tp + t * td + dd[None] * dt[:, None]
         p = p + t * dd
         path[alive] += t
         arrived = floor & (events[alive] > 0)
         out_idx.append(alive[arrived])
         out_x.append(p[0, arrived] - hit_x)
         out_y.append(p[1, arrived])
+        out_j.append(tp[:, :2, arrived])
         # the surface: reflected back down with R (every band alike), the rest leaves
         factor[alive[top]] *= _fresnel_up(dd[2, top], ior) if fresnel_top else 0.0
         dd[2, top] = -dd[2, top]
+        td[:, 2, top] = -td[:, 2, top]
         p[2, top] = 0.0
-        # scatter the rest
+        # scatter the rest: the new direction turned with the old (the scattering's frame carried
+        # along), so a tangent keeps cos θ of itself and loses its part along the new direction
         n_in = int(inside.sum())
         if n_in:
             u = rng.random(n_in)
-            dd[:, inside] = _turn(dd[:, inside], np.interp(u, cdf, theta), 2.0 * np.pi * rng.random(n_in))
+            angle = np.interp(u, cdf, theta)
+            new = _turn(dd[:, inside], angle, 2.0 * np.pi * rng.random(n_in))
+            old_t = td[:, :, inside]
+            td[:, :, inside] = (np.cos(angle) * old_t
+                                - dd[None, :, inside] * np.einsum("tkn,kn->tn", old_t, new)[:, None])
+            dd[:, inside] = new
             events[alive[inside]] += 1
         pos[:, alive], d[:, alive] = p, dd
+        t_pos[:, :, alive], t_dir[:, :, alive] = tp, td
         keep = ~floor
         alive = alive[keep]
         # Russian roulette on the largest band weight
@@ -148,7 +180,12 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
             alive = alive[~over]
     idx = np.concatenate(out_idx)
     w = (factor[idx] * _band_weights(a, b, b_star, events[idx], path[idx]) / photons).astype(np.float32)
-    return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, lost / photons)
+    # the focusing each photon keeps: its landing's derivatives over the unscattered ray's,
+    # D / cos² θ_w in the beam's plane and D / cos θ_w across it
+    j = np.concatenate(out_j, axis=-1)  # (tangent, x/y, n)
+    unscattered = np.array([depth_m / cos_w**2, depth_m / cos_w])
+    memory = (j / unscattered[:, None, None]).transpose(1, 0, 2).reshape(4, -1).astype(np.float32)
+    return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, lost / photons, memory)
 
 
 def _band_weights(a: np.ndarray, b: np.ndarray, b_star: float, events: np.ndarray, path: np.ndarray
@@ -207,12 +244,25 @@ def spread_multiplier(sample: SpreadSample, azimuth: tuple[float, float], texel_
     weight = blend[:, None] * blend[None, :]  # [iy, ix]
     gain = np.exp(np.asarray(extinction, np.float64) * path_m)
     rows = j % mt
+    if sample.memory is None:
+        parts = [(1.0, None)]
+    else:  # k̂ᵀ M k̂ of each photon's memory, M turned to the floor's axes
+        turn = np.array([[ax, -ay], [ay, ax]])
+        mem = np.einsum("ab,bcn,dc->adn", turn, sample.memory.reshape(2, 2, -1).astype(np.float64), turn)
+        kx, ky = np.meshgrid(j.astype(np.float64), j.astype(np.float64))  # [iy, ix]
+        k2 = np.where(kx * kx + ky * ky > 0, kx * kx + ky * ky, 1.0)
+        parts = [(kx * kx / k2, mem[0, 0]), (kx * ky / k2, mem[0, 1] + mem[1, 0]), (ky * ky / k2, mem[1, 1])]
 
     def multiplier(band: int) -> np.ndarray:
-        tally = np.bincount(flat, weights=sample.weight[band], minlength=mt * mt).reshape(mt, mt)
-        measured = np.fft.fft2(tally)[np.ix_(rows, rows)] * gain[band]
+        measured = np.zeros((m, m), np.complex128)
+        for shape, memory in parts:
+            w = sample.weight[band] if memory is None else sample.weight[band] * memory
+            tally = np.bincount(flat, weights=w, minlength=mt * mt).reshape(mt, mt)
+            measured += shape * np.fft.fft2(tally)[np.ix_(rows, rows)]
+        measured[0, 0] = float(sample.weight[band].sum(dtype=np.float64))
+        measured *= gain[band]
         if weight.min() == 1.0:
             return measured
         return weight * measured + (1.0 - weight) * fine(band)
 
-    return multiplier, sample.weight.sum(axis=1) * gain
+    return multiplier, sample.weight.sum(axis=1, dtype=np.float64) * gain
