@@ -78,6 +78,9 @@ class SmallAngleScattering:
     def reset(self, heights: np.ndarray) -> None:
         """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
         self.heights = np.asarray(heights, np.float64)
+        cell = self.extent_m / self.heights.shape[0]
+        self.slopes = [(np.roll(self.heights, -1, axis) - np.roll(self.heights, 1, axis)) / (2.0 * cell)
+                       for axis in (1, 0)]  # ∂h/∂x, ∂h/∂y at the cell centres, central differences
         self.scattered = {}
         self.single_mean = np.zeros_like(self.b)
         self.transferred_mean = np.zeros_like(self.b)
@@ -105,6 +108,27 @@ class SmallAngleScattering:
         offset = self.depth_m / cos_w  # along the beam, back to the mean level
         height = periodic_bilinear(self.heights, self.extent_m, x - down[0] * offset, y - down[1] * offset)
         return (self.depth_m + height) / cos_w
+
+    def refracted_paths(self, light: np.ndarray, down: np.ndarray, x: np.ndarray | None = None,
+                        y: np.ndarray | None = None) -> np.ndarray:
+        """As :meth:`local_paths`, but down each texel's own ray: the light from ``light`` (unit,
+        towards it) refracted at the surface's normal where it entered (the slopes bilinear there),
+        so a ray the surface tilted travels its own longer or shorter path — first order in the
+        slope for an oblique beam, where :meth:`local_paths` keeps only the height."""
+        if x is None:
+            x, y = self.texel_x, self.texel_y
+        offset = self.depth_m / -down[2]
+        ex, ey = x - down[0] * offset, y - down[1] * offset
+        height = periodic_bilinear(self.heights, self.extent_m, ex, ey)
+        gx, gy = (periodic_bilinear(g, self.extent_m, ex, ey) for g in self.slopes)
+        norm = np.sqrt(1.0 + gx * gx + gy * gy)
+        nx, ny, nz = -gx / norm, -gy / norm, 1.0 / norm
+        ix, iy, iz = -np.asarray(light, np.float64)  # going down
+        cos_i = -(ix * nx + iy * ny + iz * nz)
+        eta = 1.0 / self.ior
+        cos_t = np.sqrt(np.maximum(0.0, 1.0 - eta * eta * (1.0 - cos_i * cos_i)))
+        tz = eta * iz + (eta * cos_i - cos_t) * nz
+        return (self.depth_m + height) / np.maximum(-tz, 1e-6)
 
     def lost(self, down: np.ndarray, path: float, x: np.ndarray | None = None, y: np.ndarray | None = None
              ) -> np.ndarray:
@@ -164,7 +188,8 @@ class SmallAngleScattering:
         centres = (np.arange(mc) + 0.5) * self.extent_m / mc - 0.5 * self.extent_m
         return np.meshgrid(centres, centres)
 
-    def terms(self, single: np.ndarray, down: np.ndarray, path: float, x=None, y=None) -> list:
+    def terms(self, single: np.ndarray, light: np.ndarray, down: np.ndarray, path: float, x=None, y=None
+              ) -> list:
         """[(the map a multiplier acts on (K, M, M), which multiplier: the path's derivative or not)]
         for the single-scattering map ``single`` at the texels (x, y) (default: the map's). Each
         texel's light took its own path s(x) (:meth:`local_paths`). Wells's spread weights the map by
@@ -174,10 +199,10 @@ class SmallAngleScattering:
         sinusoidal sea at 9.58 m the weight alone left the 8 m wave's pattern 15 % too strong)."""
         if self.optics.beam_spread is BeamSpread.WELLS:
             return [(single * self.lost(down, path, x, y), False)]
-        longer = self.local_paths(down, x, y) - path
+        longer = self.refracted_paths(light, down, x, y) - path
         return [(single, False), (single * longer, True)]
 
-    def transfer(self, single: np.ndarray, coarse: np.ndarray | None, down: np.ndarray,
+    def transfer(self, single: np.ndarray, coarse: np.ndarray | None, light: np.ndarray, down: np.ndarray,
                  path: float) -> tuple[np.ndarray, np.ndarray]:
         """(the pass's scattered light on the map (K, M, M), its transfer's k = 0 term over the patch
         per unit of the pass's mean irradiance (K,)), summed over the :meth:`terms`. Without
@@ -189,7 +214,7 @@ class SmallAngleScattering:
         out, at_zero = 0.0, 0.0
         if coarse is None:
             on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
-            for term, derivative in self.terms(single, down, path):
+            for term, derivative in self.terms(single, light, down, path):
                 multiplier, zero = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
                 out = out + transferred(term, multiplier)
                 at_zero = at_zero + np.divide(term.mean(axis=(1, 2)), on_map, out=np.zeros_like(on_map),
@@ -200,8 +225,8 @@ class SmallAngleScattering:
             self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
                            axis_weights(mc, self.extent_m, self.texel_x[0]), self.coarse_centres(mc))
         whole = coarse.mean(axis=(1, 2))
-        for (term, derivative), (term_c, _) in zip(self.terms(single, down, path),
-                                                   self.terms(coarse, down, path, *self.at_map[3])):
+        for (term, derivative), (term_c, _) in zip(self.terms(single, light, down, path),
+                                                   self.terms(coarse, light, down, path, *self.at_map[3])):
             far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
             near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
             out = out + self.on_map(transferred(term_c, far_m)) + transferred(term - self.on_map(term_c),
@@ -227,7 +252,8 @@ class SmallAngleScattering:
         S (e^{b s(x)} − 1), is what the transfer spreads, normalised to the mean path's e^{b s̄} − 1
         that the transfer's own k = 0 term carries."""
         down, path = self.beam(direction)
-        part, weighting = self.transfer(single, coarse, down, path)
+        light = np.asarray(direction, np.float64) / np.linalg.norm(direction)
+        part, weighting = self.transfer(single, coarse, light, down, path)
         self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
         mean = np.asarray(delivered_flux, np.float64) / self.area
         self.single_mean += mean

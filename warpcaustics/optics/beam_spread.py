@@ -67,7 +67,7 @@ class SpreadSample:
     memory: np.ndarray | None = None
     """(4, n) each photon's focusing memory M (row-major, beam frame): how its landing moves when
     the unscattered ray's landing moves by ξ is M ξ (the identity for a photon that never turned;
-    a photon turned by θ keeps about cos θ of the ray's direction change after the turn)."""
+    a turned photon's landing moves further: 1.03–1.07 on average in Darecki et al.'s water)."""
 
 
 def _turn(d: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
@@ -228,8 +228,9 @@ def spread_multiplier(sample: SpreadSample, azimuth: tuple[float, float], texel_
     ``TALLY_MAX`` across), Fourier transformed and taken at the map's frequencies, times e^{c s̄}
     (``extinction`` c (K,), the mean path ``path_m``) so that it multiplies a map already attenuated
     by e^{−c s̄}; past ``EXACT_BELOW`` of the tally's texels it blends into ``fine`` (a function of the
-    band, Wells's multiplier on the same grid). ``azimuth``: the beam's horizontal direction (unit x,
-    y) on the floor."""
+    band, Wells's multiplier on the same grid). With the sample's ``memory`` each photon counts
+    k̂ᵀ M k̂ of its weight at k ≠ 0 (M turned to the floor's axes). ``azimuth``: the beam's horizontal
+    direction (unit x, y) on the floor."""
     ax, ay = azimuth
     x = sample.along * ax - sample.across * ay
     y = sample.along * ay + sample.across * ax
