@@ -7,7 +7,10 @@ beam's path s = D / cos θ_w to the floor and its obliquity), then scales the sc
 passes so that its mean over the patch is the random walk's: the walk's floor flux less the
 single-scattering map's. The map is the single-scattering map plus that scattered light — the
 unscattered pattern exact, the scattered light with the structure of the small-angle approximation
-and the amount of the walk, free of the walk's noise.
+and the amount of the walk, free of the walk's noise. With ``optics.beam_spread = "walk"`` the
+transfer is the column's beam spread function measured by a walk of a pencil beam
+(:mod:`warpcaustics.optics.beam_spread`), with the scattered light's first-order response to the
+surface's focusing and to each texel's own path (:meth:`SmallAngleScattering.terms`).
 """
 
 from __future__ import annotations
