@@ -47,8 +47,13 @@ DEPTH_STEP = 0.05
 """The walked spread's derivative by the path comes from central differences: two more walks this
 much (relatively) shallower and deeper."""
 
-MULTIPLIER_CACHE_BYTES = 1 << 29
-"""The most memory the transfer's multipliers keep between frames (512 MiB)."""
+MULTIPLIER_CACHE_BYTES = 1 << 30
+"""The most memory the transfer's multipliers keep between frames and renderers of a process
+(1 GiB): a sweep renders each frame with a renderer of its own."""
+
+_MULTIPLIERS: collections.OrderedDict = collections.OrderedDict()
+"""The transfer's multipliers by (the water, its depth, the spread, the beam, texel, M, derivative):
+(by band, k = 0 values, bytes), least recently used first."""
 
 
 class SmallAngleScattering:
@@ -72,11 +77,11 @@ class SmallAngleScattering:
         self.area = self.extent_m**2
         self.heights = None
         self.at_map = None
-        self.multipliers = collections.OrderedDict()
-        """The transfer's multipliers by (spread, beam, texel, M): (by band, k = 0 values, bytes),
-        least recently used first."""
         """(Mc, (rows, weights), (columns, weights), (x, y) of the coarse texels' centres): where the
         map's texels lie on an Mc × Mc coarse map of the patch (:func:`axis_weights` per axis)."""
+        o = self.optics
+        self.cache_key = (o.beam_spread, o.phase_function, o.hg_g, o.petzold_station, o.beam_spread_photons,
+                          o.mc_seed, tuple(self.a.tolist()), tuple(self.b.tolist()), self.depth_m, self.ior)
 
     def reset(self, heights: np.ndarray) -> None:
         """Start a frame on a surface of cell-centre ``heights`` (N, N) [m] (periodic)."""
@@ -145,15 +150,17 @@ class SmallAngleScattering:
         texels for the beam ``down`` with mean path ``path``: a function of the band, and its k = 0
         values (K,) — Wells's closed form, or the walked beam spread function
         (``optics.beam_spread``); with ``derivative`` (walked only) its derivative by the path,
-        from a second walk ``DEPTH_STEP`` deeper. Kept for the next frame (the sun's and a fixed
-        sky's directions come back), up to ``MULTIPLIER_CACHE_BYTES``."""
+        from two more walks ``DEPTH_STEP`` shallower and deeper. Kept for the next frames of the
+        process (the sun's and a fixed sky's directions come back), up to
+        ``MULTIPLIER_CACHE_BYTES``."""
         walked = self.optics.beam_spread is BeamSpread.WALK
-        key = (walked, derivative, *np.round(np.asarray(down, np.float64), 9).tolist(), float(texel_m), m)
-        if key not in self.multipliers:
+        beam = np.round(np.asarray(down, np.float64), 9).tolist()
+        key = (self.cache_key, derivative, *beam, float(texel_m), m)
+        if key not in _MULTIPLIERS:
             if not walked:
                 entry = (*wells_multiplier(self.optics, texel_m, m, path, self.b, down), 8 * m * m)
             elif derivative:  # e^{c s̄} ∂H̃/∂s by central differences, + c M: H̃ varies slowly, e^{cs} not
-                at, zero_at, nbytes = self._walked(texel_m, m, down, path, self.depth_m)
+                at, zero_at = self.multiplier(texel_m, m, down, path)
                 ends = [self._walked(texel_m, m, down, path * f, self.depth_m * f)
                         for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP)]
                 c = self.a + self.b
@@ -162,14 +169,14 @@ class SmallAngleScattering:
                 table = np.stack([(deep[k] * ends[1][0](k) - shallow[k] * ends[0][0](k)) / step + c[k] * at(k)
                                   for k in range(len(self.b))]).astype(np.complex64)
                 zero = (deep * ends[1][1] - shallow * ends[0][1]) / step + c * zero_at
-                entry = ((lambda band: table[band]), zero, nbytes)
+                entry = ((lambda band: table[band]), zero, table.nbytes)
             else:
                 entry = self._walked(texel_m, m, down, path, self.depth_m)
-            self.multipliers[key] = entry
-            while sum(e[2] for e in self.multipliers.values()) > MULTIPLIER_CACHE_BYTES:
-                self.multipliers.popitem(last=False)
-        self.multipliers.move_to_end(key)
-        function, at_zero, _ = self.multipliers[key]
+            _MULTIPLIERS[key] = entry
+            while sum(e[2] for e in _MULTIPLIERS.values()) > MULTIPLIER_CACHE_BYTES:
+                _MULTIPLIERS.popitem(last=False)
+        _MULTIPLIERS.move_to_end(key)
+        function, at_zero, _ = _MULTIPLIERS[key]
         return function, at_zero
 
     def _walked(self, texel_m: float, m: int, down: np.ndarray, path: float, depth_m: float):
