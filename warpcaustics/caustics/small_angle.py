@@ -202,11 +202,13 @@ class SmallAngleScattering:
               ) -> list:
         """[(the map a multiplier acts on (K, M, M), which multiplier: the path's derivative or not)]
         for the single-scattering map ``single`` at the texels (x, y) (default: the map's). Each
-        texel's light took its own path s(x) (:meth:`local_paths`). Wells's spread weights the map by
-        the light each texel's ray lost to scattering, e^{b s(x)} − 1 over the mean path's (a k = 0
-        correction); the walked spread expands the transfer to first order in s(x) − s̄ at every
-        frequency, S M(k, s̄) + S (s − s̄) ∂M/∂s — a longer path also spreads its light wider (on a
-        sinusoidal sea at 9.58 m the weight alone left the 8 m wave's pattern 15 % too strong)."""
+        texel's light took its own path s(x). Wells's spread weights the map by the light each
+        texel's ray lost to scattering, e^{b s(x)} − 1 over the mean path's (a k = 0 correction; s(x)
+        from the height where it entered, :meth:`local_paths`); the walked spread expands the
+        transfer to first order in s(x) − s̄ at every frequency, S M(k, s̄) + S (s − s̄) ∂M/∂s, s(x)
+        down the texel's own refracted ray (:meth:`refracted_paths`) — a longer path also spreads its
+        light wider (on a sinusoidal sea at 9.58 m the weight alone left the 8 m wave's pattern 15 %
+        too strong)."""
         if self.optics.beam_spread is BeamSpread.WELLS:
             return [(single * self.lost(down, path, x, y), False)]
         longer = self.refracted_paths(light, down, x, y) - path
@@ -258,9 +260,8 @@ class SmallAngleScattering:
         (towards it), the flux its map holds over the whole patch (K,) [W nm⁻¹], the group its
         scattered light is reported in (``sun``; ``sky_even`` and ``sky``, the sky's two halves), and
         for a window of a periodic sea the whole patch's single-scattering light on coarse texels
-        (K, Mc, Mc) (:meth:`transfer`). The light each texel's ray lost to scattering on its own path,
-        S (e^{b s(x)} − 1), is what the transfer spreads, normalised to the mean path's e^{b s̄} − 1
-        that the transfer's own k = 0 term carries."""
+        (K, Mc, Mc) (:meth:`transfer`). Each texel's light took its own path (:meth:`terms`); the
+        transfer's k = 0 term, so weighted, is what the walk's mean scales."""
         down, path = self.beam(direction)
         light = np.asarray(direction, np.float64) / np.linalg.norm(direction)
         part, weighting = self.transfer(single, coarse, light, down, path)

@@ -118,13 +118,3 @@ def transferred(single: np.ndarray, multiplier) -> np.ndarray:
     for band in range(len(out)):
         out[band] = np.fft.ifft2(spectrum[band] * multiplier(band)).real
     return out
-
-
-def scattered_light(single: np.ndarray, texel_m: float, optics: OpticsConfig, path_m: float,
-                    scattering_per_m: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """(K, M, M) the small-angle scattered light of one beam's single-scattering map ``single``
-    (K, M, M) [W m⁻² nm⁻¹] on texels of ``texel_m``, the map taken as periodic: F⁻¹[Ŝ (e^{b s G} − 1)]
-    per band."""
-    m = single.shape[-1]
-    multiplier, _ = wells_multiplier(optics, texel_m, m, path_m, scattering_per_m, direction)
-    return transferred(single, multiplier)
