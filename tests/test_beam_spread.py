@@ -4,7 +4,9 @@ The walk of a pencil beam in still water (:mod:`warpcaustics.optics.beam_spread`
 what it did not produce: its mean against PythonicDISORT's plane-parallel solution (every band from
 one walk, by the bands' likelihood weights), its spatial spread against the exact single-scattering
 integral in optically thin water (the geometry of wide angles and the absorption along lengthened
-paths), and its tally against a spread with a closed-form spectrum.
+paths), its tally against a spread with a closed-form spectrum, and the small-angle map it makes,
+with its first-order response to the surface, against a Monte Carlo of a sinusoidal sea written
+apart from the package.
 """
 
 from __future__ import annotations
