@@ -133,7 +133,7 @@ def test_the_tally_gives_the_spectrum_of_a_known_spread():
     n = 200_000
     sigma_texels, texel = 2.5, 0.01
     offsets = rng.normal(0.0, sigma_texels * texel, (2, n))
-    sample = SpreadSample(offsets[0], offsets[1], np.full((1, n), 0.3 / n), n, 0.0)
+    sample = SpreadSample(offsets[0], offsets[1], np.full((1, n), 0.3 / n), n)
     azimuth = (math.cos(math.radians(30.0)), math.sin(math.radians(30.0)))
     gain = np.array([2.0])
 

@@ -23,6 +23,7 @@ import numpy as np
 from warpcaustics.config import BeamSpread, Config
 from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
 from warpcaustics.optics.small_angle import transferred, wells_multiplier
+from warpcaustics.reference.floor import refract
 from warpcaustics.scene.receivers import periodic_bilinear
 
 
@@ -105,17 +106,22 @@ class SmallAngleScattering:
         down = np.array([horizontal[0] * sin_w, horizontal[1] * sin_w, -cos_w])
         return down, self.depth_m / cos_w
 
+    def entry(self, down: np.ndarray, x: np.ndarray | None = None, y: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) [m] where the light reaching each texel (x, y) (default: the map's) entered the
+        water: back along the beam to the mean level, the still-water refraction's offset."""
+        if x is None:
+            x, y = self.texel_x, self.texel_y
+        offset = self.depth_m / -down[2]
+        return x - down[0] * offset, y - down[1] * offset
+
     def local_paths(self, down: np.ndarray, x: np.ndarray | None = None, y: np.ndarray | None = None
                     ) -> np.ndarray:
         """The path [m] through the water of the light reaching each texel (x, y) [m] (default: the
-        map's): from the surface where it entered (the height there, bilinear, at the still-water
-        refraction's offset) down the beam to the floor."""
-        if x is None:
-            x, y = self.texel_x, self.texel_y
-        cos_w = -down[2]
-        offset = self.depth_m / cos_w  # along the beam, back to the mean level
-        height = periodic_bilinear(self.heights, self.extent_m, x - down[0] * offset, y - down[1] * offset)
-        return (self.depth_m + height) / cos_w
+        map's): from the surface where it entered (the height there, bilinear, :meth:`entry`) down
+        the beam to the floor."""
+        height = periodic_bilinear(self.heights, self.extent_m, *self.entry(down, x, y))
+        return (self.depth_m + height) / -down[2]
 
     def refracted_paths(self, light: np.ndarray, down: np.ndarray, x: np.ndarray | None = None,
                         y: np.ndarray | None = None) -> np.ndarray:
@@ -123,20 +129,13 @@ class SmallAngleScattering:
         towards it) refracted at the surface's normal where it entered (the slopes bilinear there),
         so a ray the surface tilted travels its own longer or shorter path — first order in the
         slope for an oblique beam, where :meth:`local_paths` keeps only the height."""
-        if x is None:
-            x, y = self.texel_x, self.texel_y
-        offset = self.depth_m / -down[2]
-        ex, ey = x - down[0] * offset, y - down[1] * offset
+        ex, ey = self.entry(down, x, y)
         height = periodic_bilinear(self.heights, self.extent_m, ex, ey)
         gx, gy = (periodic_bilinear(g, self.extent_m, ex, ey) for g in self.slopes)
-        norm = np.sqrt(1.0 + gx * gx + gy * gy)
-        nx, ny, nz = -gx / norm, -gy / norm, 1.0 / norm
-        ix, iy, iz = -np.asarray(light, np.float64)  # going down
-        cos_i = -(ix * nx + iy * ny + iz * nz)
-        eta = 1.0 / self.ior
-        cos_t = np.sqrt(np.maximum(0.0, 1.0 - eta * eta * (1.0 - cos_i * cos_i)))
-        tz = eta * iz + (eta * cos_i - cos_t) * nz
-        return (self.depth_m + height) / np.maximum(-tz, 1e-6)
+        normal = np.stack([-gx, -gy, np.ones_like(gx)], axis=-1)
+        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+        ray = refract(-np.asarray(light, np.float64), normal, 1.0 / self.ior)
+        return (self.depth_m + height) / np.maximum(-ray[..., 2], 1e-6)
 
     def lost(self, down: np.ndarray, path: float, x: np.ndarray | None = None, y: np.ndarray | None = None
              ) -> np.ndarray:

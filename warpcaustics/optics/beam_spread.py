@@ -42,14 +42,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from warpcaustics.optics.phase import phase_quadrature
+from warpcaustics.reference.floor import fresnel_transmittance
 
 ROULETTE_BELOW = 1e-3
 """A photon whose largest band weight falls below this plays Russian roulette (survives 1 in 10,
 its weight ×10)."""
 
 MAX_EVENTS = 1000
-"""Scatterings after which a photon is dropped (its light counted as lost; with the roulette above
-none has come near it in the project's waters)."""
+"""Scatterings after which a photon is dropped (its light lost; with the roulette above none has
+come near it in the project's waters)."""
 
 
 @dataclass(frozen=True)
@@ -62,8 +63,6 @@ class SpreadSample:
     across: np.ndarray
     weight: np.ndarray
     photons: int
-    lost: float
-    """Share of the photons' weight dropped at ``MAX_EVENTS`` (every band alike), for the report."""
     memory: np.ndarray | None = None
     """(4, n) each photon's focusing memory M (row-major, beam frame): how its landing moves when
     the unscattered ray's landing moves by ξ is M ξ (the identity for a photon that never turned;
@@ -81,19 +80,6 @@ def _turn(d: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
     s, c = np.sin(theta), np.cos(theta)
     out = c * d + s * (np.cos(phi) * e1 + np.sin(phi) * e2)
     return out / np.linalg.norm(out, axis=0)
-
-
-def _fresnel_up(mu: np.ndarray, ior: float) -> np.ndarray:
-    """Unpolarised Fresnel reflectance water → air at cos θ = ``mu`` in the water (1 past the
-    critical angle)."""
-    sin_t = ior * np.sqrt(np.maximum(0.0, 1.0 - mu * mu))
-    out = np.ones_like(mu)
-    ok = sin_t < 1.0
-    ci, ct = mu[ok], np.sqrt(1.0 - sin_t[ok] ** 2)
-    rs = (ior * ci - ct) / (ior * ci + ct)
-    rp = (ci - ior * ct) / (ci + ior * ct)
-    out[ok] = 0.5 * (rs * rs + rp * rp)
-    return out
 
 
 def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, scattering: np.ndarray,
@@ -124,7 +110,6 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
     factor = np.ones(photons)  # Fresnel reflections and the roulette's boosts, every band alike
     alive = np.arange(photons)
     out_idx, out_x, out_y, out_j = [], [], [], []
-    lost = 0.0
     while alive.size:
         p, dd = pos[:, alive], d[:, alive]
         tp, td = t_pos[:, :, alive], t_dir[:, :, alive]
@@ -146,7 +131,7 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
         out_y.append(p[1, arrived])
         out_j.append(tp[:, :2, arrived])
         # the surface: reflected back down with R (every band alike), the rest leaves
-        factor[alive[top]] *= _fresnel_up(dd[2, top], ior) if fresnel_top else 0.0
+        factor[alive[top]] *= 1.0 - fresnel_transmittance(dd[2, top], ior) if fresnel_top else 0.0
         dd[2, top] = -dd[2, top]
         td[:, 2, top] = -td[:, 2, top]
         p[2, top] = 0.0
@@ -174,10 +159,7 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
             low_idx = alive[low]
             factor[low_idx[survive]] *= 10.0
             alive = np.concatenate([alive[~low], low_idx[survive]])
-        over = events[alive] >= MAX_EVENTS
-        if over.any():
-            lost += float(factor[alive[over]].sum())
-            alive = alive[~over]
+        alive = alive[events[alive] < MAX_EVENTS]
     idx = np.concatenate(out_idx)
     w = (factor[idx] * _band_weights(a, b, b_star, events[idx], path[idx]) / photons).astype(np.float32)
     # the focusing each photon keeps: its landing's derivatives over the unscattered ray's,
@@ -185,7 +167,7 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
     j = np.concatenate(out_j, axis=-1)  # (tangent, x/y, n)
     unscattered = np.array([depth_m / cos_w**2, depth_m / cos_w])
     memory = (j / unscattered[:, None, None]).transpose(1, 0, 2).reshape(4, -1).astype(np.float32)
-    return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, lost / photons, memory)
+    return SpreadSample(np.concatenate(out_x), np.concatenate(out_y), w, photons, memory)
 
 
 def _band_weights(a: np.ndarray, b: np.ndarray, b_star: float, events: np.ndarray, path: np.ndarray
