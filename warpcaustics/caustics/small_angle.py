@@ -23,7 +23,7 @@ import numpy as np
 from warpcaustics.config import BeamSpread, Config
 from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
 from warpcaustics.optics.small_angle import transferred, wells_multiplier
-from warpcaustics.reference.floor import refract
+from warpcaustics.optics.snell import refract
 from warpcaustics.scene.receivers import periodic_bilinear
 
 

@@ -18,7 +18,7 @@ from warpcaustics.caustics.eikonal import GridCaustics, GridStage, all_lit, make
 from warpcaustics.config import Config
 from warpcaustics.kernels.caustics import eikonal as eikonal_kernels
 from warpcaustics.kernels.caustics import wave3d as wave_kernels
-from warpcaustics.reference import fresnel_transmittance
+from warpcaustics.optics.snell import fresnel_transmittance
 from warpcaustics.water import Surface
 
 COURANT = 0.5

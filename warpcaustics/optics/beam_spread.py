@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from warpcaustics.optics.phase import phase_quadrature
-from warpcaustics.reference.floor import fresnel_transmittance
+from warpcaustics.optics.snell import fresnel_transmittance
 
 ROULETTE_BELOW = 1e-3
 """A photon whose largest band weight falls below this plays Russian roulette (survives 1 in 10,

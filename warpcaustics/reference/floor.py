@@ -10,31 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from warpcaustics.optics.snell import fresnel_transmittance, refract  # noqa: F401 (re-exported)
+
 MIN_DOWNWARD_COS = 1.0e-3
 DEGENERATE_AREA_TEXELS = 1.0e-9
 MAX_CLIPPED_TEXELS = 4096
 SAMPLE_SUBDIVISIONS = 32
 _CHUNK_PAIRS = 1 << 18  # (triangle, texel) pairs clipped at once; bounds peak memory
-
-
-def fresnel_transmittance(cos_i: np.ndarray, eta: float) -> np.ndarray:
-    """Exact unpolarised Fresnel transmittance for ``eta = n1/n2`` (0 on TIR or cos_i <= 0)."""
-    cos_i = np.asarray(cos_i, dtype=np.float64)
-    k = 1.0 - eta**2 * (1.0 - cos_i**2)
-    ok = (cos_i > 0) & (k > 0)
-    cos_t = np.sqrt(np.where(ok, k, 1.0))
-    ci = np.where(ok, cos_i, 1.0)
-    rs = (eta * ci - cos_t) / (eta * ci + cos_t)
-    rp = (ci - eta * cos_t) / (ci + eta * cos_t)
-    return np.where(ok, 1.0 - 0.5 * (rs**2 + rp**2), 0.0)
-
-
-def refract(d: np.ndarray, n: np.ndarray, eta: float) -> np.ndarray:
-    """Snell's law for arrays of unit vectors (..., 3); zero vectors on TIR."""
-    c = -np.sum(n * d, axis=-1, keepdims=True)
-    k = 1.0 - eta**2 * (1.0 - c**2)
-    t = eta * d + (eta * c - np.sqrt(np.maximum(k, 0.0))) * n
-    return np.where(k >= 0, t, 0.0)
 
 
 def sun_visibility(positions, sun_dir, extent_m):

@@ -26,7 +26,7 @@ from warpcaustics.kernels.scene import camera as camera_kernels
 from warpcaustics.kernels.scene.camera import above as above_kernels
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.optics.refraction import still_water_refraction
-from warpcaustics.reference.floor import fresnel_transmittance
+from warpcaustics.optics.snell import fresnel_transmittance
 from warpcaustics.scene.camera import pinhole
 from warpcaustics.scene.receivers import Receivers
 
