@@ -95,6 +95,21 @@ def measure(zeniths, depths, counts, frames: int, samplings=("stratified",),
     return rows
 
 
+def cones(zenith: float, depth: float, frames: int) -> None:
+    """The cones' CV and spectrum against the stratified sky's as its directions grow, and the
+    continuum extrapolated from the last two counts (the directions' own power falls as 1/D)."""
+    rows = measure((zenith,), (depth,), (16, 64), frames, ("cones",), spectra=True)
+    rows += measure((zenith,), (depth,), (16, 64, 256, 1024), frames, spectra=True)
+    p256, p1024 = (np.array(r["relative_power"]) for r in rows[-2:])
+    extrapolated = (4.0 * p1024 - p256) / 3.0
+    print("    the continuum extrapolated from 256 and 1024 stratified directions, (4 P_1024 - P_256)/3: "
+          + " ".join(f"{x:.2e}" for x in extrapolated)
+          + f"; CV {np.sqrt(max(float(extrapolated.sum()), 0.0)):.4f} (the bands' sum)", flush=True)
+    for row in rows[:2]:
+        print(f"    cones, {row['directions']} directions: CV from the bands' sum "
+              f"{np.sqrt(float(np.sum(row['relative_power']))):.4f}", flush=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="16 and 64 directions, 3.2 m, one frame")
@@ -103,11 +118,21 @@ def main(argv: list[str] | None = None) -> int:
                         help="also each count with sky.sampling = 'halves' (the CV and power spectrum "
                              "with the sky's continuum, issue 32), at an 85° sun, --depth (3.2 m), 16 and 64 "
                              "directions, and 256 stratified directions for one frame")
+    parser.add_argument("--cones", action="store_true",
+                        help="sky.sampling = 'cones' (each direction spread over its cell of the sky) at "
+                             "16 and 64 directions against the stratified sky's 16 to 1024 and the "
+                             "continuum extrapolated from them, (4 P_1024 - P_256)/3, per octave band, at an "
+                             "85° sun and --depth (3.2 m)")
     parser.add_argument("--depth", type=float, default=3.2,
-                        help="with --halves: the floor's depth [m] (default 3.2)")
+                        help="with --halves or --cones: the floor's depth [m] (default 3.2)")
+    parser.add_argument("--zenith", type=float, default=85.0,
+                        help="with --cones: the sun's zenith [deg] (default 85)")
     args = parser.parse_args(argv)
     if args.quick:
         measure((85.0,), (3.2,), (16, 64), 1)
+        measure((85.0,), (3.2,), (16,), 1, ("cones",))
+    elif args.cones:
+        cones(args.zenith, args.depth, args.frames)
     elif args.halves:
         measure((85.0,), (args.depth,), (16, 64), args.frames, ("stratified", "halves"), spectra=True)
         measure((85.0,), (args.depth,), (256,), 1, spectra=True)

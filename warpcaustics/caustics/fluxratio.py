@@ -9,9 +9,10 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.caustics.multiple import MultipleScattering
+from warpcaustics.caustics.sky_cones import SkyCones
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
-from warpcaustics.config import FloorShape, Scattering, SkySampling
+from warpcaustics.config import FloorShape, Scattering, SkyModel, SkySampling
 from warpcaustics.kernels.caustics import coarse as coarse_kernels
 from warpcaustics.kernels.caustics import coverage as cover_kernels
 from warpcaustics.kernels.caustics import fluxratio as floor_kernels
@@ -56,6 +57,13 @@ def coarse_resolution(cfg, periodic: bool) -> int:
     cells = side / COARSE_TEXELS_PER_WINDOW / (extent / n)
     r = max(CELLS_PER_COARSE_TEXEL, 2 ** int(np.floor(np.log2(max(cells, 1.0)))))
     return max(1, n // r)
+
+
+def needs_coarse(cfg) -> bool:
+    """Whether the floor stage keeps the whole patch's light on coarse texels beside a window: for the
+    small-angle transfer, and for the sky's cells (``sky.sampling = "cones"``)."""
+    cones = cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
+    return cfg.optics.scattering is Scattering.SMALL_ANGLE or cones
 
 
 class FloorCaustics:
@@ -226,12 +234,14 @@ class FluxRatioStage(CausticStage):
                                                light.sun_irradiance, light.optics.absorption_per_m,
                                                light.optics.scattering_per_m, device,
                                                floor_albedo=floor_albedo, **sky)
-        coarse = 0
         if cfg.optics.scattering is Scattering.SMALL_ANGLE:
             self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
                                                     light.optics.absorption_per_m,
                                                     light.optics.scattering_per_m)
-            coarse = coarse_resolution(cfg, water.periodic)
+        self.cones = None
+        if cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES:
+            self.cones = SkyCones(cfg, light.sky_directions, scene.sun_direction, float(light.group_ior[0]))
+        coarse = coarse_resolution(cfg, water.periodic) if needs_coarse(cfg) else 0
         disk_share = light.sun_irradiance / len(light.sun_directions)
         self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
                                    device, periodic=water.periodic, window=window,
@@ -242,9 +252,7 @@ class FluxRatioStage(CausticStage):
         cfg = scene.config
         m = cfg.caustics.map_resolution
         walk = k * m * m * 4 if cfg.optics.scattering is not Scattering.SINGLE else 0  # the walk's texels
-        coarse = 0
-        if cfg.optics.scattering is Scattering.SMALL_ANGLE:
-            coarse = k * coarse_resolution(cfg, cfg.water.periodic) ** 2 * 8
+        coarse = k * coarse_resolution(cfg, cfg.water.periodic) ** 2 * 8 if needs_coarse(cfg) else 0
         return floor_bytes(scene.water_resolution, m, k, groups) + walk + coarse
 
     def render(self, frame: Frame) -> StageOutput:
@@ -321,11 +329,12 @@ class FluxRatioStage(CausticStage):
         "halves"``, the map of its even-numbered directions alone (else None): one shaded refraction
         and deposit per sky direction, each with its share of the sky's irradiance (with halves,
         the even-numbered ones first). With the small-angle transfer each direction's map is read
-        back and given its own transfer (its own path), its scattered light reported by half."""
+        back and given its own transfer (its own path), its scattered light reported by half; with
+        ``sky.sampling = "cones"`` it is read back and spread over its cell of the sky first."""
         light = self.light
         transmitted = 0.0
         total = even = None
-        separate = self.small_angle is not None
+        separate = self.small_angle is not None or self.cones is not None
         count = len(light.sky_directions)
         halves = self.scene.config.sky.sampling is SkySampling.HALVES
         order = [*range(0, count, 2), *range(1, count, 2)] if halves else range(count)
@@ -339,11 +348,15 @@ class FluxRatioStage(CausticStage):
                                         irradiance=irradiance, bands=read)
             transmitted = transmitted + flux
             if separate:
-                one = floor.numpy().copy()
+                one, coarse = floor.numpy().copy(), self._coarse(frame)
+                if self.cones is not None:
+                    with frame.watch.stage("sky_cones"):
+                        one, coarse = self.cones.spread(i, one, coarse)
                 total = one if total is None else total + one
-                with frame.watch.stage("small_angle"):
-                    group = SKY_GROUPS[i % 2] if halves else "sky"
-                    self.small_angle.add(one, direction, flux[1], group=group, coarse=self._coarse(frame))
+                if self.small_angle is not None:
+                    with frame.watch.stage("small_angle"):
+                        group = SKY_GROUPS[i % 2] if halves else "sky"
+                        self.small_angle.add(one, direction, flux[1], group=group, coarse=coarse)
             if halves and n == count // 2 - 1:  # the last of the even-numbered directions
                 even = total.copy() if separate else floor.numpy().copy()
         return (floor.numpy().copy() if total is None else total), transmitted, even

@@ -20,29 +20,12 @@ import math
 
 import numpy as np
 
+from warpcaustics.caustics.window import MapWindow
 from warpcaustics.config import BeamSpread, Config
 from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
 from warpcaustics.optics.small_angle import transferred, wells_multiplier
 from warpcaustics.optics.snell import refract
 from warpcaustics.scene.receivers import periodic_bilinear
-
-
-def axis_weights(n: int, extent_m: float, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(the grid indices used, (len(coords), used) weights): linear interpolation along one axis of a
-    periodic grid of N cell-centre samples over ``extent_m`` at ``coords`` [m] (as
-    :func:`~warpcaustics.scene.receivers.periodic_bilinear` does per axis)."""
-    u = (np.asarray(coords, np.float64) + 0.5 * extent_m) * n / extent_m - 0.5
-    i0 = np.floor(u).astype(np.int64)
-    t = u - i0
-    i0 = i0 % n
-    i1 = (i0 + 1) % n
-    used = np.unique(np.concatenate([i0, i1]))
-    weights = np.zeros((len(u), len(used)))
-    at = np.arange(len(u))
-    np.add.at(weights, (at, np.searchsorted(used, i0)), 1.0 - t)
-    np.add.at(weights, (at, np.searchsorted(used, i1)), t)
-    return used, weights
-
 
 DEPTH_STEP = 0.05
 """The walked spread's derivative by the path comes from central differences: two more walks this
@@ -69,17 +52,11 @@ class SmallAngleScattering:
         self.ior = float(ior)
         self.a = np.asarray(absorption_per_m, np.float64)
         self.b = np.asarray(scattering_per_m, np.float64)
-        m = cfg.caustics.map_resolution
-        side, centre = cfg.map_window
-        self.texel_m = side / m
-        centres = (np.arange(m) + 0.5) * self.texel_m - 0.5 * side
-        self.texel_x, self.texel_y = np.meshgrid(centres + centre[0], centres + centre[1])  # [iy, ix]
-        self.extent_m = float(cfg.water.extent_m)
+        self.window = MapWindow(cfg)
+        self.texel_m = self.window.texel_m
+        self.extent_m = self.window.extent_m
         self.area = self.extent_m**2
         self.heights = None
-        self.at_map = None
-        """(Mc, (rows, weights), (columns, weights), (x, y) of the coarse texels' centres): where the
-        map's texels lie on an Mc × Mc coarse map of the patch (:func:`axis_weights` per axis)."""
         o = self.optics
         self.cache_key = (o.beam_spread, o.phase_function, o.hg_g, o.petzold_station, o.beam_spread_photons,
                           o.mc_seed, tuple(self.a.tolist()), tuple(self.b.tolist()), self.depth_m, self.ior)
@@ -111,7 +88,7 @@ class SmallAngleScattering:
         """(x, y) [m] where the light reaching each texel (x, y) (default: the map's) entered the
         water: back along the beam to the mean level, the still-water refraction's offset."""
         if x is None:
-            x, y = self.texel_x, self.texel_y
+            x, y = self.window.texel_x, self.window.texel_y
         offset = self.depth_m / -down[2]
         return x - down[0] * offset, y - down[1] * offset
 
@@ -192,11 +169,6 @@ class SmallAngleScattering:
         table = np.stack([measured(band) for band in range(len(self.b))]).astype(np.complex64)
         return (lambda band: table[band]), at_zero, table.nbytes
 
-    def coarse_centres(self, mc: int) -> tuple[np.ndarray, np.ndarray]:
-        """(x, y) [m] of the whole patch's Mc × Mc coarse texel centres, [iy, ix]."""
-        centres = (np.arange(mc) + 0.5) * self.extent_m / mc - 0.5 * self.extent_m
-        return np.meshgrid(centres, centres)
-
     def terms(self, single: np.ndarray, light: np.ndarray, down: np.ndarray, path: float, x=None, y=None
               ) -> list:
         """[(the map a multiplier acts on (K, M, M), which multiplier: the path's derivative or not)]
@@ -232,26 +204,16 @@ class SmallAngleScattering:
                                               where=on_map > 0) * zero
             return out, at_zero
         mc = coarse.shape[-1]
-        if self.at_map is None or self.at_map[0] != mc:
-            self.at_map = (mc, axis_weights(mc, self.extent_m, self.texel_y[:, 0]),
-                           axis_weights(mc, self.extent_m, self.texel_x[0]), self.coarse_centres(mc))
         whole = coarse.mean(axis=(1, 2))
+        centres = self.window.on_coarse(mc)[3]
         for (term, derivative), (term_c, _) in zip(self.terms(single, light, down, path),
-                                                   self.terms(coarse, light, down, path, *self.at_map[3])):
+                                                   self.terms(coarse, light, down, path, *centres)):
             far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
             near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
-            out = out + self.on_map(transferred(term_c, far_m)) + transferred(term - self.on_map(term_c),
-                                                                              near_m)
+            out = out + self.window.convolve(term, term_c, far_m, near_m)
             at_zero = at_zero + np.divide(term_c.mean(axis=(1, 2)), whole, out=np.zeros_like(whole),
                                           where=whole > 0) * zero
         return out, at_zero
-
-    def on_map(self, a: np.ndarray) -> np.ndarray:
-        """(K, M, M) the coarse map ``a`` (K, Mc, Mc) read bilinearly at the map's texels, periodic:
-        separable, as the map's texels are a grid (the rows and columns it needs, then one matrix
-        product per axis)."""
-        _, (rows, wy), (cols, wx), _ = self.at_map
-        return wy @ a[:, rows][:, :, cols] @ wx.T
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
             group: str = "sun", coarse: np.ndarray | None = None) -> None:

@@ -124,8 +124,8 @@ def _check_map_window(cfg: Config) -> None:
 def _check_sky(cfg: Config) -> None:
     sky = cfg.sky
     if sky.model is SkyModel.NONE:
-        if sky.sampling is SkySampling.HALVES:
-            raise ConfigError("sky.sampling = \"halves\" draws the sky's directions: set sky.model "
+        if sky.sampling is not SkySampling.STRATIFIED:
+            raise ConfigError(f"sky.sampling = \"{sky.sampling.value}\" needs a sky: set sky.model "
                               "(e.g. \"uniform\") or sky.sampling = \"stratified\"")
         if sky.diffuse_fraction:
             raise ConfigError(f"sky.diffuse_fraction = {sky.diffuse_fraction:g} needs a sky; set "
@@ -150,6 +150,16 @@ def _check_sky(cfg: Config) -> None:
             raise ConfigError("sky.sampling = \"halves\" keeps the halves' maps apart in caustics.method = "
                               "\"fluxratio\" with optics.scattering = \"single\" or \"small_angle\"; set "
                               "those or sky.sampling = \"stratified\"")
+    if sky.sampling is SkySampling.CONES:
+        if method is not CausticsMethod.FLUXRATIO or cfg.optics.scattering is Scattering.MULTIPLE:
+            raise ConfigError("sky.sampling = \"cones\" spreads each direction's floor map in "
+                              "caustics.method = \"fluxratio\" with optics.scattering = \"single\" or "
+                              "\"small_angle\"; set "
+                              "those or sky.sampling = \"stratified\"")
+        if not cfg.water.periodic:
+            raise ConfigError(f"sky.sampling = \"cones\" spreads each direction's light over a periodic sea, "
+                              f"not water.model = {cfg.water.model.value!r}; use water.model = \"fft\" or "
+                              "sky.sampling = \"stratified\"")
 
 
 def _check_scattering(cfg: Config) -> None:

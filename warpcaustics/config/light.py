@@ -25,6 +25,7 @@ class SkyModel(str, enum.Enum):
 class SkySampling(str, enum.Enum):
     STRATIFIED = "stratified"
     HALVES = "halves"
+    CONES = "cones"
 
 
 class SkySpectrum(str, enum.Enum):
@@ -89,4 +90,7 @@ class SkyConfig:
     ``halves``, two stratified halves of ``directions``/2, each turned and offset at random anew
     every frame, so that each half is an unbiased estimate of the sky's continuum with an error of
     its own: the frame statistics then also give the CV without the directions' own caustic noise
-    (``cv_continuous_sky``, issue 32; ``fluxratio`` with single or small-angle scattering)."""
+    (``cv_continuous_sky``, issue 32; ``fluxratio`` with single or small-angle scattering);
+    ``cones``, the stratified set with each direction's pattern spread over the floor as its cell of
+    the sky would spread it (``optics/sky_cells.py``): the sky's continuum, without its directions'
+    own caustics, at the cost of the same directions (``fluxratio`` on a periodic sea)."""

@@ -98,3 +98,13 @@ def sky_radiance(sky_type: int | None, directions: np.ndarray, sun_direction: np
         grid = np.stack(np.broadcast_arrays(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t), axis=-1)
         norm = float(cie_relative_radiance(sky_type, grid, sun_direction).mean()) * math.pi
     return rel[..., None] * e / norm
+
+
+def stratified_hemisphere(count: int, offset: float, turn: float) -> np.ndarray:
+    """(count, 3) cosine-weighted stratified directions: sinθ_j = √((j + offset)/count), φ_j = turn +
+    (j + offset) × the golden angle, j < count."""
+    j = np.arange(count) + offset
+    sin_t = np.sqrt(j / count)
+    cos_t = np.sqrt(1.0 - sin_t * sin_t)
+    phi = turn + j * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)

@@ -19,6 +19,7 @@ from warpcaustics.config import (
     config_from_dict,
     read_toml,
 )
+from warpcaustics.optics.sky import stratified_hemisphere
 from warpcaustics.scene.heights import DEFAULT_RESOLUTION, load_heights
 from warpcaustics.scene.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
 
@@ -85,11 +86,11 @@ class Scene:
         sky = self.config.sky
         count = sky.directions
         if rng is None:
-            d = _stratified_hemisphere(count, 0.5, 0.0)
+            d = stratified_hemisphere(count, 0.5, 0.0)
         else:
             d = np.empty((count, 3))
             for half in range(2):
-                d[half::2] = _stratified_hemisphere(count // 2, rng.random(), 2.0 * math.pi * rng.random())
+                d[half::2] = stratified_hemisphere(count // 2, rng.random(), 2.0 * math.pi * rng.random())
         cos_t = d[:, 2]
         if sky.model in (SkyModel.CIE, SkyModel.CIE_CLEAR):
             from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance
@@ -176,21 +177,11 @@ def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None 
     return scene_from_config(cfg, base, str(path) if path is not None else None)
 
 
-def _stratified_hemisphere(count: int, offset: float, turn: float) -> np.ndarray:
-    """(count, 3) cosine-weighted stratified directions: sinθ_j = √((j + offset)/count), φ_j = turn +
-    (j + offset) × the golden angle, j < count."""
-    j = np.arange(count) + offset
-    sin_t = np.sqrt(j / count)
-    cos_t = np.sqrt(1.0 - sin_t * sin_t)
-    phi = turn + j * math.pi * (3.0 - math.sqrt(5.0))
-    return np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=1)
-
-
 @functools.lru_cache(maxsize=64)
 def _cie_mean_radiance(sky_type: int, sun_direction: tuple[float, float, float]) -> float:
     """A CIE sky's cosine-weighted mean relative radiance over the hemisphere (4096 stratified
     directions), computed once per sky and sun rather than every frame."""
     from warpcaustics.optics.sky import cie_relative_radiance
 
-    dense = _stratified_hemisphere(4096, 0.5, 0.0)
+    dense = stratified_hemisphere(4096, 0.5, 0.0)
     return float(cie_relative_radiance(sky_type, dense, np.asarray(sun_direction)).mean())

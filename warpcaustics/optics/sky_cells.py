@@ -1,0 +1,112 @@
+"""The sky's cells: what a continuum of sky directions does to the floor's caustics that a few
+directions do not (``sky.sampling = "cones"``, issue 32 item 3).
+
+Each of the sky's K stratified directions (:func:`~warpcaustics.optics.sky.stratified_hemisphere`)
+stands for a cell of the sky: the directions nearest it in the projected disk p = (sinθ cosφ,
+sinθ sinφ), where cosine-weighted directions are uniform, so the K cells share the disk's area π
+equally. Rendered as a point, each direction draws a caustic pattern of its own, and a few such
+patterns add to the floor's variance like noise, falling only as 1/K (docs/validation.md); a real
+sky's continuum washes them out.
+
+Light from a direction p of a cell refracts into the water at θ_w, sinθ_w = |p|/n, and reaches the
+floor D below where it entered displaced by −D t(p), t(p) = (p/n) / √(1 − |p|²/n²). To first order
+the surface focuses every direction of a cell alike, so the cell's light is its own direction p_j's
+pattern moved by −D (t(p) − t(p_j)) for each p, weighted by the sky's radiance there and the flat
+surface's Fresnel transmittance: p_j's pattern convolved with the distribution of those
+displacements, whose Fourier transform (numpy's sign, F[f](k) = Σ f(x) e^{−ik·x}) is
+
+    B̂_j(k) = Σ_s w_s exp(i D k·(t(p_s) − t(p_j)) − ½ kᵀ Σ_s k) / Σ_s w_s,
+
+over S points p_s of a dense stratified set in the cell. Each point stands for a small disc of the
+projected disk, radius r = 1/√(K S), which t stretches into an ellipse by its Jacobian,
+J = [I + p pᵀ / (n² c²)] / (n c) with c = √(1 − |p|²/n²) (1/(n c³) along the azimuth, 1/(n c)
+across); it is taken as a Gaussian of the same second moments, Σ_s = D² (r²/4) J Jᵀ, so the
+multiplier is smooth at every frequency rather than a sum of S point shifts. B̂_j(0) = 1: the mean
+is unchanged.
+
+What the first order leaves out: a cell's directions meet the waves at different obliquities, so
+their patterns differ in shape as well as in place; the attenuation along their paths differs too.
+Both are measured against many point directions (docs/validation.md, ``benchmarks/sky_directions``).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from warpcaustics.optics.sky import cie_relative_radiance, stratified_hemisphere
+from warpcaustics.optics.snell import fresnel_transmittance
+
+POINTS_PER_CELL = 256
+"""Points of the dense stratified set each cell holds on average (S): the set cuts the cells' edges
+coarsely, so that B̂ is off the continuum's by up to 0.016 at the horizon's cell (0.008 with 1024
+points; against a Monte Carlo of 3 million directions, ``tests/test_sky_cones.py``), and 64 points
+put the cells' centroids off by 1/6 of a point's disc radius."""
+
+NEGLIGIBLE_EXPONENT = 30.0
+"""Frequencies where every point's Gaussian is below e^{−30} (1e-13) are left at zero."""
+
+
+def floor_offsets(directions: np.ndarray, ior: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t (…, 2), J (…, 2, 2)): light from unit ``directions`` (…, 3, towards the sky) reaches the
+    floor D below where it entered displaced by −D t; J = ∂t/∂p, p the direction's horizontal part."""
+    p = np.asarray(directions, np.float64)[..., :2]
+    c = np.sqrt(1.0 - np.sum(p * p, axis=-1) / ior**2)
+    t = p / (ior * c[..., None])
+    outer = p[..., :, None] * p[..., None, :] / (ior * c[..., None, None]) ** 2
+    jacobian = (np.eye(2) + outer) / (ior * c[..., None, None])
+    return t, jacobian
+
+
+@functools.lru_cache(maxsize=16)
+def sky_cells(directions: tuple, sky_type: int | None, sun_direction: tuple, ior: float,
+              points_per_cell: int = POINTS_PER_CELL) -> tuple:
+    """Per direction of ``directions`` (K tuples of 3, cosine-weighted stratified): (its cell's
+    points (S_j, 3), their weights (S_j,)): the points of a stratified set of K × ``points_per_cell``
+    nearest it in the projected disk, weighted by the sky's relative radiance (CIE type
+    ``sky_type``, None: uniform) and the flat surface's Fresnel transmittance into water of ``ior``."""
+    d = np.asarray(directions, np.float64)
+    from scipy.spatial import cKDTree
+
+    dense = stratified_hemisphere(len(d) * points_per_cell, 0.5, 0.0)
+    _, nearest = cKDTree(d[:, :2]).query(dense[:, :2])
+    weight = fresnel_transmittance(dense[:, 2], 1.0 / ior)
+    if sky_type is not None:
+        weight = weight * cie_relative_radiance(sky_type, dense, np.asarray(sun_direction, np.float64))
+    return tuple((dense[nearest == j], weight[nearest == j]) for j in range(len(d)))
+
+
+def cell_multiplier(direction: np.ndarray, points: np.ndarray, weights: np.ndarray, count: int,
+                    depth_m: float, ior: float, texel_m: float, m: int,
+                    points_per_cell: int = POINTS_PER_CELL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """B̂_j(k) on the FFT grid of an M × M periodic map of ``texel_m`` texels (numpy's ``fft2``
+    order, [ky, kx]) for the direction ``direction`` whose cell of a sky of ``count`` cells holds
+    ``points`` (S, 3) weighted by ``weights`` (S,), a floor ``depth_m`` below the water's surface:
+    (rows, columns, complex values) where it is not negligible (zero elsewhere; :func:`dense`)."""
+    t_j, _ = floor_offsets(np.asarray(direction, np.float64), ior)
+    t_s, jac = floor_offsets(points, ior)
+    shift = depth_m * (t_s - t_j)  # (S, 2)
+    r = 1.0 / math.sqrt(count * points_per_cell)
+    cov = depth_m**2 * 0.25 * r * r * jac @ np.swapaxes(jac, -1, -2)  # (S, 2, 2)
+    k = 2.0 * math.pi * np.fft.fftfreq(m, texel_m)
+    kx, ky = k[None, :], k[:, None]
+    smallest = float(np.linalg.eigvalsh(cov).min())
+    keep = 0.5 * (kx * kx + ky * ky) * smallest < NEGLIGIBLE_EXPONENT  # elsewhere every term is ~0
+    rows, cols = np.nonzero(keep)
+    qx, qy = k[cols], k[rows]
+    total = np.zeros(len(rows), np.complex128)
+    w = np.asarray(weights, np.float64) / float(np.sum(weights))
+    for s in range(len(w)):
+        exponent = (1j * (qx * shift[s, 0] + qy * shift[s, 1])
+                    - 0.5 * (qx * qx * cov[s, 0, 0] + 2.0 * qx * qy * cov[s, 0, 1] + qy * qy * cov[s, 1, 1]))
+        total += w[s] * np.exp(exponent)
+    return rows, cols, total.astype(np.complex64)
+
+
+def dense(sparse: tuple[np.ndarray, np.ndarray, np.ndarray], m: int) -> np.ndarray:
+    """(M, M) complex64: a multiplier from :func:`cell_multiplier`'s (rows, columns, values)."""
+    out = np.zeros((m, m), np.complex64)
+    out[sparse[0], sparse[1]] = sparse[2]
+    return out
