@@ -28,11 +28,11 @@ SCENE = ROOT / "configs/field/gernez2009.toml"
 ZENITHS = (20.0, 50.0, 80.0)
 SQRT_WINDS = (1.2, 2.4, 3.6)
 
-BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform",
-          "water.extent_m": 32.0, "water.resolution": 1024}
+BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform", "sky.sampling": "stratified",
+          "optics.beam_spread": "wells", "water.extent_m": 32.0, "water.resolution": 1024}
 """The set-up the budget starts from: configs/field/gernez2009.toml as it was before issue 27 (a
-JONSWAP sea, a uniform sky, 1024² cells over 32 m); every row but the last changes one thing on top
-of it."""
+JONSWAP sea, a uniform sky of 16 point directions, Wells's spread, 1024² cells over 32 m); every row
+but the last changes one thing on top of it."""
 
 ROWS: dict[str, tuple[dict | None, str]] = {
     "baseline": ({}, "the set-up before issue 27: JONSWAP, uniform sky, small-angle scattering (Petzold)"),
@@ -55,8 +55,12 @@ ROWS: dict[str, tuple[dict | None, str]] = {
     "elfouhaily_cie_clear": ({"water.spectrum": "elfouhaily", "sky.model": "cie_clear"},
                              "Elfouhaily's sea and the CIE clear sky together, on 3.1 cm cells (the config "
                              "until 2026-12-05)"),
-    "configured": (None, "configs/field/gernez2009.toml as it is now: Elfouhaily's sea, the CIE clear sky, "
-                         "3.9 mm cells (2048² over 8 m)"),
+    "walked_spread": ({"optics.beam_spread": "walk"}, "the small-angle transfer measured by a pencil beam's "
+                      "walk instead of Wells's closed form (2026-12-06)"),
+    "sky_cones": ({"sky.sampling": "cones"}, "each sky direction spread over its cell of the sky: the sky's "
+                  "continuum instead of 16 point directions (2026-12-06)"),
+    "configured": (None, "configs/field/gernez2009.toml as it is now: Elfouhaily's sea, the CIE clear sky "
+                         "in cones, the walked spread, 3.9 mm cells (2048² over 8 m)"),
 }
 """name → (overrides on top of ``BEFORE``, or None: the config as it is; what it changes). The field
 command sets the sun, the sky's share and the wind at each point."""
