@@ -59,11 +59,15 @@ def coarse_resolution(cfg, periodic: bool) -> int:
     return max(1, n // r)
 
 
+def sky_in_cones(cfg) -> bool:
+    """A sky whose directions are spread over their cells (``sky.sampling = "cones"``)."""
+    return cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
+
+
 def needs_coarse(cfg) -> bool:
     """Whether the floor stage keeps the whole patch's light on coarse texels beside a window: for the
-    small-angle transfer, and for the sky's cells (``sky.sampling = "cones"``)."""
-    cones = cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
-    return cfg.optics.scattering is Scattering.SMALL_ANGLE or cones
+    small-angle transfer, and for the sky's cells."""
+    return cfg.optics.scattering is Scattering.SMALL_ANGLE or sky_in_cones(cfg)
 
 
 class FloorCaustics:
@@ -239,7 +243,7 @@ class FluxRatioStage(CausticStage):
                                                     light.optics.absorption_per_m,
                                                     light.optics.scattering_per_m)
         self.cones = None
-        if cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES:
+        if sky_in_cones(cfg):
             self.cones = SkyCones(cfg, light.sky_directions, scene.sun_direction, float(light.group_ior[0]))
         coarse = coarse_resolution(cfg, water.periodic) if needs_coarse(cfg) else 0
         disk_share = light.sun_irradiance / len(light.sun_directions)
