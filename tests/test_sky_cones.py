@@ -71,6 +71,24 @@ def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
         assert table[0, 0] == pytest.approx(1.0, abs=1e-6)
 
 
+def test_the_splatted_multiplier_is_the_sum_s():
+    """Where the points' discs are under a few texels the multiplier comes from the points splatted on
+    the grid (``SPLAT_ABOVE``): against the sum over points for three cells of 16 at 0.3, 1 and 3 m,
+    within 0.05 at every frequency and 0.012 rms (measured ≤ 0.040 and 0.003–0.009)."""
+    scene = wc.load_scene(None, {**SEA, "sky.directions": 16})
+    directions, _ = scene.sky_directions()
+    key = tuple(tuple(float(v) for v in d) for d in directions)
+    cells = sky_cells(key, None, tuple(float(v) for v in scene.sun_direction), IOR)
+    for depth, texel, m in ((3.0, 0.02, 128), (1.0, 0.01, 128), (0.3, 0.004, 256)):
+        for j in (0, 8, 15):
+            summed = dense(cell_multiplier(directions[j], *cells[j], 16, depth, IOR, texel, m,
+                                           splat_above=1 << 40), m)
+            splatted = dense(cell_multiplier(directions[j], *cells[j], 16, depth, IOR, texel, m,
+                                             splat_above=0), m)
+            gap = np.abs(summed - splatted)
+            assert gap.max() < 0.05 and np.sqrt(np.mean(gap**2)) < 0.012, (depth, j, gap.max())
+
+
 def test_cones_keep_the_sky_s_mean_and_wash_out_its_directions():
     """On a 32² FFT sea over 2 m (the whole periodic patch as the map), the sun 5° high with 85 % sky,
     3 m deep: the cones' map has the stratified map's mean (the spread moves light, keeps it), and

@@ -6,7 +6,7 @@ transfer after it."""
 
 from __future__ import annotations
 
-import functools
+import collections
 
 import numpy as np
 
@@ -16,15 +16,26 @@ from warpcaustics.optics.sky import CIE_CLEAR_TYPE
 from warpcaustics.optics.sky_cells import cell_multiplier, dense, sky_cells
 from warpcaustics.optics.small_angle import transferred
 
+CACHE_BYTES = 256 << 20
+"""The most memory the cells' multipliers keep between frames and renderers of a process (a sweep
+renders each frame with a renderer of its own); each is sparse, usually a few thousand values."""
 
-@functools.lru_cache(maxsize=512)
+_CACHE: collections.OrderedDict = collections.OrderedDict()
+
+
 def _multiplier(j: int, directions: tuple, sky_type: int | None, sun: tuple, ior: float, depth_m: float,
                 texel_m: float, m: int) -> tuple:
-    """Direction j's cell multiplier, sparse (it is non-zero on few frequencies: kept for the next
-    frames and renderers of the process, as a sweep renders each frame with a renderer of its own)."""
-    points, weights = sky_cells(directions, sky_type, sun, ior)[j]
-    return cell_multiplier(np.asarray(directions[j]), points, weights, len(directions), depth_m, ior,
-                           texel_m, m)
+    """Direction j's cell multiplier, sparse, kept (least recently used first out) up to
+    ``CACHE_BYTES``."""
+    key = (j, directions, sky_type, sun, ior, depth_m, texel_m, m)
+    if key not in _CACHE:
+        points, weights = sky_cells(directions, sky_type, sun, ior)[j]
+        _CACHE[key] = cell_multiplier(np.asarray(directions[j]), points, weights, len(directions), depth_m,
+                                      ior, texel_m, m)
+        while sum(sum(a.nbytes for a in v) for v in _CACHE.values()) > CACHE_BYTES and len(_CACHE) > 1:
+            _CACHE.popitem(last=False)
+    _CACHE.move_to_end(key)
+    return _CACHE[key]
 
 
 class SkyCones:

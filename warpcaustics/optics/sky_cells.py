@@ -48,6 +48,16 @@ put the cells' centroids off by 1/6 of a point's disc radius."""
 NEGLIGIBLE_EXPONENT = 30.0
 """Frequencies where every point's Gaussian is below e^{−30} (1e-13) are left at zero."""
 
+SPLAT_ABOVE = 1 << 24
+"""Past this many (frequency, point) terms — points' discs under a few texels, so that few
+frequencies are negligible — the multiplier is the FFT of the points splatted on the map's grid
+(bilinear) times the Gaussian of their mean disc: within 0.04 of the sum (rms 0.003–0.009) on 16
+cells 0.3–3 m deep (``tests/test_sky_cones.py``), the bilinear splat's smoothing and one disc for
+all, and ~100–1000× faster."""
+
+NEGLIGIBLE_VALUE = 1e-6
+"""A splatted multiplier's values below this are left at zero (kept sparse)."""
+
 
 def floor_offsets(directions: np.ndarray, ior: float) -> tuple[np.ndarray, np.ndarray]:
     """(t (…, 2), J (…, 2, 2)): light from unit ``directions`` (…, 3, towards the sky) reaches the
@@ -67,9 +77,9 @@ def sky_cells(directions: tuple, sky_type: int | None, sun_direction: tuple, ior
     points (S_j, 3), their weights (S_j,)): the points of a stratified set of K × ``points_per_cell``
     nearest it in the projected disk, weighted by the sky's relative radiance (CIE type
     ``sky_type``, None: uniform) and the flat surface's Fresnel transmittance into water of ``ior``."""
-    d = np.asarray(directions, np.float64)
     from scipy.spatial import cKDTree
 
+    d = np.asarray(directions, np.float64)
     dense = stratified_hemisphere(len(d) * points_per_cell, 0.5, 0.0)
     _, nearest = cKDTree(d[:, :2]).query(dense[:, :2])
     weight = fresnel_transmittance(dense[:, 2], 1.0 / ior)
@@ -80,11 +90,17 @@ def sky_cells(directions: tuple, sky_type: int | None, sun_direction: tuple, ior
 
 def cell_multiplier(direction: np.ndarray, points: np.ndarray, weights: np.ndarray, count: int,
                     depth_m: float, ior: float, texel_m: float, m: int,
-                    points_per_cell: int = POINTS_PER_CELL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    points_per_cell: int = POINTS_PER_CELL, splat_above: int = SPLAT_ABOVE
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """B̂_j(k) on the FFT grid of an M × M periodic map of ``texel_m`` texels (numpy's ``fft2``
     order, [ky, kx]) for the direction ``direction`` whose cell of a sky of ``count`` cells holds
     ``points`` (S, 3) weighted by ``weights`` (S,), a floor ``depth_m`` below the water's surface:
-    (rows, columns, complex values) where it is not negligible (zero elsewhere; :func:`dense`)."""
+    (rows, columns, complex values) where it is not negligible (zero elsewhere; :func:`dense`).
+    A cell without points (or weight) leaves the map as it is."""
+    w = np.asarray(weights, np.float64)
+    if len(w) == 0 or float(np.sum(w)) <= 0.0:
+        return np.zeros(1, np.int64), np.zeros(1, np.int64), np.ones(1, np.complex64)
+    w = w / float(np.sum(w))
     t_j, _ = floor_offsets(np.asarray(direction, np.float64), ior)
     t_s, jac = floor_offsets(points, ior)
     shift = depth_m * (t_s - t_j)  # (S, 2)
@@ -95,14 +111,36 @@ def cell_multiplier(direction: np.ndarray, points: np.ndarray, weights: np.ndarr
     smallest = float(np.linalg.eigvalsh(cov).min())
     keep = 0.5 * (kx * kx + ky * ky) * smallest < NEGLIGIBLE_EXPONENT  # elsewhere every term is ~0
     rows, cols = np.nonzero(keep)
+    if len(rows) * len(w) > splat_above:
+        return _splatted(shift, cov, w, k, texel_m, m)
     qx, qy = k[cols], k[rows]
     total = np.zeros(len(rows), np.complex128)
-    w = np.asarray(weights, np.float64) / float(np.sum(weights))
     for s in range(len(w)):
         exponent = (1j * (qx * shift[s, 0] + qy * shift[s, 1])
                     - 0.5 * (qx * qx * cov[s, 0, 0] + 2.0 * qx * qy * cov[s, 0, 1] + qy * qy * cov[s, 1, 1]))
         total += w[s] * np.exp(exponent)
     return rows, cols, total.astype(np.complex64)
+
+
+def _splatted(shift: np.ndarray, cov: np.ndarray, w: np.ndarray, k: np.ndarray, texel_m: float, m: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`cell_multiplier` for points' discs under a few texels: the points splatted bilinearly
+    at −shift on the periodic M × M grid (the multiplier's e^{ik·shift} is a move by −shift), its
+    FFT, times the Gaussian of the points' weighted mean disc."""
+    u = (-shift / texel_m) % m  # (S, 2): x, y in texels
+    i0 = np.floor(u).astype(np.int64)
+    f = u - i0
+    image = np.zeros((m, m))
+    for dy in (0, 1):
+        for dx in (0, 1):
+            share = w * np.where(dx, f[:, 0], 1.0 - f[:, 0]) * np.where(dy, f[:, 1], 1.0 - f[:, 1])
+            np.add.at(image, ((i0[:, 1] + dy) % m, (i0[:, 0] + dx) % m), share)
+    c = np.einsum("s,sij->ij", w, cov)
+    kx, ky = k[None, :], k[:, None]
+    disc = np.exp(-0.5 * (kx * kx * c[0, 0] + 2.0 * kx * ky * c[0, 1] + ky * ky * c[1, 1]))
+    out = np.fft.fft2(image) * disc
+    rows, cols = np.nonzero(np.abs(out) > NEGLIGIBLE_VALUE)
+    return rows, cols, out[rows, cols].astype(np.complex64)
 
 
 def dense(sparse: tuple[np.ndarray, np.ndarray, np.ndarray], m: int) -> np.ndarray:
