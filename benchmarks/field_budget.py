@@ -55,6 +55,8 @@ ROWS: dict[str, tuple[dict | None, str]] = {
     "elfouhaily_cie_clear": ({"water.spectrum": "elfouhaily", "sky.model": "cie_clear"},
                              "Elfouhaily's sea and the CIE clear sky together, on 3.1 cm cells (the config "
                              "until 2026-12-05)"),
+    "baseline_2026_12_06": ({}, "the baseline again, with each window's scattered light from the sea around "
+                            "it (since 2026-12-05 late): the rows below compare with it"),
     "walked_spread": ({"optics.beam_spread": "walk"}, "the small-angle transfer measured by a pencil beam's "
                       "walk instead of Wells's closed form (2026-12-06)"),
     "sky_cones": ({"sky.sampling": "cones"}, "each sky direction spread over its cell of the sky: the sky's "
