@@ -154,7 +154,7 @@ def write_table(path: Path, results: list[dict]) -> None:
     left empty there)."""
     columns = list(dict.fromkeys(key for r in results for key in r))
     with path.open("w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=columns, restval="")
+        writer = csv.DictWriter(fh, fieldnames=columns, restval="", lineterminator="\n")
         writer.writeheader()
         writer.writerows(results)
 
