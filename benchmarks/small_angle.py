@@ -13,6 +13,9 @@ transfer and the bilinear read at the window's texels). A fourth, ``small_angle`
 ``optics.beam_spread = "walk"`` (the column's beam spread function from a walk of a pencil beam per
 light direction instead of Wells's closed form), is timed warm like the others — its walks and
 multipliers are kept from the first frame — and its first frame, which walks them, is reported too.
+A fifth, ``small_angle`` with the sky in cones (``sky.sampling = "cones"``: each sky direction's map
+spread over its cell of the sky before its transfer), gives the cones' cost against the point
+directions, warm and first frame (which computes the cells' multipliers).
 """
 
 from __future__ import annotations
@@ -37,11 +40,13 @@ def run(quick: bool, device: str) -> dict:
     times, stages = {}, {}
     first = {}
     for mode, scattering in (("single", "single"), ("small_angle", "small_angle"),
-                             ("periodic_window", "small_angle"), ("walked_spread", "small_angle")):
+                             ("periodic_window", "small_angle"), ("walked_spread", "small_angle"),
+                             ("sky_cones", "small_angle")):
         spread = "walk" if mode == "walked_spread" else "wells"
+        sampling = "cones" if mode == "sky_cones" else "stratified"
         scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml",
                               {**BEFORE, **overrides, "optics.scattering": scattering,
-                               "optics.beam_spread": spread})
+                               "optics.beam_spread": spread, "sky.sampling": sampling})
         coarse = fluxratio.coarse_resolution
         if mode == "periodic_window":  # the baseline: no coarse map, the window taken whole as periodic
             fluxratio.coarse_resolution = lambda cfg, periodic: 0
@@ -63,12 +68,15 @@ def run(quick: bool, device: str) -> dict:
            "coarse_texels": fluxratio.coarse_resolution(scene.config, True),
            "walked_spread_s": times["walked_spread"],
            "walked_spread_ratio": times["walked_spread"] / times["small_angle"],
+           "sky_cones_s": times["sky_cones"], "sky_cones_ratio": times["sky_cones"] / times["small_angle"],
            "first_frame_s": {k: round(v, 2) for k, v in first.items()}, "stages_s": stages}
     print(f"small_angle  field frame N={n} | single {times['single']:.2f} s | small_angle "
           f"{times['small_angle']:.2f} s | ×{row['ratio']:.2f} | the window periodic (no coarse map) "
           f"{times['periodic_window']:.2f} s: the coarse map ×{row['coarse_ratio']:.2f} | walked spread "
           f"{times['walked_spread']:.2f} s (×{row['walked_spread_ratio']:.2f} of Wells's; first frame "
-          f"{first['walked_spread']:.1f} s against {first['small_angle']:.1f} s)", flush=True)
+          f"{first['walked_spread']:.1f} s against {first['small_angle']:.1f} s) | sky in cones "
+          f"{times['sky_cones']:.2f} s (×{row['sky_cones_ratio']:.2f} of point directions; first frame "
+          f"{first['sky_cones']:.1f} s)", flush=True)
     return {"benchmark": "small_angle_scattering", **device_record(device), "repeats": repeats,
             "results": [row]}
 
