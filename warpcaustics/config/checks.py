@@ -155,8 +155,7 @@ def _check_sky(cfg: Config) -> None:
         if method is not CausticsMethod.FLUXRATIO or cfg.optics.scattering is Scattering.MULTIPLE:
             raise ConfigError("sky.sampling = \"cones\" spreads each direction's floor map in "
                               "caustics.method = \"fluxratio\" with optics.scattering = \"single\" or "
-                              "\"small_angle\"; set "
-                              "those or sky.sampling = \"stratified\"")
+                              "\"small_angle\"; set those or sky.sampling = \"stratified\"")
         if not cfg.water.periodic:
             raise ConfigError(f"sky.sampling = \"cones\" spreads each direction's light over a periodic sea, "
                               f"not water.model = {cfg.water.model.value!r}; use water.model = \"fft\" or "
