@@ -6,10 +6,9 @@ transfer after it."""
 
 from __future__ import annotations
 
-import collections
-
 import numpy as np
 
+from warpcaustics.caustics.cache import BoundedCache
 from warpcaustics.caustics.window import MapWindow
 from warpcaustics.config import Config, SkyModel
 from warpcaustics.optics.sky import CIE_CLEAR_TYPE
@@ -17,25 +16,22 @@ from warpcaustics.optics.sky_cells import cell_multiplier, dense, sky_cells
 from warpcaustics.optics.small_angle import transferred
 
 CACHE_BYTES = 256 << 20
-"""The most memory the cells' multipliers keep between frames and renderers of a process (a sweep
-renders each frame with a renderer of its own); each is sparse, usually a few thousand values."""
+"""The most memory the cells' multipliers keep between frames and renderers of a process; each is
+sparse, usually a few thousand values."""
 
-_CACHE: collections.OrderedDict = collections.OrderedDict()
+_CACHE = BoundedCache(CACHE_BYTES, size=lambda sparse: sum(a.nbytes for a in sparse))
 
 
 def _multiplier(j: int, directions: tuple, sky_type: int | None, sun: tuple, ior: float, depth_m: float,
                 texel_m: float, m: int) -> tuple:
-    """Direction j's cell multiplier, sparse, kept (least recently used first out) up to
-    ``CACHE_BYTES``."""
-    key = (j, directions, sky_type, sun, ior, depth_m, texel_m, m)
-    if key not in _CACHE:
+    """Direction j's cell multiplier, sparse, kept up to ``CACHE_BYTES``."""
+
+    def make():
         points, weights = sky_cells(directions, sky_type, sun, ior)[j]
-        _CACHE[key] = cell_multiplier(np.asarray(directions[j]), points, weights, len(directions), depth_m,
-                                      ior, texel_m, m)
-        while sum(sum(a.nbytes for a in v) for v in _CACHE.values()) > CACHE_BYTES and len(_CACHE) > 1:
-            _CACHE.popitem(last=False)
-    _CACHE.move_to_end(key)
-    return _CACHE[key]
+        return cell_multiplier(np.asarray(directions[j]), points, weights, len(directions), depth_m, ior,
+                               texel_m, m)
+
+    return _CACHE.get((j, directions, sky_type, sun, ior, depth_m, texel_m, m), make)
 
 
 class SkyCones:
@@ -66,4 +62,4 @@ class SkyCones:
             return transferred(single, near), None
         mc = coarse.shape[-1]
         far = self.multiplier(j, self.window.extent_m / mc, mc)
-        return self.window.convolve(single, coarse, far, near), transferred(coarse, far)
+        return self.window.convolve(single, coarse, far, near)

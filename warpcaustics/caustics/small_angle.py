@@ -15,11 +15,11 @@ surface's focusing and to each texel's own path (:meth:`SmallAngleScattering.ter
 
 from __future__ import annotations
 
-import collections
 import math
 
 import numpy as np
 
+from warpcaustics.caustics.cache import BoundedCache
 from warpcaustics.caustics.window import MapWindow
 from warpcaustics.config import BeamSpread, Config
 from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
@@ -35,9 +35,9 @@ MULTIPLIER_CACHE_BYTES = 1 << 30
 """The most memory the transfer's multipliers keep between frames and renderers of a process
 (1 GiB): a sweep renders each frame with a renderer of its own."""
 
-_MULTIPLIERS: collections.OrderedDict = collections.OrderedDict()
+_MULTIPLIERS = BoundedCache(MULTIPLIER_CACHE_BYTES, size=lambda entry: entry[2])
 """The transfer's multipliers by (the water, its depth, the spread, the beam, texel, M, derivative):
-(by band, k = 0 values, bytes), least recently used first."""
+(by band, k = 0 values, bytes)."""
 
 
 class SmallAngleScattering:
@@ -129,31 +129,29 @@ class SmallAngleScattering:
         from two more walks ``DEPTH_STEP`` shallower and deeper. Kept for the next frames of the
         process (the sun's and a fixed sky's directions come back), up to
         ``MULTIPLIER_CACHE_BYTES``."""
-        walked = self.optics.beam_spread is BeamSpread.WALK
         beam = np.round(np.asarray(down, np.float64), 9).tolist()
         key = (self.cache_key, derivative, *beam, float(texel_m), m)
-        if key not in _MULTIPLIERS:
-            if not walked:
-                entry = (*wells_multiplier(self.optics, texel_m, m, path, self.b, down), 8 * m * m)
-            elif derivative:  # e^{c s̄} ∂H̃/∂s by central differences, + c M: H̃ varies slowly, e^{cs} not
-                at, zero_at = self.multiplier(texel_m, m, down, path)
-                ends = [self._walked(texel_m, m, down, path * f, self.depth_m * f)
-                        for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP)]
-                c = self.a + self.b
-                shallow, deep = (np.exp(-c * path * (f - 1.0)) for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP))
-                step = 2.0 * DEPTH_STEP * path
-                table = np.stack([(deep[k] * ends[1][0](k) - shallow[k] * ends[0][0](k)) / step + c[k] * at(k)
-                                  for k in range(len(self.b))]).astype(np.complex64)
-                zero = (deep * ends[1][1] - shallow * ends[0][1]) / step + c * zero_at
-                entry = ((lambda band: table[band]), zero, table.nbytes)
-            else:
-                entry = self._walked(texel_m, m, down, path, self.depth_m)
-            _MULTIPLIERS[key] = entry
-            while sum(e[2] for e in _MULTIPLIERS.values()) > MULTIPLIER_CACHE_BYTES:
-                _MULTIPLIERS.popitem(last=False)
-        _MULTIPLIERS.move_to_end(key)
-        function, at_zero, _ = _MULTIPLIERS[key]
+        function, at_zero, _ = _MULTIPLIERS.get(key, lambda: self._make_multiplier(texel_m, m, down, path,
+                                                                                   derivative))
         return function, at_zero
+
+    def _make_multiplier(self, texel_m: float, m: int, down: np.ndarray, path: float, derivative: bool):
+        """(:meth:`multiplier`'s function of the band, its k = 0 values, the bytes it holds)."""
+        if self.optics.beam_spread is not BeamSpread.WALK:
+            return (*wells_multiplier(self.optics, texel_m, m, path, self.b, down), 8 * m * m)
+        if not derivative:
+            return self._walked(texel_m, m, down, path, self.depth_m)
+        # e^{c s̄} ∂H̃/∂s by central differences, + c M: H̃ varies slowly, e^{cs} not
+        at, zero_at = self.multiplier(texel_m, m, down, path)
+        ends = [self._walked(texel_m, m, down, path * f, self.depth_m * f)
+                for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP)]
+        c = self.a + self.b
+        shallow, deep = (np.exp(-c * path * (f - 1.0)) for f in (1.0 - DEPTH_STEP, 1.0 + DEPTH_STEP))
+        step = 2.0 * DEPTH_STEP * path
+        table = np.stack([(deep[k] * ends[1][0](k) - shallow[k] * ends[0][0](k)) / step + c[k] * at(k)
+                          for k in range(len(self.b))]).astype(np.complex64)
+        zero = (deep * ends[1][1] - shallow * ends[0][1]) / step + c * zero_at
+        return (lambda band: table[band]), zero, table.nbytes
 
     def _walked(self, texel_m: float, m: int, down: np.ndarray, path: float, depth_m: float):
         """(the walked spread's multiplier by band, its k = 0 values, the bytes it holds) for a
@@ -210,7 +208,7 @@ class SmallAngleScattering:
                                                    self.terms(coarse, light, down, path, *centres)):
             far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
             near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
-            out = out + self.window.convolve(term, term_c, far_m, near_m)
+            out = out + self.window.convolve(term, term_c, far_m, near_m)[0]
             at_zero = at_zero + np.divide(term_c.mean(axis=(1, 2)), whole, out=np.zeros_like(whole),
                                           where=whole > 0) * zero
         return out, at_zero

@@ -65,10 +65,11 @@ class MapWindow:
         _, (rows, wy), (cols, wx), _ = self.on_coarse(a.shape[-1])
         return wy @ a[:, rows][:, :, cols] @ wx.T
 
-    def convolve(self, window: np.ndarray, coarse: np.ndarray, far, near) -> np.ndarray:
-        """(K, M, M) B*S on the window's texels of the window's map ``window`` (K, M, M) whose whole
-        patch's light is ``coarse`` (K, Mc, Mc): the coarse map convolved over the periodic patch
-        (``far``: B's multiplier by band on the coarse texels' FFT grid) and read at the texels, plus
-        the window's detail beyond the coarse texels convolved as periodic over the window
-        (``near``: on the window's grid)."""
-        return self.on_map(transferred(coarse, far)) + transferred(window - self.on_map(coarse), near)
+    def convolve(self, window: np.ndarray, coarse: np.ndarray, far, near) -> tuple[np.ndarray, np.ndarray]:
+        """(B*S on the window's texels (K, M, M), B*C on the coarse texels (K, Mc, Mc)) for the
+        window's map ``window`` (K, M, M) whose whole patch's light is ``coarse`` (K, Mc, Mc): the
+        coarse map convolved over the periodic patch (``far``: B's multiplier by band on the coarse
+        texels' FFT grid) and read at the texels, plus the window's detail beyond the coarse texels
+        convolved as periodic over the window (``near``: on the window's grid)."""
+        whole = transferred(coarse, far)
+        return self.on_map(whole) + transferred(window - self.on_map(coarse), near), whole

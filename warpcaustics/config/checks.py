@@ -124,8 +124,8 @@ def _check_map_window(cfg: Config) -> None:
 def _check_sky(cfg: Config) -> None:
     sky = cfg.sky
     if sky.model is SkyModel.NONE:
-        if sky.sampling is SkySampling.HALVES:  # cones without a sky spread nothing: a field config with
-            # its sky turned off (--set sky.model=none) still loads
+        # cones without a sky spread nothing: a field config with its sky turned off still loads
+        if sky.sampling is SkySampling.HALVES:
             raise ConfigError("sky.sampling = \"halves\" draws the sky's directions: set sky.model "
                               "(e.g. \"uniform\") or sky.sampling = \"stratified\"")
         if sky.diffuse_fraction:
