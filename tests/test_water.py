@@ -418,3 +418,34 @@ def test_water_depth_sets_the_depth_the_waves_feel():
     assert not np.allclose(water.ocean_spectrum(shallow, kx, ky), water.ocean_spectrum(deep, kx, ky))
     omega = water.FFTOcean.from_config(sensor, "cpu").omega.numpy()
     np.testing.assert_allclose(omega, water.dispersion(np.hypot(kx, ky), 1000.0), rtol=1e-6)
+
+
+def test_a_long_wave_patch_holds_the_waves_longer_than_its_cut():
+    """``water.shortest_wave_m`` = L drops the waves of wavelength L or shorter: the spectrum is zero
+    at |k| ≥ 2π/L and unchanged below, and the elevation variance a 128 m patch of the waves over
+    8 m holds (Σ P Δk²) is the float64 integral of Elfouhaily et al.'s omnidirectional spectrum
+    (eqs. 31, 40: S = (B_l + B_h)/k³) below 2π/8 m⁻¹ to 2 %: half of a 5 m/s sea's, whose peak is
+    10 m long."""
+    from warpcaustics.config import config_from_dict
+    from warpcaustics.water.elfouhaily import curvature_spectra
+
+    def drawn(shortest_m: float) -> tuple[np.ndarray, np.ndarray, float]:
+        cfg = config_from_dict({}, {"water.spectrum": "elfouhaily", "water.wind_speed_m_s": 5.0,
+                                    "water.fetch_m": 20000.0, "floor.depth_m": 3.2, "water.depth_m": 1000.0,
+                                    "water.extent_m": 128.0, "water.resolution": 1024,
+                                    "water.shortest_wave_m": shortest_m})
+        kx, ky = np.meshgrid(water.wavenumbers(1024, 128.0), water.wavenumbers(1024, 128.0))
+        p = water.ocean_spectrum(cfg, kx, ky)
+        return p, np.hypot(kx, ky), float(p.sum() * (2 * np.pi / 128.0) ** 2)
+
+    whole, k, total = drawn(0.0)
+    long, _, long_part = drawn(8.0)
+    cut = 2 * np.pi / 8.0
+    assert np.all(long[k >= cut * (1 - 1e-9)] == 0.0)
+    below = k < cut * (1 - 1e-9)
+    np.testing.assert_array_equal(long[below], whole[below])
+    kk = np.logspace(-3, 4, 400001)
+    b_long, b_short, _ = curvature_spectra(kk, 5.0, 20000.0)
+    s = (b_long + b_short) / kk**3
+    assert long_part == pytest.approx(np.trapezoid(s[kk < cut], kk[kk < cut]), rel=0.02)
+    assert 0.3 < long_part / total < 0.7

@@ -77,6 +77,10 @@ class WaterConfig:
     """Phillips constant A (dimensionless): height variance = A·π·(V²/g)²/2 over all k."""
     small_wave_m: float = field(default=0.0, metadata=_length())
     """Waves shorter than this are suppressed by exp(-k² l²) (Tessendorf eq. 41) [m]."""
+    shortest_wave_m: float = field(default=0.0, metadata=_length())
+    """Waves of this wavelength or shorter are dropped from the spectrum (``fft``) [m]; 0 = none: a
+    coarse large patch that carries only the waves a finer patch of this side lacks (``warpcaustics
+    field gernez2009``'s ``--large-scale``)."""
     fetch_m: float = field(default=100_000.0, metadata=_positive(1.0e7))
     """Distance over which the wind has blown (JONSWAP, Elfouhaily) [m]."""
     jonswap_gamma: float = field(default=3.3, metadata=_range(1.0, 10.0))

@@ -89,5 +89,11 @@ def wave_depth_m(cfg: Config) -> float:
 
 
 def ocean_spectrum(cfg: Config, kx: np.ndarray, ky: np.ndarray) -> np.ndarray:
-    """The directional spectrum P(k) [m⁴] named by ``water.spectrum``."""
-    return SPECTRA[cfg.water.spectrum](cfg, kx, ky)
+    """The directional spectrum P(k) [m⁴] named by ``water.spectrum``, without the waves of
+    ``water.shortest_wave_m`` or shorter (k ≥ 2π/λ, to a part in 10⁹ so that a patch of that side's
+    own wavenumbers are dropped)."""
+    p = SPECTRA[cfg.water.spectrum](cfg, kx, ky)
+    shortest = cfg.water.shortest_wave_m
+    if shortest:
+        p = np.where(np.hypot(kx, ky) >= 2.0 * np.pi / shortest * (1.0 - 1e-9), 0.0, p)
+    return p
