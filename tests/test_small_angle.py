@@ -181,6 +181,37 @@ def test_a_deep_window_takes_its_large_scales_from_the_whole_patch():
     assert max(abs(s - 1.0) for s in swings) > 0.2  # the windows' own light swings: the test can tell
 
 
+@pytest.mark.parametrize("elevation_deg", [5.0, 50.0])
+def test_the_patchs_coarse_map_has_the_whole_maps_window_means(elevation_deg):
+    """A 1 m window of the Gernez sea (8 m, 128² cells; its sun, sky in cones and small-angle
+    scattered light): the whole patch's coarse map (RenderResult.coarse_floor_irradiance, the
+    transfer's and the cones' large scales, with the scattered light added as the window's map has
+    it) against a render of the whole patch on texels as coarse: the means over the 64 squares the
+    window's size agree each within 3 % (measured 2.6 % at a 5° sun, 1.0 % at 50°), their CV within
+    3 % (1.7 %, 0.0 %), the sky's part within 1 % (0.1 %), and the patch's mean to 1e-6."""
+    from warpcaustics.batch.stats import frame_statistics
+
+    base = {"water.resolution": 128, "sun.elevation_deg": elevation_deg, "sky.diffuse_fraction": 0.5,
+            "sky.directions": 4, "sun.disk_samples": 4}
+    scene = CONFIGS / "field" / "gernez2009.toml"
+    window = wc.load_scene(scene, {**base, "caustics.map_resolution": 64})
+    result = wc.render(window, device="cpu")
+    patch = {**base, "caustics.map_extent_m": 0.0, "caustics.map_resolution": 64}
+    whole = wc.render(wc.load_scene(scene, patch), device="cpu")
+
+    def squares(a):
+        return a[0].astype(np.float64).reshape(8, 8, 8, 8).mean(axis=(1, 3))
+
+    coarse, direct = squares(result.coarse_floor_irradiance), squares(whole.floor_irradiance)
+    assert np.abs(coarse / direct - 1.0).max() < 0.03
+    assert coarse.std() / coarse.mean() == pytest.approx(direct.std() / direct.mean(), rel=0.03)
+    assert coarse.mean() == pytest.approx(direct.mean(), rel=1e-6)
+    sky = squares(result.coarse_sky_floor_irradiance) / squares(whole.sky_floor_irradiance)
+    assert np.abs(sky - 1.0).max() < 0.01
+    stats = frame_statistics(result, window.config.stats)["irradiance_w_m2"]["patch_windows"]
+    assert stats["count"] == 64 and stats["cv"] == pytest.approx(coarse.std() / coarse.mean(), rel=1e-6)
+
+
 def test_refracted_paths_follow_snells_law_at_the_local_slope():
     """``SmallAngleScattering.refracted_paths`` (the walked spread's path of each texel's light): on a
     sinusoidal sea (4 m waves, slope up to 0.16) under a sun 40° from the zenith along the waves,

@@ -97,6 +97,13 @@ class RenderResult:
     first half of the sky's directions (the even-numbered; the rest is the second half's): two
     independent estimates of the sky's continuum, for statistics without the directions' own
     caustic noise (:func:`warpcaustics.batch.stats.continuous_sky_cv`)."""
+    coarse_floor_irradiance: np.ndarray | None = None
+    """A window of a periodic sea under the small-angle transfer or a sky in cones: (K, Mc, Mc) the
+    whole patch's light on the coarse texels the transfer and the cones take its large scales from
+    [W m⁻² nm⁻¹], the map's counterpart over the patch: the variance at scales above the window
+    (:func:`warpcaustics.batch.stats.frame_statistics`'s ``patch_windows``)."""
+    coarse_sky_floor_irradiance: np.ndarray | None = None
+    """With :attr:`coarse_floor_irradiance` and a sky: the sky's part of it."""
     camera_radiance: np.ndarray | None = None
     """(K, H, W) spectral radiance reaching the camera [W m^-2 sr^-1 nm^-1], image row 0 at the top."""
     camera_gbuffer: dict[str, np.ndarray] | None = None

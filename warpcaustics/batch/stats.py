@@ -119,6 +119,37 @@ def field_statistics(field: np.ndarray, flash_threshold: float) -> dict:
     }
 
 
+def window_means(coarse: np.ndarray, count: int) -> dict:
+    """Mean and CV of the means of a whole periodic patch's coarse map over its ``count`` × ``count``
+    squares the size of the floor-map window: by the law of total variance, the patch's variance
+    is the windows' mean variance within them plus this variance between them (``patch_windows``
+    of :func:`frame_statistics`)."""
+    f = np.asarray(coarse, np.float64)
+    m = f.shape[-1] // count
+    means = f.reshape(count, m, count, m).mean(axis=(1, 3))
+    mean = float(means.mean())
+    return {"count": count * count, "mean": mean, "cv": float(means.std() / mean) if mean > 0.0 else 0.0}
+
+
+def patch_windows(result) -> dict[str, np.ndarray] | None:
+    """{field: its coarse map of the whole patch} for the band-integrated irradiance, and its sky and
+    direct parts, where the map is a window of a periodic sea that the window's side tiles on the
+    coarse texels (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else None."""
+    coarse = result.coarse_floor_irradiance
+    if coarse is None:
+        return None
+    count = round(result.scene.config.water.extent_m / result.map_extent_m)
+    if count < 2 or abs(count * result.map_extent_m - result.scene.config.water.extent_m) > 1e-6 * count \
+            or coarse.shape[-1] % count:
+        return None
+    widths = result.bin_widths_nm
+    out = {"irradiance_w_m2": band_integrated(coarse, widths)}
+    if result.coarse_sky_floor_irradiance is not None:
+        out["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
+        out["direct_irradiance_w_m2"] = out["irradiance_w_m2"] - out["sky_irradiance_w_m2"]
+    return {name: (f, count) for name, f in out.items()}
+
+
 def frame_statistics(result, cfg: StatsConfig) -> dict:
     """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
@@ -126,7 +157,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     collector. Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each
     of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
     its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
-    (:func:`continuous_sky_cv`)."""
+    (:func:`continuous_sky_cv`). Where the map is a window of a periodic sea that tiles the patch,
+    the band-integrated fields also have ``patch_windows``: the means over the whole patch's
+    windows, from its coarse map (:func:`window_means`)."""
     widths = result.bin_widths_nm
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
@@ -162,9 +195,12 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "pdf_edges": PDF_EDGES.tolist(),
         "par_band_nm": covered,
     }
+    patch = patch_windows(result) or {}
     for name, f in fields.items():
         averaged = collector(f)
         stats = field_statistics(averaged, cfg.flash_threshold)
+        if name in patch:
+            stats["patch_windows"] = window_means(*patch[name])
         if name in halves:
             sky_part, even_part = (collector(h) for h in halves[name])
             stats["continuous_sky"] = continuous_sky_moments(

@@ -24,6 +24,9 @@ SKY_GROUPS = ("sky_even", "sky")
 """The small-angle transfer's groups of the sky's even- and odd-numbered directions
 (``sky.sampling = "halves"``; else all are ``sky``)."""
 
+COARSE_FIELDS = ("coarse_floor_irradiance", "coarse_sky_floor_irradiance")
+"""The whole patch's light on coarse texels beside a window (RenderResult), and its sky's part."""
+
 
 def floor_bytes(n: int, m: int, k: int, groups: int) -> int:
     """Device memory of the refraction and floor stages [bytes]."""
@@ -283,24 +286,28 @@ class FluxRatioStage(CausticStage):
         with watch.stage("readback"):
             # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
             floor_np = floor.numpy().copy()
+        coarse = self._coarse(frame)  # the sun's, on the whole patch beside a window
         if self.small_angle is not None:
             self.small_angle.reset(frame.surface.positions.numpy()[..., 2])
             with watch.stage("small_angle"):  # the disk's directions share one transfer, its centre's
                 centre = np.mean(self.light.sun_directions, axis=0)
-                self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1],
-                                     coarse=self._coarse(frame))
-        single_sky = None
+                self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1], coarse=coarse)
+        single_sky = coarse_sky = None
         if self.light.sky_directions is not None:
-            sky_np, sky_flux, even = self._sky(frame)
+            sky_np, sky_flux, even, coarse_sky = self._sky(frame)
             extra["sky_floor_irradiance"] = single_sky = sky_np
             extra["sky_floor_irradiance_even"] = single_even = even
             floor_np, flux = floor_np + sky_np, flux + sky_flux
+        if coarse is not None:
+            extra["coarse_floor_irradiance"] = coarse if coarse_sky is None else coarse + coarse_sky
+            extra["coarse_sky_floor_irradiance"] = coarse_sky
         transmitted = flux[0]
         extra["delivered_flux_w_nm"] = flux[1]
         if self.multiple is None:
             return floor_np, transmitted, extra, None
         # the walk's maps replace the single-scattering ones
         single = (floor_np, transmitted, {"delivered_flux_w_nm": extra.pop("delivered_flux_w_nm")})
+        single_coarse = tuple(extra.pop(key, None) for key in COARSE_FIELDS)
         with watch.stage("multiple_scattering"):
             floor_np, walk = self.multiple.run(frame.surface, frame.visible)
             transmitted = np.asarray(walk["transmitted"])
@@ -321,6 +328,7 @@ class FluxRatioStage(CausticStage):
             with watch.stage("small_angle"):
                 scattered, walk["small_angle"] = self.small_angle.finish(floor_flux)
             floor_np = single[0] + sum(scattered.values())
+            extra.update(self._coarse_scattered(*single_coarse))
             if single_sky is not None:
                 sky_scattered = [scattered[g] for g in SKY_GROUPS if g in scattered]
                 extra["sky_floor_irradiance"] = single_sky + sum(sky_scattered)
@@ -328,16 +336,29 @@ class FluxRatioStage(CausticStage):
                     extra["sky_floor_irradiance_even"] = single_even + scattered[SKY_GROUPS[0]]
         return floor_np, transmitted, extra, single
 
-    def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """The sky's floor map, (2, K) flux (entering, delivered) and, with ``sky.sampling =
-        "halves"``, the map of its even-numbered directions alone (else None): one shaded refraction
+    def _coarse_scattered(self, whole: np.ndarray | None, sky: np.ndarray | None) -> dict:
+        """The coarse maps of the whole patch (:attr:`RenderResult.coarse_floor_irradiance`, its sky's
+        part) with the small-angle transfer's scattered light added, as the window's map has it; {}
+        without them."""
+        if whole is None:
+            return {}
+        parts = self.small_angle.scattered_coarse
+        out = {"coarse_floor_irradiance": whole + sum(parts.values())}
+        if sky is not None:
+            out["coarse_sky_floor_irradiance"] = sky + sum(parts[g] for g in SKY_GROUPS if g in parts)
+        return out
+
+    def _sky(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """The sky's floor map, (2, K) flux (entering, delivered), with ``sky.sampling = "halves"``
+        the map of its even-numbered directions alone (else None), and beside a window of a periodic
+        sea the whole patch's sky on coarse texels (else None): one shaded refraction
         and deposit per sky direction, each with its share of the sky's irradiance (with halves,
         the even-numbered ones first). With the small-angle transfer each direction's map is read
         back and given its own transfer (its own path), its scattered light reported by half; with
         ``sky.sampling = "cones"`` it is read back and spread over its cell of the sky first."""
         light = self.light
         transmitted = 0.0
-        total = even = None
+        total = even = total_coarse = None
         separate = self.small_angle is not None or self.cones is not None
         count = len(light.sky_directions)
         halves = self.scene.config.sky.sampling is SkySampling.HALVES
@@ -357,13 +378,17 @@ class FluxRatioStage(CausticStage):
                     with frame.watch.stage("sky_cones"):
                         one, coarse = self.cones.spread(i, one, coarse)
                 total = one if total is None else total + one
+                if coarse is not None:
+                    total_coarse = coarse if total_coarse is None else total_coarse + coarse
                 if self.small_angle is not None:
                     with frame.watch.stage("small_angle"):
                         group = SKY_GROUPS[i % 2] if halves else "sky"
                         self.small_angle.add(one, direction, flux[1], group=group, coarse=coarse)
             if halves and n == count // 2 - 1:  # the last of the even-numbered directions
                 even = total.copy() if separate else floor.numpy().copy()
-        return (floor.numpy().copy() if total is None else total), transmitted, even
+        if not separate:
+            total_coarse = self._coarse(frame)
+        return (floor.numpy().copy() if total is None else total), transmitted, even, total_coarse
 
     def _coarse(self, frame: Frame) -> np.ndarray | None:
         """The whole patch's light on coarse texels since the last clearing pass (K, Mc, Mc), or None

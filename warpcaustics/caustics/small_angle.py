@@ -68,6 +68,9 @@ class SmallAngleScattering:
         self.slopes = [(np.roll(self.heights, -1, axis) - np.roll(self.heights, 1, axis)) / (2.0 * cell)
                        for axis in (1, 0)]  # ∂h/∂x, ∂h/∂y at the cell centres, central differences
         self.scattered = {}
+        self.scattered_coarse = {}
+        """{group: (K, Mc, Mc)} the passes' scattered light on the whole patch's coarse texels, beside
+        a window (unscaled until :meth:`finish`)."""
         self.single_mean = np.zeros_like(self.b)
         self.transferred_mean = np.zeros_like(self.b)
         self.paths = []
@@ -184,9 +187,10 @@ class SmallAngleScattering:
         return [(single, False), (single * longer, True)]
 
     def transfer(self, single: np.ndarray, coarse: np.ndarray | None, light: np.ndarray, down: np.ndarray,
-                 path: float) -> tuple[np.ndarray, np.ndarray]:
+                 path: float) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """(the pass's scattered light on the map (K, M, M), its transfer's k = 0 term over the patch
-        per unit of the pass's mean irradiance (K,)), summed over the :meth:`terms`. Without
+        per unit of the pass's mean irradiance (K,), and with ``coarse`` its scattered light on the
+        coarse texels (K, Mc, Mc), else None), summed over the :meth:`terms`. Without
         ``coarse`` the map is the whole periodic patch. With ``coarse`` (K, Mc, Mc), the whole
         patch's single-scattering light on coarse texels beside a window, the window's scattered light
         is the whole patch's at the large scales, read bilinearly from the coarse texels, plus the
@@ -200,18 +204,20 @@ class SmallAngleScattering:
                 out = out + transferred(term, multiplier)
                 at_zero = at_zero + np.divide(term.mean(axis=(1, 2)), on_map, out=np.zeros_like(on_map),
                                               where=on_map > 0) * zero
-            return out, at_zero
+            return out, at_zero, None
         mc = coarse.shape[-1]
+        out_c = 0.0
         whole = coarse.mean(axis=(1, 2))
         centres = self.window.on_coarse(mc)[3]
         for (term, derivative), (term_c, _) in zip(self.terms(single, light, down, path),
                                                    self.terms(coarse, light, down, path, *centres)):
             far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
             near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
-            out = out + self.window.convolve(term, term_c, far_m, near_m)[0]
+            on_window, on_coarse = self.window.convolve(term, term_c, far_m, near_m)
+            out, out_c = out + on_window, out_c + on_coarse
             at_zero = at_zero + np.divide(term_c.mean(axis=(1, 2)), whole, out=np.zeros_like(whole),
                                           where=whole > 0) * zero
-        return out, at_zero
+        return out, at_zero, out_c
 
     def add(self, single: np.ndarray, direction: np.ndarray, delivered_flux: np.ndarray,
             group: str = "sun", coarse: np.ndarray | None = None) -> None:
@@ -223,8 +229,10 @@ class SmallAngleScattering:
         transfer's k = 0 term, so weighted, is what the walk's mean scales."""
         down, path = self.beam(direction)
         light = np.asarray(direction, np.float64) / np.linalg.norm(direction)
-        part, weighting = self.transfer(single, coarse, light, down, path)
+        part, weighting, part_c = self.transfer(single, coarse, light, down, path)
         self.scattered[group] = part if group not in self.scattered else self.scattered[group] + part
+        if part_c is not None:
+            self.scattered_coarse[group] = self.scattered_coarse.get(group, 0.0) + part_c
         mean = np.asarray(delivered_flux, np.float64) / self.area
         self.single_mean += mean
         # the transfer's k = 0 term over the patch, weighted by the local paths, measured on the
@@ -236,12 +244,15 @@ class SmallAngleScattering:
         """({group: (K, M, M)} the passes' scattered light scaled to the walk's mean (the walk's floor
         flux over the patch, (K,) [W nm⁻¹], less the single-scattering map's), and what was done:
         the scale per band (the walk's scattered light over the small-angle approximation's, which
-        keeps every scattered photon going forward), the passes' paths."""
+        keeps every scattered photon going forward), the passes' paths. Beside a window the coarse
+        texels' scattered light is scaled the same (:attr:`scattered_coarse`)."""
         walk_mean = np.asarray(walk_floor_flux, np.float64) / self.area
         wanted = np.maximum(walk_mean - self.single_mean, 0.0)
         scale = np.divide(wanted, self.transferred_mean, out=np.zeros_like(wanted),
                           where=self.transferred_mean > 0)
         scattered = {group: part * scale[:, None, None] for group, part in self.scattered.items()}
+        self.scattered_coarse = {group: part * scale[:, None, None]
+                                 for group, part in self.scattered_coarse.items()}
         info = {"scale": scale.tolist(), "scattered_mean": wanted.tolist(),
                 "single_mean": self.single_mean.tolist(), "paths_m": [float(p) for p in self.paths]}
         return scattered, info
