@@ -292,6 +292,9 @@ def main(argv: list[str] | None = None) -> int:
     # The small-angle scattering mode against single scattering (benchmarks/small_angle.py).
     small_angle = _in_child("run", args.quick, args.device, module="small_angle")
 
+    # The field comparison's long waves against its scene's frame (benchmarks/long_waves.py).
+    long_waves = _in_child("run", args.quick, args.device, module="long_waves")
+
     # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
     spectra = _in_child("run", args.quick, args.device, module="spectra")
 
@@ -332,6 +335,7 @@ def main(argv: list[str] | None = None) -> int:
         "multiple": multiple,
         "small_angle": small_angle,
         "spectra": spectra,
+        "long_waves": long_waves,
         "sweep": sweeps,
         "memory": memory,
     }

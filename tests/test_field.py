@@ -28,6 +28,49 @@ def test_pooled_statistics_equal_those_of_all_texels():
     assert cv == pytest.approx(every.std() / every.mean(), rel=1e-12)
 
 
+def test_nested_scales_give_the_cv_of_the_whole_sea():
+    """A sea's map E = L·S, a smooth large-scale L (the long waves') times an independent fine
+    pattern S: the CV from S's and L's relative variances equals numpy's over all of E's texels (to
+    the sampling of L and S: 1 %), and exceeds either alone."""
+    rng = np.random.default_rng(11)
+    n = 512
+    x = np.arange(n) * 2 * np.pi / n
+    large = 1.0 + 0.2 * np.sin(3 * x)[:, None] * np.cos(2 * x + 0.4)[None, :]
+    fine = rng.gamma(50.0, 0.02, (n, n))  # CV 0.14, L's about 0.1
+    whole = (large * fine).std() / (large * fine).mean()
+    r_fine, r_large = (fine.std() / fine.mean()) ** 2, (large.std() / large.mean()) ** 2
+    cv = field.nested_cv(r_fine, r_large)
+    assert cv == pytest.approx(whole, rel=0.01)
+    assert cv > 1.2 * math.sqrt(max(r_fine, r_large))
+    assert field.nested_cv() == 0.0
+
+
+def test_a_window_and_its_patchs_windows_give_the_patchs_cv():
+    """Frames of a periodic patch whose light varies at scales above a window: the CV from one
+    window per frame and the means of all the patch's windows (the law of total variance) equals
+    numpy's over every texel of every frame (3 %), where the window's frames pooled alone miss most
+    of the large scales."""
+    rng = np.random.default_rng(4)
+    n, w = 128, 16
+    x = np.arange(n) * 2 * np.pi / n
+    window, windows, every = [], [], []
+    for _ in range(40):
+        phase = rng.uniform(0, 2 * np.pi, 2)
+        large = 1.0 + 0.3 * np.sin(x + phase[0])[:, None] * np.sin(2 * x + phase[1])[None, :]
+        frame = large * rng.gamma(30.0, 1.0 / 30.0, (n, n))
+        centre = frame[56:72, 56:72]
+        means = frame.reshape(n // w, w, n // w, w).mean(axis=(1, 3))
+        window.append((centre.mean(), centre.std() / centre.mean()))
+        windows.append((means.mean(), means.std() / means.mean()))
+        every.append(frame)
+    every = np.stack(every)
+    whole = every.std() / every.mean()
+    assert math.sqrt(field.patch_variance(window, windows)) == pytest.approx(whole, rel=0.03)
+    assert math.sqrt(field.patch_variance(window, None)) == pytest.approx(field.pooled_statistics(window)[1])
+    with pytest.raises(ValueError):
+        field.patch_variance([], windows)
+
+
 def test_points_carry_the_papers_values():
     """Measured CVs are the package's; the diffuse share is the paper's at its printed zeniths and
     linear between them; the wind series starts at √U = 1.2 and is at zenith 40°."""
@@ -87,6 +130,25 @@ def test_command_on_still_water_measures_no_fluctuation(tmp_path, capsys):
     assert "done 0, skipped 6" in capsys.readouterr().out
 
 
+def test_overcast_series_compares_the_skys_light_alone(tmp_path):
+    """--series overcast: the paper's Fig. 7a points under the CIE overcast sky, the map's sky part
+    alone (flat water: no fluctuation), no uniform-sky columns; the long waves off (0): the
+    scene's waves are the model."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "out"
+    field.run_gernez2009(_scene(tmp_path), out, series=("overcast",), zeniths=(20.0, 85.0), frames=1,
+                         quiet=True, long_waves_m=0.0, device="cpu")
+    rows = list(csv.DictReader((out / "gernez2009.csv").open()))
+    measured = jerlov.gernez2009_cv_by("sun_zenith_deg", sky="overcast")
+    assert [float(r["measured_cv"]) for r in rows] == pytest.approx([measured.cv[0], measured.cv[-1]])
+    assert all(float(r["model_cv"]) < 1e-5 and r["model_cv_uniform_sky"] == "" for r in rows)
+    assert all(r["model_cv_long_waves"] == "" and r["model_cv"] == r["model_cv_patch"] for r in rows)
+    assert all(float(r["diffuse_fraction"]) == 0.99 for r in rows)
+    run = next(out.glob("*/run.json")).read_text()
+    assert '"cie_type": 1' in run and '"model": "cie"' in run
+    assert not (out / "long_waves").exists()
+
+
 def test_a_condition_shared_by_both_series_is_rendered_once(tmp_path):
     """With the scene's wind at a wind class (4 m/s = 2²), the 40° zenith point and that wind's
     point are one condition: one variant, found by both points."""
@@ -118,6 +180,10 @@ def test_bad_input_is_one_line(tmp_path, capsys):
                              quick=True)
     with pytest.raises(ConfigError, match="sky.model"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sky.model": "none"}, quick=True)
+    with pytest.raises(ConfigError, match="--long-waves = 4 m must exceed water.extent_m = 4 m"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=4.0, quick=True)
+    with pytest.raises(ConfigError, match="--long-waves = -1"):
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=-1.0, quick=True)
     assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "o"),
                  "--zeniths", "20,x"]) == 2
     assert "--zeniths '20,x' must be comma-separated numbers" in capsys.readouterr().err

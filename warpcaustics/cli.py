@@ -125,6 +125,9 @@ def _parser() -> argparse.ArgumentParser:
                     help="darecki2011: only these measured depths [m], comma-separated (default all)")
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
+    fd.add_argument("--long-waves", type=float, metavar="M",
+                    help="gernez2009: side [m] of a coarse patch of the waves longer than the scene's, "
+                         "rendered at each point too (default 128); 0: the scene's waves alone")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
                     help="seconds between a point's frames (default: gernez2009 2, darecki2011 and "
@@ -184,6 +187,10 @@ def _field(args: argparse.Namespace) -> int:
                   quiet=args.quiet, force=args.force, overrides=_overrides(args))
     if args.frame_interval is not None:  # else each data set's own default
         common["frame_interval_s"] = args.frame_interval
+    if args.long_waves is not None:
+        if args.dataset != "gernez2009":
+            raise ConfigError(f"--long-waves is a flag of gernez2009, not of {args.dataset}")
+        common["long_waves_m"] = args.long_waves
     paths = DATASETS[args.dataset](args.scene, args.out, **points, **common)
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0

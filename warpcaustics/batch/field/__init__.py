@@ -11,7 +11,7 @@ data set registered by name (``warpcaustics field NAME SCENE --out DIR``):
 Each renders its points as one resumable sweep (:mod:`.common`) and writes a CSV and a figure.
 """
 
-from warpcaustics.batch.field.common import pooled_statistics
+from warpcaustics.batch.field.common import nested_cv, patch_variance, pooled_statistics
 from warpcaustics.batch.field.darecki2011 import run_darecki2011
 from warpcaustics.batch.field.darecki2011_wind import run_darecki2011_wind
 from warpcaustics.batch.field.gernez2009 import (
@@ -38,5 +38,5 @@ POINT_FLAGS = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011":
 __all__ = [
     "DATASETS", "POINT_FLAGS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction",
     "direct_transmission", "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011",
-    "run_darecki2011_wind", "run_gernez2009", "select_points",
+    "run_darecki2011_wind", "run_gernez2009", "select_points", "nested_cv", "patch_variance",
 ]

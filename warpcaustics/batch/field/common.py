@@ -72,10 +72,10 @@ def pooled_statistics(
     E[E²] = mean over frames of μᵢ²(1 + CVᵢ²), so CV² = E[E²]/μ² − 1 with μ the mean of the μᵢ.
     ``background``: a uniform irradiance Bᵢ added to every texel of frame i (its mean grows by
     Bᵢ, its variance does not)."""
+    if background is not None:
+        frames = with_background(frames, background)
     mu = np.array([m for m, _ in frames], np.float64)
     sd = mu * np.array([c for _, c in frames], np.float64)
-    if background is not None:
-        mu = mu + np.asarray(background, np.float64)
     mean = float(mu.mean())
     second = float(np.mean(mu**2 + sd**2))
     return mean, math.sqrt(max(second / mean**2 - 1.0, 0.0)) if mean > 0 else 0.0
@@ -89,3 +89,36 @@ def continuous_sky(stats: list[dict]) -> float | None:
         return None
     cv = continuous_sky_cv(moments)
     return None if cv is None else round(cv, 4)
+
+
+def with_background(frames: list[tuple[float, float]], background: list[float]) -> list[tuple[float, float]]:
+    """Each frame's (mean, CV) with a uniform irradiance Bᵢ added to every texel (its mean grows by
+    Bᵢ, its variance does not)."""
+    return [(m + b, c * m / (m + b) if m + b > 0 else 0.0) for (m, c), b in zip(frames, background)]
+
+
+def nested_cv(*relative_variances: float) -> float:
+    """The CV of a field built of nested, independent scales, each given by its relative variance
+    r = CV²: 1 + CV² = Π (1 + rᵢ). For a window of a patch, the law of total variance splits the
+    patch's variance into the mean within the windows, r_w Ē_w² (r_w each window's CV² about its own
+    mean), and that between their means, r_b Ē²: where the large scales scale the small ones
+    without changing their contrast, 1 + CV² = (1 + r_w)(1 + r_b). Longer waves that the patch cannot
+    hold and that tilt and lift it as a whole add a factor of their own."""
+    product = 1.0
+    for r in relative_variances:
+        product *= 1.0 + r
+    return math.sqrt(max(product - 1.0, 0.0))
+
+
+def patch_variance(window: list[tuple[float, float]], windows: list[tuple[float, float]] | None) -> float:
+    """The relative variance of a periodic patch's irradiance from the frames (mean, CV) of a window
+    of it and, per frame, the (mean, CV) of the means of all its windows (``patch_windows`` of the
+    statistics; None: the map is the whole patch, or no such statistics, and the frames pool as they
+    are): within, the mean of the frames' CV²; between, the windows' pooled CV² (:func:`nested_cv`)."""
+    if not window:
+        raise ValueError("patch_variance needs the window's frames")
+    if windows is None:
+        return pooled_statistics(window)[1] ** 2
+    within = float(np.mean([c * c for _, c in window]))
+    between = pooled_statistics(windows)[1] ** 2
+    return nested_cv(within, between) ** 2

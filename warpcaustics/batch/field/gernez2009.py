@@ -13,15 +13,23 @@ at each measured zenith, with the paper's diffuse share, and at each wind, as on
 (issue 7's runner: ``--workers`` processes), then pools every point's frames and writes
 ``gernez2009.csv`` and ``gernez2009.png``.
 
-The model's CV is spatial: the CV over the floor-map window after the collector, pooled over the
-frames. The measurement's is temporal, at one point over minutes. The two agree for a statistically
-homogeneous, stationary sea (ergodicity), which a linear random FFT sea is.
+The model's CV is spatial, over the whole sea: within the floor-map window after the collector
+(each frame's CV about the window's own mean), between the windows of the scene's periodic patch
+(the means of the patch's windows on the coarse map of it the window's light is computed beside,
+``patch_windows``), and, with ``--long-waves``, the waves longer than the patch, from a coarse
+patch of them alone (``water.shortest_wave_m``) rendered at every point too; the three scales nest
+(:func:`~warpcaustics.batch.field.common.nested_cv`). The measurement's is temporal, at one point
+over minutes. The two agree for a statistically homogeneous, stationary sea (ergodicity), which a
+linear random FFT sea is. Before 2026-12-06 the model's CV was the window's frames pooled: three
+frames 2 s apart sample the patch's windows poorly (its 8 m waves' period is 2.3 s), which at a low
+sun, where most of the variance lies at scales above the window, left it several times too low.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import Enum
 from pathlib import Path
 
 import numpy as np
@@ -31,14 +39,30 @@ from warpcaustics.batch.field.common import (
     check_overrides,
     continuous_sky,
     frame_statistics_of,
+    nested_cv,
+    patch_variance,
     pooled_statistics,
     render_points,
+    with_background,
 )
 from warpcaustics.config import Scattering, SkyModel
 from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
-SERIES = ("zenith", "wind")
+SERIES = ("zenith", "wind", "overcast")
+"""zenith: Fig. 8a, CV against the sun's zenith under clear skies; wind: Fig. 8c, against √wind;
+overcast: Fig. 7a, against the sun's zenith under overcast skies (the sky's light alone)."""
+
+DEFAULT_SERIES = ("zenith", "wind")
+"""The series run unless ``--series`` names others: the clear skies of the paper's Fig. 8."""
+
+OVERCAST_SKY = {"sky.model": "cie", "sky.cie_type": 1}
+"""The overcast series' sky: the CIE standard overcast sky (type 1, ../shared/data/sky). The paper's
+overcast minutes had less than 0.6 of the clear-sky model's irradiance above water."""
+
+OVERCAST_DIFFUSE_FRACTION = 0.99
+"""The largest share ``sky.diffuse_fraction`` takes: the sun keeps 1 %, and the overcast series
+compares the sky's part of the map alone (run.json's ``sky_irradiance_w_m2``)."""
 
 WIND_SERIES_ZENITH_DEG = 40.0
 """Sun zenith of the wind series. The paper's Fig. 8c pools all zeniths; 40° is our choice, near the
@@ -58,7 +82,19 @@ QUICK_OVERRIDES = {
 tests). Its CVs are not a comparison: the surface cells (12.5 cm) are far too coarse to focus."""
 
 
-POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s")
+LONG_WAVES_EXTENT_M = 128.0
+"""The side [m] of the patch of the waves longer than the scene's (``--long-waves``): the scene's 8 m
+patch holds about half of a 5 m/s sea's elevation variance (its peak is 10 m long), and 128 m hold
+all of the wind series' (at 13 m/s over 20 km of fetch the peak is 25 m long; waves over 64 m
+carry none of the variance). At a low sun their tilts decide the light (docs/validation.md)."""
+
+LONG_WAVES_OVERRIDES = {"water.resolution": 256, "caustics.map_resolution": 256}
+"""The long waves' grid: 50 cm cells, 16 or more a wave, and the floor map of the whole patch on
+texels as large (measured against finer grids: docs/validation.md); ``--quick`` uses 64 cells
+and texels."""
+
+POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s", "sky.model",
+              "sky.cie_type")
 """The keys each point sets (Point.overrides): a --set of one of them would be overwritten."""
 
 
@@ -78,6 +114,8 @@ class Point:
         out = {"sun.elevation_deg": 90.0 - self.sun_zenith_deg, "sky.diffuse_fraction": self.diffuse_fraction}
         if self.wind_m_s is not None:
             out["water.wind_speed_m_s"] = self.wind_m_s
+        if self.series == "overcast":
+            out.update(OVERCAST_SKY)
         return out
 
 
@@ -90,8 +128,9 @@ def diffuse_fraction(sun_zenith_deg: float) -> float:
     return float(np.interp(sun_zenith_deg, share.sun_zenith_deg, share.diffuse_fraction))
 
 
-def gernez2009_points(series: tuple[str, ...] = SERIES) -> list[Point]:
-    """The measured points: CV against the sun's zenith (Fig. 8a) and against √wind (Fig. 8c)."""
+def gernez2009_points(series: tuple[str, ...] = DEFAULT_SERIES) -> list[Point]:
+    """The measured points: CV against the sun's zenith (Fig. 8a) and against √wind (Fig. 8c) under
+    clear skies, and against the sun's zenith under overcast skies (Fig. 7a)."""
     import jerlov
 
     points = []
@@ -105,25 +144,30 @@ def gernez2009_points(series: tuple[str, ...] = SERIES) -> list[Point]:
         for x, cv, sd in zip(by_wind.x, by_wind.cv, by_wind.cv_sd):
             if x >= MIN_SQRT_WIND:
                 points.append(Point("wind", WIND_SERIES_ZENITH_DEG, float(x) ** 2, f, float(cv), float(sd)))
+    if "overcast" in series:
+        by_zenith = jerlov.gernez2009_cv_by("sun_zenith_deg", sky="overcast")
+        for z, cv, sd in zip(by_zenith.x, by_zenith.cv, by_zenith.cv_sd):
+            points.append(Point("overcast", float(z), None, OVERCAST_DIFFUSE_FRACTION, float(cv), float(sd)))
     return points
 
 
 def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
                   sqrt_winds: tuple[float, ...] | None) -> list[Point]:
-    """The points of the zenith series at ``zeniths`` [deg] and of the wind series at ``sqrt_winds``
-    [√(m/s)] (None: all of that series); a value the record does not hold is an error naming them."""
+    """The points of the zenith and overcast series at ``zeniths`` [deg] and of the wind series at
+    ``sqrt_winds`` [√(m/s)] (None: all of that series); a value the record does not hold is an error
+    naming them."""
     chosen = []
-    for series, wanted, key in (("zenith", zeniths, lambda p: p.sun_zenith_deg),
-                                ("wind", sqrt_winds, lambda p: math.sqrt(p.wind_m_s))):
-        have = [p for p in points if p.series == series]
+    flags = ((("zenith", "overcast"), zeniths, lambda p: p.sun_zenith_deg, "--zeniths"),
+             (("wind",), sqrt_winds, lambda p: math.sqrt(p.wind_m_s), "--sqrt-winds"))
+    for series, wanted, key, flag in flags:
+        have = [p for p in points if p.series in series]
         if wanted is None:
             chosen += have
             continue
         for value in wanted:
             match = [p for p in have if abs(key(p) - value) < 1e-6]
             if not match:
-                flag = "--zeniths" if series == "zenith" else "--sqrt-winds"
-                held = ", ".join(f"{key(p):g}" for p in have) or "none (not in --series)"
+                held = ", ".join(sorted({f"{key(p):g}" for p in have}, key=float)) or "none (not in --series)"
                 raise ConfigError(f"{flag}: {value:g} is not a measured point; the record holds {held}")
             chosen += match
     return chosen
@@ -142,7 +186,7 @@ def run_gernez2009(
     scene: str | Path,
     out: str | Path,
     *,
-    series: tuple[str, ...] = SERIES,
+    series: tuple[str, ...] = DEFAULT_SERIES,
     frames: int = 3,
     frame_interval_s: float = 2.0,
     workers: int = 1,
@@ -153,11 +197,15 @@ def run_gernez2009(
     overrides: dict | None = None,
     zeniths: tuple[float, ...] | None = None,
     sqrt_winds: tuple[float, ...] | None = None,
+    long_waves_m: float = LONG_WAVES_EXTENT_M,
 ) -> dict[str, Path]:
     """Render every point of the comparison (a resumable sweep into ``out``), pool each point's
     frames and write ``gernez2009.csv`` and ``gernez2009.png``. ``overrides``: config keys set on
     every point (``--set``: a row of the error budget); ``zeniths`` / ``sqrt_winds``: only these of
-    the record's points (None: all)."""
+    the record's points (None: all). ``long_waves_m``: the side of a coarse patch of the waves longer
+    than the scene's, rendered at every point too (a second sweep, into ``out/long_waves``) and
+    combined with the scene's (:func:`~warpcaustics.batch.field.common.nested_cv`); 0: the scene's waves
+    alone."""
     from warpcaustics.scene import load_scene
 
     unknown = set(series) - set(SERIES)
@@ -174,17 +222,53 @@ def run_gernez2009(
     if not points:
         raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
     if quick:  # the first and last zenith, the first wind
-        ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1]}
+        first = lambda ps: ps[:1]  # noqa: E731
+        ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": first, "overcast": first}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
+    long_fixed = _long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
     overrides, variants = point_variants(points, base.config)
+    out = Path(out)
     sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
                           quiet=quiet, force=force)
-    rows = _rows(points, overrides, sweep, Path(out), base.config)
-    out = Path(out)
+    long = None
+    if long_fixed is not None:
+        long_out = out / LONG_WAVES_FOLDER
+        long = (render_points(scene_path, long_fixed, variants, times, long_out, workers=workers,
+                              device=device, quiet=quiet, force=force), long_out)
+    rows = _rows(points, overrides, (sweep, out), long, base.config)
     paths = {"csv": out / "gernez2009.csv", "png": out / "gernez2009.png"}
     write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
     return paths
+
+
+LONG_WAVES_FOLDER = "long_waves"
+"""The long waves' sweep, inside the comparison's folder."""
+
+
+def _long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scene_path: Path) -> dict | None:
+    """The overrides of the long waves' patch at every point: ``extent_m`` wide, without the waves of
+    the scene's patch's side or shorter (which the scene holds), its floor map the whole patch;
+    None for ``extent_m`` = 0. A patch no larger than the scene's own is an error naming
+    --long-waves."""
+    from warpcaustics.scene import load_scene
+
+    if not (math.isfinite(extent_m) and extent_m >= 0.0):
+        raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
+                          "scene's waves alone")
+    if extent_m == 0.0:
+        return None
+    if extent_m <= config.water.extent_m:
+        raise ConfigError(f"--long-waves = {extent_m:g} m must exceed water.extent_m = "
+                          f"{config.water.extent_m:g} m (the scene's own patch), or be 0 for its waves alone")
+    grid = {"water.resolution": 64, "caustics.map_resolution": 64} if quick else LONG_WAVES_OVERRIDES
+    long = {**fixed, **grid, "water.extent_m": extent_m, "water.shortest_wave_m": config.water.extent_m,
+            "caustics.map_extent_m": 0.0}
+    try:
+        load_scene(scene_path, long)
+    except ConfigError as exc:
+        raise ConfigError(f"--long-waves = {extent_m:g} m: {exc}") from None
+    return long
 
 
 def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]:
@@ -222,10 +306,39 @@ def _check_scene(config) -> None:
 
 def _scene_value(config, key: str):
     section, name = key.split(".")
-    return getattr(getattr(config, section), name)
+    value = getattr(getattr(config, section), name)
+    return value.value if isinstance(value, Enum) else value
 
 
-def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) -> list[dict]:
+def _columns(stats: list[dict], t: float, *, overcast: bool = False, key=lambda s: s) -> dict:
+    """Each frame's (mean, CV) of the map as rendered, with the sky as a uniform background (its
+    directions' own caustics removed), and with the sun's scattered light, lost by single
+    scattering (direct transmission ``t``), back as a uniform background too; ``key`` picks the
+    texels' statistics or the patch's windows' (``patch_windows``: None where a frame has none).
+    Under an overcast sky the map is the sky's part alone, and the two columns that remove the
+    sky's own pattern have nothing left to say."""
+    if any(key(s[name]) is None for s in stats for name in STAT_FIELDS):
+        return None
+
+    def frames(name: str) -> list[tuple[float, float]]:
+        return [(key(s[name])["mean"], key(s[name])["cv"]) for s in stats]
+
+    if overcast:
+        return {"model_cv": frames("sky_irradiance_w_m2")}
+    total, direct = frames("irradiance_w_m2"), frames("direct_irradiance_w_m2")
+    sky = [m for m, _ in frames("sky_irradiance_w_m2")]
+    scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky)]
+    return {"model_cv": total, "model_cv_uniform_sky": with_background(direct, sky),
+            "model_cv_uniform_sky_scattered": with_background(direct, scattered)}
+
+
+STAT_FIELDS = ("irradiance_w_m2", "direct_irradiance_w_m2", "sky_irradiance_w_m2")
+"""The run.json statistics the columns read."""
+
+
+def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> list[dict]:
+    """One row per point: the measured CV beside the model's, from the scene's frames (``fine``:
+    (sweep, folder)) and, with ``long`` ((sweep, folder) or None), the long waves' patch's."""
     from warpcaustics.optics.spectra import bins_for, water_optics
 
     bins = bins_for(config.optics)
@@ -233,23 +346,25 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
     b = float(water_optics(config.optics, bins).scattering_per_m[band])
     rows = []
     for point, o in zip(points, overrides):
-        whole, direct, sky = [], [], []
-        for s in frame_statistics_of(sweep, out, o):
-            whole.append(s["irradiance_w_m2"])
-            direct.append((s["direct_irradiance_w_m2"]["mean"], s["direct_irradiance_w_m2"]["cv"]))
-            sky.append(s["sky_irradiance_w_m2"]["mean"])
-        total = [(w["mean"], w["cv"]) for w in whole]
-        mean, cv = pooled_statistics(total)
-        per_frame = [c for _, c in total]
-        # the sky as a uniform background: its K directions' own caustics removed
-        _, cv_uniform_sky = pooled_statistics(direct, sky)
-        # and the sun's scattered light, lost by single scattering, back as a uniform background (a
-        # map that holds the scattered light already, optics.scattering = "small_angle", adds none)
+        stats = frame_statistics_of(*fine, o)
+        # a map that holds the scattered light already (optics.scattering = "small_angle") adds none
         t = 1.0
         if config.optics.scattering is Scattering.SINGLE:
             t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
-        scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky)]
-        _, cv_scattered = pooled_statistics(direct, scattered)
+        overcast = point.series == "overcast"
+        window = _columns(stats, t, overcast=overcast)
+        windows = _columns(stats, t, overcast=overcast, key=lambda s: s.get("patch_windows"))
+        mean, cv_window = pooled_statistics(window["model_cv"])
+        per_frame = [c for _, c in window["model_cv"]]
+        # the scene's patch: within the window, and between the windows of the whole patch
+        patch = {name: patch_variance(frames, None if windows is None else windows[name])
+                 for name, frames in window.items()}
+        cvs = {name: math.sqrt(r) for name, r in patch.items()}
+        cv_long = None
+        if long is not None:  # and the waves longer than the patch
+            waves = _columns(frame_statistics_of(*long, o), t, overcast=overcast)
+            cvs = {name: nested_cv(patch[name], pooled_statistics(waves[name])[1] ** 2) for name in patch}
+            cv_long = round(pooled_statistics(waves["model_cv"])[1], 4)
         wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s
         rows.append(
             {
@@ -260,21 +375,31 @@ def _rows(points: list[Point], overrides: list[dict], sweep, out: Path, config) 
                 "diffuse_fraction": round(point.diffuse_fraction, 4),
                 "measured_cv": round(point.measured_cv, 4),
                 "measured_cv_sd": round(point.measured_cv_sd, 4),
-                "model_cv": round(cv, 4),
+                **{name: round(cvs[name], 4) if name in cvs else None for name in CV_COLUMNS},
+                "model_cv_window": round(cv_window, 4),
+                "model_cv_patch": round(math.sqrt(patch["model_cv"]), 4),
+                "model_cv_long_waves": cv_long,
                 "model_cv_frame_sd": round(float(np.std(per_frame)), 4),
-                "model_cv_uniform_sky": round(cv_uniform_sky, 4),
-                "model_cv_uniform_sky_scattered": round(cv_scattered, 4),
-                "model_cv_continuous_sky": continuous_sky(whole),
+                "model_cv_continuous_sky": continuous_sky([s["irradiance_w_m2"] for s in stats]),
                 "direct_transmission": round(t, 4),
-                "frames": len(total),
+                "frames": len(stats),
                 "model_mean_w_m2": mean,
             }
         )
     return rows
 
 
+CV_COLUMNS = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered")
+"""The model's CVs from the scene's patch and, with ``--long-waves``, the longer waves' (:func:`_columns`)."""
+
 PLOT_NEEDS = "the comparison's plot needs"
 """How the missing-matplotlib error begins (io.files.pyplot)."""
+
+
+TITLES = {"zenith": "clear sky: CV at 510 nm, 3.2 m, 8 mm collector",
+          "wind": f"clear sky: CV against the wind, sun zenith {WIND_SERIES_ZENITH_DEG:g}°",
+          "overcast": "overcast sky (CIE type 1): the sky's light alone"}
+"""Each series' panel."""
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:
@@ -283,47 +408,25 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
     fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 4.2), squeeze=False)
     for ax, s in zip(axes[0], series):
         rs = [r for r in rows if r["series"] == s]
-        x = [r["sun_zenith_deg"] if s == "zenith" else r["sqrt_wind"] for r in rs]
-        ax.errorbar(
-            x,
-            [r["measured_cv"] for r in rs],
-            yerr=[r["measured_cv_sd"] for r in rs],
-            fmt="ko",
-            capsize=3,
-            label="Gernez & Antoine 2009 (median ± sd)",
-        )
-        ax.errorbar(
-            x,
-            [r["model_cv"] for r in rs],
-            yerr=[r["model_cv_frame_sd"] for r in rs],
-            fmt="s-",
-            color="tab:blue",
-            capsize=3,
-            label="model as rendered (sky over its directions)",
-        )
-        ax.plot(
-            x,
-            [r["model_cv_uniform_sky"] for r in rs],
-            "v--",
-            color="tab:green",
-            label="model, sky as a uniform background",
-        )
-        ax.plot(
-            x,
-            [r["model_cv_uniform_sky_scattered"] for r in rs],
-            "^:",
-            color="tab:orange",
-            label="… and the sun's scattered light too",
-        )
-        if all(r["model_cv_continuous_sky"] is not None for r in rs):
-            ax.plot(x, [r["model_cv_continuous_sky"] for r in rs], "D-", color="tab:purple",
-                    label="model, the sky's continuum (sky.sampling = halves)")
-        if s == "zenith":
-            ax.set_xlabel("sun zenith angle [deg]")
-            ax.set_title("CV at 510 nm, 3.2 m, 8 mm collector")
-        else:
-            ax.set_xlabel("√(wind speed) [√(m/s)]")
-            ax.set_title(f"CV against the wind, sun zenith {WIND_SERIES_ZENITH_DEG:g}°")
+        x = [r["sqrt_wind"] if s == "wind" else r["sun_zenith_deg"] for r in rs]
+        ax.errorbar(x, [r["measured_cv"] for r in rs], yerr=[r["measured_cv_sd"] for r in rs], fmt="ko",
+                    capsize=3, label="Gernez & Antoine 2009 (median ± sd)")
+        ax.errorbar(x, [r["model_cv"] for r in rs], yerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
+                    color="tab:blue", capsize=3,
+                    label="model as rendered (the scene's waves and the longer ones)")
+        for column, style, colour, label in (
+            ("model_cv_window", "s:", "tab:gray", "model, the window alone (its frames pooled)"),
+            ("model_cv_uniform_sky", "v--", "tab:green", "model, sky as a uniform background"),
+            ("model_cv_uniform_sky_scattered", "^:", "tab:orange", "… and the sun's scattered light too"),
+            ("model_cv_continuous_sky", "D-", "tab:purple",
+             "model, the sky's continuum (sky.sampling = halves)"),
+        ):
+            if column == "model_cv_window" and all(r[column] == r["model_cv"] for r in rs):
+                continue  # the window is the model
+            if all(r[column] is not None for r in rs):
+                ax.plot(x, [r[column] for r in rs], style, color=colour, mfc="none", label=label)
+        ax.set_xlabel("√(wind speed) [√(m/s)]" if s == "wind" else "sun zenith angle [deg]")
+        ax.set_title(TITLES[s])
         ax.set_ylabel("CV of downwelling irradiance")
         ax.set_ylim(bottom=0.0)
         ax.grid(alpha=0.3)

@@ -1,0 +1,70 @@
+"""The cost of the waves longer than the field scene's patch: ``python -m benchmarks.long_waves``.
+
+``warpcaustics field gernez2009`` renders, beside each frame of the scene (``configs/field/
+gernez2009.toml``: 2048² cells over 8 m, a 1 m window of 512² texels, 16 sun-disk and 16 sky
+directions in cones, small-angle scattering), a frame of a 128 m patch of the waves longer than 8 m
+alone (``--long-waves``: 256² cells, the whole patch on 256² texels, ``water.shortest_wave_m`` = 8).
+This times a warm frame of each at an 85° sun (the paper's diffuse share), one core, and prints the
+long waves' frame over the scene's: what the comparison pays for them. The statistics' windows of
+the whole patch (``patch_windows``, from the coarse map the window's light is computed beside) are
+timed too, against the statistics without them. ``--quick``: the scene on 256² cells (keeps the
+script running).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from benchmarks.run import ROOT, device_record, median_time
+
+SCENE = ROOT / "configs/field/gernez2009.toml"
+POINT = {"sun.elevation_deg": 5.0, "sky.diffuse_fraction": 0.85}
+"""An 85° sun at the paper's diffuse share (``jerlov.gernez2009_diffuse_share``)."""
+
+QUICK = {"water.resolution": 256, "caustics.map_resolution": 256}
+
+
+def run(quick: bool, device: str) -> dict:
+    import warpcaustics as wc
+    from warpcaustics.batch.field.gernez2009 import LONG_WAVES_EXTENT_M, LONG_WAVES_OVERRIDES
+    from warpcaustics.batch.stats import frame_statistics
+
+    repeats = 2 if quick else 3
+    scene_overrides = {**POINT, **(QUICK if quick else {})}
+    long_overrides = {**POINT, **LONG_WAVES_OVERRIDES, "water.extent_m": LONG_WAVES_EXTENT_M,
+                      "water.shortest_wave_m": 8.0, "caustics.map_extent_m": 0.0}
+    times = {}
+    results = {}
+    for name, overrides in (("scene", scene_overrides), ("long_waves", long_overrides)):
+        scene = wc.load_scene(SCENE, overrides)
+        renderer = wc.Renderer(scene, device=device)
+        renderer.render(0.0)  # warm-up: the kernels, the spreads and the cells' multipliers
+        times[name] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
+        results[name] = (renderer.render(1.0), scene.config.stats)
+    result, stats_cfg = results["scene"]
+    with_windows = median_time(lambda: frame_statistics(result, stats_cfg), repeats)
+    coarse = result.coarse_floor_irradiance
+    result.coarse_floor_irradiance = None  # the statistics without the patch's windows
+    try:
+        without = median_time(lambda: frame_statistics(result, stats_cfg), repeats)
+    finally:
+        result.coarse_floor_irradiance = coarse
+    ratio = times["long_waves"] / times["scene"]
+    print(f"scene frame {times['scene']:.2f} s, long waves' frame {times['long_waves']:.2f} s: "
+          f"x{ratio:.3f} of the scene's")
+    print(f"statistics {with_windows * 1e3:.1f} ms with the patch's windows, {without * 1e3:.1f} ms without: "
+          f"x{with_windows / without:.2f}")
+    return {"benchmark": "long_waves", **device_record(device), "quick": quick, "repeats": repeats,
+            "scene_overrides": scene_overrides, "long_waves_overrides": long_overrides,
+            "seconds": times, "long_over_scene": ratio,
+            "statistics_seconds": {"with_patch_windows": with_windows, "without": without}}
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.run import module_main
+
+    return module_main(argv, "long_waves", run, __doc__)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
