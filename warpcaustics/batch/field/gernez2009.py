@@ -221,9 +221,9 @@ def run_gernez2009(
     points = select_points(gernez2009_points(series), zeniths, sqrt_winds)
     if not points:
         raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
-    if quick:  # the first and last zenith, the first wind
-        first = lambda ps: ps[:1]  # noqa: E731
-        ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": first, "overcast": first}
+    if quick:  # the first and last zenith, the first wind, the first overcast zenith
+        ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1],
+                "overcast": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
     long_fixed = _long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
     overrides, variants = point_variants(points, base.config)
@@ -413,7 +413,7 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
                     capsize=3, label="Gernez & Antoine 2009 (median ± sd)")
         ax.errorbar(x, [r["model_cv"] for r in rs], yerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
                     color="tab:blue", capsize=3,
-                    label="model as rendered (the scene's waves and the longer ones)")
+                    label="model as rendered (over the whole sea)")
         for column, style, colour, label in (
             ("model_cv_window", "s:", "tab:gray", "model, the window alone (its frames pooled)"),
             ("model_cv_uniform_sky", "v--", "tab:green", "model, sky as a uniform background"),
