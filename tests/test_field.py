@@ -352,6 +352,19 @@ def test_the_command_offers_every_registered_data_set_with_its_point_flags():
             assert getattr(args, flag) == "1"
 
 
+def test_long_waves_is_gernez2009s_flag(tmp_path, capsys):
+    """--long-waves reaches run_gernez2009's long_waves_m; on another data set it is a one-line error."""
+    from warpcaustics.cli import main
+
+    assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"),
+                 "--long-waves", "64"]) == 2
+    assert "--long-waves is a flag of gernez2009, not of darecki2011" in capsys.readouterr().err
+    assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "g"),
+                 "--long-waves", "2"]) == 2
+    assert "--long-waves = 2 m must exceed water.extent_m = 4 m" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists() and not (tmp_path / "g").exists()
+
+
 def test_frames_are_the_interval_apart(monkeypatch, capsys, tmp_path):
     """--frame-interval sets the seconds between a point's frames (each data set's default without
     it); zero, negative or not finite is a one-line error before anything renders."""

@@ -138,9 +138,9 @@ def patch_windows(result) -> dict[str, np.ndarray] | None:
     coarse = result.coarse_floor_irradiance
     if coarse is None:
         return None
-    count = round(result.scene.config.water.extent_m / result.map_extent_m)
-    if count < 2 or abs(count * result.map_extent_m - result.scene.config.water.extent_m) > 1e-6 * count \
-            or coarse.shape[-1] % count:
+    extent = result.scene.config.water.extent_m
+    count = round(extent / result.map_extent_m)
+    if count < 2 or abs(count * result.map_extent_m - extent) > 1e-6 * extent or coarse.shape[-1] % count:
         return None
     widths = result.bin_widths_nm
     out = {"irradiance_w_m2": band_integrated(coarse, widths)}
