@@ -131,23 +131,24 @@ def window_means(coarse: np.ndarray, count: int) -> dict:
     return {"count": count * count, "mean": mean, "cv": float(means.std() / mean) if mean > 0.0 else 0.0}
 
 
-def patch_windows(result) -> dict[str, np.ndarray] | None:
-    """{field: its coarse map of the whole patch} for the band-integrated irradiance, and its sky and
-    direct parts, where the map is a window of a periodic sea that the window's side tiles on the
-    coarse texels (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else None."""
+def patch_windows(result) -> dict[str, dict]:
+    """{field: :func:`window_means` of its coarse map of the whole patch} for the band-integrated
+    irradiance, and its sky and direct parts, where the map is a window of a periodic sea that the
+    window's side tiles on the coarse texels
+    (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else {}."""
     coarse = result.coarse_floor_irradiance
     if coarse is None:
-        return None
+        return {}
     extent = result.scene.config.water.extent_m
     count = round(extent / result.map_extent_m)
     if count < 2 or abs(count * result.map_extent_m - extent) > 1e-6 * extent or coarse.shape[-1] % count:
-        return None
+        return {}
     widths = result.bin_widths_nm
-    out = {"irradiance_w_m2": band_integrated(coarse, widths)}
+    maps = {"irradiance_w_m2": band_integrated(coarse, widths)}
     if result.coarse_sky_floor_irradiance is not None:
-        out["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
-        out["direct_irradiance_w_m2"] = out["irradiance_w_m2"] - out["sky_irradiance_w_m2"]
-    return {name: (f, count) for name, f in out.items()}
+        maps["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
+        maps["direct_irradiance_w_m2"] = maps["irradiance_w_m2"] - maps["sky_irradiance_w_m2"]
+    return {name: window_means(f, count) for name, f in maps.items()}
 
 
 def frame_statistics(result, cfg: StatsConfig) -> dict:
@@ -195,12 +196,12 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "pdf_edges": PDF_EDGES.tolist(),
         "par_band_nm": covered,
     }
-    patch = patch_windows(result) or {}
+    patch = patch_windows(result)
     for name, f in fields.items():
         averaged = collector(f)
         stats = field_statistics(averaged, cfg.flash_threshold)
         if name in patch:
-            stats["patch_windows"] = window_means(*patch[name])
+            stats["patch_windows"] = patch[name]
         if name in halves:
             sky_part, even_part = (collector(h) for h in halves[name])
             stats["continuous_sky"] = continuous_sky_moments(

@@ -363,8 +363,9 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
         cv_long = None
         if long is not None:  # and the waves longer than the patch
             waves = _columns(frame_statistics_of(*long, o), t, overcast=overcast)
-            cvs = {name: nested_cv(patch[name], pooled_statistics(waves[name])[1] ** 2) for name in patch}
-            cv_long = round(pooled_statistics(waves["model_cv"])[1], 4)
+            longer = {name: pooled_statistics(frames)[1] for name, frames in waves.items()}
+            cvs = {name: nested_cv(patch[name], longer[name] ** 2) for name in patch}
+            cv_long = round(longer["model_cv"], 4)
         wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s
         rows.append(
             {
