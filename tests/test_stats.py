@@ -267,3 +267,46 @@ def test_an_animation_reports_its_probes_integrated(tmp_path):
     expected = stats.integrate_series(series, 0.1, 0.15)
     assert integrated["mean"] == pytest.approx(expected.mean(axis=0).tolist(), rel=1e-9)
     assert integrated["cv"][0] < run["time_statistics"]["cv"][0]
+
+
+def test_window_means_share_the_texels_a_window_edge_crosses():
+    """``window_means`` of a coarse map whose texels the windows do not divide (20 windows on 32
+    texels: 1.6 a window) equals the means of the same map upsampled 5× (each texel a constant
+    block, so 8 fine texels a window) taken window by window (1e-12); with whole texels a window it
+    is the plain block mean."""
+    rng = np.random.default_rng(3)
+    coarse = rng.uniform(0.5, 2.0, (32, 32))
+    fine = np.kron(coarse, np.ones((5, 5)))
+    exact = fine.reshape(20, 8, 20, 8).mean(axis=(1, 3))
+    got = stats.window_means(coarse, 20)
+    assert got["count"] == 400
+    assert got["mean"] == pytest.approx(coarse.mean(), rel=1e-12)
+    assert got["cv"] == pytest.approx(exact.std() / exact.mean(), rel=1e-12)
+    blocks = coarse.reshape(8, 4, 8, 4).mean(axis=(1, 3))
+    assert stats.window_means(coarse, 8)["cv"] == pytest.approx(blocks.std() / blocks.mean(), rel=1e-12)
+
+
+def test_every_band_has_its_patch_windows():
+    """A 0.4 m window of an 8 m periodic sea under the small-angle transfer (configs/field/darecki2011.toml,
+    three bands, stats.per_band): each band's ``patch_windows`` are its own coarse map's 20 × 20
+    window means (``RenderResult.coarse_floor_irradiance[k]``, 1.6 coarse texels a window, compared on
+    the map upsampled to whole texels a window, 1e-9), and the bands' means weighted by their widths
+    add up to the band-integrated irradiance's (1e-9)."""
+    from warpcaustics.batch.stats import frame_statistics
+
+    scene = wc.load_scene(CONFIGS / "field" / "darecki2011.toml", {
+        "water.resolution": 64, "water.extent_m": 8.0, "caustics.map_resolution": 40,
+        "sun.disk_samples": 2, "sky.directions": 2, "optics.beam_spread": "wells"})
+    r = wc.render(scene, device="cpu")
+    s = frame_statistics(r, scene.config.stats)
+    coarse = np.asarray(r.coarse_floor_irradiance, np.float64)
+    assert coarse.shape[-1] == 32
+    total = 0.0
+    for k, (key, band) in enumerate(s["bands"].items()):
+        fine = np.kron(coarse[k], np.ones((5, 5))).reshape(20, 8, 20, 8).mean(axis=(1, 3))
+        windows = band["patch_windows"]
+        assert windows["count"] == 400, key
+        assert windows["mean"] == pytest.approx(fine.mean(), rel=1e-9), key
+        assert windows["cv"] == pytest.approx(fine.std() / fine.mean(), rel=1e-9), key
+        total += windows["mean"] * r.bin_widths_nm[k]
+    assert total == pytest.approx(s["irradiance_w_m2"]["patch_windows"]["mean"], rel=1e-9)

@@ -119,35 +119,52 @@ def field_statistics(field: np.ndarray, flash_threshold: float) -> dict:
     }
 
 
+def tile_weights(texels: int, count: int) -> np.ndarray:
+    """(count, texels) weights that average a row of ``texels`` equal texels over ``count`` equal
+    intervals tiling the same length: each weight is the texel's overlap with the interval over the
+    interval's length, so a texel that straddles two intervals is shared by its overlap (exact for a
+    map constant over each texel)."""
+    width = texels / count  # an interval in texels, not necessarily whole
+    lo = np.arange(count)[:, None] * width
+    left = np.arange(texels)[None, :]
+    overlap = np.clip(np.minimum(lo + width, left + 1.0) - np.maximum(lo, left), 0.0, None)
+    return overlap / width
+
+
 def window_means(coarse: np.ndarray, count: int) -> dict:
     """Mean and CV of the means of a whole periodic patch's coarse map over its ``count`` × ``count``
-    squares the size of the floor-map window: by the law of total variance, the patch's variance
-    is the windows' mean variance within them plus this variance between them (``patch_windows``
-    of :func:`frame_statistics`)."""
+    squares the size of the floor-map window (a square's edge may cross a texel: it takes the
+    texel's share, :func:`tile_weights`): by the law of total variance, the patch's variance is the
+    windows' mean variance within them plus this variance between them (``patch_windows`` of
+    :func:`frame_statistics`)."""
     f = np.asarray(coarse, np.float64)
-    m = f.shape[-1] // count
-    means = f.reshape(count, m, count, m).mean(axis=(1, 3))
+    rows, cols = (tile_weights(n, count) for n in f.shape[-2:])
+    means = rows @ f @ cols.T
     mean = float(means.mean())
     return {"count": count * count, "mean": mean, "cv": float(means.std() / mean) if mean > 0.0 else 0.0}
 
 
-def patch_windows(result) -> dict[str, dict]:
-    """{field: :func:`window_means` of its coarse map of the whole patch} for the band-integrated
-    irradiance, and its sky and direct parts, where the map is a window of a periodic sea that the
-    window's side tiles on the coarse texels
-    (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else {}."""
+def patch_windows(result, views: dict | None = None) -> dict[str, dict]:
+    """{field: :func:`window_means` of its coarse map of the whole patch} where the map is a window
+    of a periodic sea whose side divides the patch's
+    (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else {}: for each of
+    ``views`` ({field: a function of a (K, M, M) map giving the field's (M, M) map}, as
+    :func:`frame_statistics` takes them; by default the band-integrated irradiance) and, with a sky,
+    the band-integrated sky and direct parts."""
     coarse = result.coarse_floor_irradiance
     if coarse is None:
         return {}
     extent = result.scene.config.water.extent_m
     count = round(extent / result.map_extent_m)
-    if count < 2 or abs(count * result.map_extent_m - extent) > 1e-6 * extent or coarse.shape[-1] % count:
+    if count < 2 or abs(count * result.map_extent_m - extent) > 1e-6 * extent:
         return {}
     widths = result.bin_widths_nm
-    maps = {"irradiance_w_m2": band_integrated(coarse, widths)}
+    views = views or {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
+    maps = {name: view(coarse) for name, view in views.items()}
     if result.coarse_sky_floor_irradiance is not None:
+        total = band_integrated(coarse, widths)
         maps["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
-        maps["direct_irradiance_w_m2"] = maps["irradiance_w_m2"] - maps["sky_irradiance_w_m2"]
+        maps["direct_irradiance_w_m2"] = total - maps["sky_irradiance_w_m2"]
     return {name: window_means(f, count) for name, f in maps.items()}
 
 
@@ -159,8 +176,8 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
     its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
     (:func:`continuous_sky_cv`). Where the map is a window of a periodic sea that tiles the patch,
-    the band-integrated fields also have ``patch_windows``: the means over the whole patch's
-    windows, from its coarse map (:func:`window_means`)."""
+    every field also has ``patch_windows``: the means over the whole patch's windows, from its
+    coarse map (:func:`window_means`)."""
     widths = result.bin_widths_nm
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
@@ -196,7 +213,7 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "pdf_edges": PDF_EDGES.tolist(),
         "par_band_nm": covered,
     }
-    patch = patch_windows(result)
+    patch = patch_windows(result, views)
     for name, f in fields.items():
         averaged = collector(f)
         stats = field_statistics(averaged, cfg.flash_threshold)

@@ -10,8 +10,10 @@ Channel, sun 30-33° from the zenith, wind 4.1-6.4 m/s, beam attenuation c(555) 
 which holds the record's conditions) with its floor at each of the record's depths, as one
 resumable sweep, pools each depth's frames per band (``stats.per_band``) and writes
 ``darecki2011.csv`` and the profile CV(z) per band, ``darecki2011.png``. As for Gernez & Antoine,
-the model's CV is spatial (a window after the collector, pooled over frames) and the measurement's
-temporal; the two agree for a stationary, homogeneous sea.
+the model's CV is spatial over the whole sea — within the window after the collector, and between
+the means of the patch's windows from its coarse map (``patch_windows``;
+:func:`~warpcaustics.batch.field.common.patch_variance`), pooled over frames — and the
+measurement's temporal; the two agree for a stationary, homogeneous sea.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from warpcaustics.batch.field.common import (
     check_overrides,
     continuous_sky,
     frame_statistics_of,
+    patch_variance,
     pooled_statistics,
     render_points,
 )
@@ -170,10 +173,17 @@ def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list
 
 
 def band_row(band: list[dict], measured: float) -> dict:
-    """One band's frames pooled, beside the measured CV: the columns every Darecki row shares."""
-    _, cv = pooled_statistics([(b["mean"], b["cv"]) for b in band])
+    """One band's frames pooled, beside the measured CV: the columns every Darecki row shares. The
+    model's CV is the whole patch's (within the window and between the patch's windows,
+    :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has ``patch_windows``;
+    ``model_cv_window`` is the window's frames pooled alone."""
+    window = [(b["mean"], b["cv"]) for b in band]
+    windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
+    _, cv_window = pooled_statistics(window)
+    cv = math.sqrt(patch_variance(window, windows if len(windows) == len(band) else None))
     return {
         "model_cv": round(cv, 4),
+        "model_cv_window": round(cv_window, 4),
         "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
         "model_over_measured": round(cv / measured, 3),
         "model_cv_continuous_sky": continuous_sky(band),
@@ -191,7 +201,10 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
         z = [r["depth_m"] for r in rs]
         ax.plot([r["measured_cv"] for r in rs], z, "ko-", label="Darecki et al. 2011 (Fig. 13a)")
         ax.errorbar([r["model_cv"] for r in rs], z, xerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
-                    color="tab:blue", capsize=3, label="model as rendered")
+                    color="tab:blue", capsize=3, label="model, the whole sea")
+        if any(r["model_cv_window"] != r["model_cv"] for r in rs):
+            ax.plot([r["model_cv_window"] for r in rs], z, "s:", color="tab:gray",
+                    label="model, the window alone (its frames pooled)")
         if all(r["model_cv_continuous_sky"] is not None for r in rs):
             ax.plot([r["model_cv_continuous_sky"] for r in rs], z, "D-", color="tab:purple",
                     label="model, the sky's continuum")
