@@ -95,7 +95,9 @@ and texels."""
 
 POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s", "sky.model",
               "sky.cie_type")
-"""The keys each point sets (Point.overrides): a --set of one of them would be overwritten."""
+"""The keys a point may set (Point.overrides): a --set of one that the chosen points set would be
+overwritten (the sky's model and type only by the overcast series: the clear series take the
+scene's, which a row of the error budget sets)."""
 
 
 @dataclass(frozen=True)
@@ -212,7 +214,6 @@ def run_gernez2009(
     if not series or unknown:
         raise ConfigError(f"--series {','.join(series)!r} must name some of: {', '.join(SERIES)}")
     times = check_frames(frames, frame_interval_s)
-    check_overrides(overrides, POINT_KEYS, "--zeniths / --sqrt-winds")
     scene_path = Path(scene).resolve()
     fixed = {**(QUICK_OVERRIDES if quick else {}), **(overrides or {})}
     base = load_scene(scene_path, fixed)
@@ -221,6 +222,7 @@ def run_gernez2009(
     points = select_points(gernez2009_points(series), zeniths, sqrt_winds)
     if not points:
         raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
+    check_overrides(overrides, tuple({k for p in points for k in p.overrides()}), "--zeniths / --sqrt-winds")
     if quick:  # the first and last zenith, the first wind, the first overcast zenith
         ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1],
                 "overcast": lambda ps: ps[:1]}
