@@ -253,26 +253,28 @@ def test_darecki_config_holds_the_records_conditions():
 def test_darecki_command_on_still_water_measures_no_fluctuation(tmp_path):
     """The depth-profile command end to end (--quick): under still water the CV is 0 in every band
     at every depth, and so is the CV with the sky's continuum (``sky.sampling = "halves"``), beside
-    the record's values; a plot is written."""
+    the record's values, and a depth the record lacks (0.5 m) has none beside it; a plot is written."""
     pytest.importorskip("matplotlib")
     flat = tmp_path / "flat.toml"
     flat.write_text(DARECKI.read_text().replace('model = "fft"', 'model = "flat"'))
     out = tmp_path / "o"
     assert main(["field", "darecki2011", str(flat), "--out", str(out), "--quick", "--frames", "1",
-                 "--depths", "0.86,9.58", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves"]) == 0
+                 "--depths", "9.58,0.5", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves"]) == 0
     rows = list(csv.DictReader((out / "darecki2011.csv").open()))
     assert all(float(r["model_cv_continuous_sky"]) < 1e-5 for r in rows)  # the sky drawn in halves
     rec = jerlov.darecki2011_irradiance_cv()
     assert [(float(r["depth_m"]), float(r["wavelength_nm"])) for r in rows] == [
-        (d, float(w)) for d in (0.86, 9.58) for w in rec.wavelengths_nm]
+        (d, float(w)) for d in (0.5, 9.58) for w in rec.wavelengths_nm]
     assert all(float(r["model_cv"]) < 1e-5 and float(r["model_cv_window"]) < 1e-5 for r in rows)
-    assert [float(r["measured_cv"]) for r in rows[:3]] == pytest.approx(rec.cv[0].tolist(), abs=1e-4)
+    assert all(r["measured_cv"] == r["model_over_measured"] == "" for r in rows[:3])  # 0.5 m: not measured
+    assert [float(r["measured_cv"]) for r in rows[3:]] == pytest.approx(rec.cv[-1].tolist(), abs=1e-4)
     assert (out / "darecki2011.png").stat().st_size > 0
 
 
 def test_darecki_bad_input_is_one_line(tmp_path, capsys):
-    with pytest.raises(ConfigError, match="--depths: 5 is not a measured depth"):
-        field.run_darecki2011(DARECKI, tmp_path / "o", depths=(5.0,), quick=True)
+    for depth in (0.0, -1.0, math.nan):
+        with pytest.raises(ConfigError, match=f"--depths: {depth:g} must be a depth above 0"):
+            field.run_darecki2011(DARECKI, tmp_path / "o", depths=(depth,), quick=True)
     with pytest.raises(ConfigError, match=r"optics.wavelengths = \[443.0, 532.0, 670.0\]"):
         field.run_darecki2011(DARECKI, tmp_path / "o", overrides={"optics.wavelengths": [510.0]}, quick=True)
     with pytest.raises(ConfigError, match="stats.per_band = true"):

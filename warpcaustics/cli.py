@@ -122,7 +122,8 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--sqrt-winds", metavar="LIST",
                     help="gernez2009: only these measured √wind classes [√(m/s)], comma-separated")
     fd.add_argument("--depths", metavar="LIST",
-                    help="darecki2011: only these measured depths [m], comma-separated (default all)")
+                    help="darecki2011: these depths [m], comma-separated (default the measured ones; others "
+                         "give the model's CV(z) with no measurement beside it)")
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
     fd.add_argument("--long-waves", type=float, metavar="M",

@@ -7,13 +7,14 @@ Channel, sun 30-33° from the zenith, wind 4.1-6.4 m/s, beam attenuation c(555) 
 2.5 mm collector. The values come from the ``jerlov`` package (``darecki2011_irradiance_cv``).
 
 ``warpcaustics field darecki2011 SCENE --out DIR`` renders SCENE (``configs/field/darecki2011.toml``,
-which holds the record's conditions) with its floor at each of the record's depths, as one
-resumable sweep, pools each depth's frames per band (``stats.per_band``) and writes
-``darecki2011.csv`` and the profile CV(z) per band, ``darecki2011.png``. As for Gernez & Antoine,
-the model's CV is spatial over the whole sea — within the window after the collector, and between
-the means of the patch's windows from its coarse map (``patch_windows``;
-:func:`~warpcaustics.batch.field.common.patch_variance`), pooled over frames — and the
-measurement's temporal; the two agree for a stationary, homogeneous sea.
+which holds the record's conditions) with its floor at each of the record's depths (or at the
+``--depths`` asked, the record's or others: the model's CV(z) between and beyond the measured
+depths, e.g. 0.5 to 10 m), as one resumable sweep, pools each depth's frames per band
+(``stats.per_band``) and writes ``darecki2011.csv`` and the profile CV(z) per band,
+``darecki2011.png``. As for Gernez & Antoine, the model's CV is spatial over the whole sea —
+within the window after the collector, and between the means of the patch's windows from its
+coarse map (``patch_windows``; :func:`~warpcaustics.batch.field.common.patch_variance`), pooled
+over frames — and the measurement's temporal; the two agree for a stationary, homogeneous sea.
 """
 
 from __future__ import annotations
@@ -69,12 +70,18 @@ def beam_attenuation(config, wavelength_nm: float) -> float:
 
 
 def select_measured(have_values: np.ndarray, wanted: tuple[float, ...] | None, flag: str,
-                    what: str) -> list[float]:
+                    what: str, *, unmeasured: bool = False) -> list[float]:
     """The record's values (depths, winds) at ``wanted`` (None: all); one the record lacks is an
-    error naming ``flag``."""
+    error naming ``flag``, unless ``unmeasured``: then ``wanted`` as asked, in increasing order
+    (positive; a duplicate once)."""
     have = [float(d) for d in have_values]
     if wanted is None:
         return have
+    if unmeasured:
+        bad = [d for d in wanted if not (math.isfinite(d) and d > 0.0)]
+        if bad:
+            raise ConfigError(f"{flag}: {bad[0]:g} must be a {what} above 0, e.g. {flag} 0.5,1,2")
+        return sorted(set(float(d) for d in wanted))
     for d in wanted:
         if not any(abs(d - h) < 1e-6 for h in have):
             raise ConfigError(f"{flag}: {d:g} is not a measured {what}; the record holds "
@@ -111,24 +118,25 @@ def run_darecki2011(
     force: bool = False,
     overrides: dict | None = None,
 ) -> dict[str, Path]:
-    """Render SCENE at each of the record's depths (or ``depths`` of them) as one resumable sweep
-    into ``out``, pool each depth's frames per band and write ``darecki2011.csv`` and
-    ``darecki2011.png``. ``overrides``: config keys set at every depth (``--set``). The frames are
-    ``frame_interval_s`` apart, by default 5 s, longer than the peak waves' period (2.6 s at the
-    record's wind): each frame is a new realisation of the largest scales, which decide the CV at
-    depth (docs/validation.md)."""
+    """Render SCENE at each of the record's depths (or at ``depths``: any positive depths, those the
+    record lacks with no measured value beside them) as one resumable sweep into ``out``, pool each
+    depth's frames per band and write ``darecki2011.csv`` and ``darecki2011.png``. ``overrides``:
+    config keys set at every depth (``--set``). The frames are ``frame_interval_s`` apart, by
+    default 5 s, longer than the peak waves' period (2.6 s at the record's wind): each frame is a
+    new realisation of the largest scales, which decide the CV at depth (docs/validation.md)."""
     rec = record()
     config, points = render_record(
         scene, out, rec, POINT_KEYS[0], rec.depth_m, depths, ("--depths", "depth"), frames=frames,
         frame_interval_s=frame_interval_s, workers=workers, device=device, quick=quick, quiet=quiet,
-        force=force, overrides=overrides)
+        force=force, overrides=overrides, unmeasured=True)
     c555 = beam_attenuation(config, 555.0)
     rows = []
     for depth, k, bands in points:
         for j, band in enumerate(bands):
-            measured = float(rec.cv[k, j])
+            measured = None if k is None else float(rec.cv[k, j])
             rows.append({"depth_m": depth, "wavelength_nm": float(rec.wavelengths_nm[j]),
-                         "measured_cv": round(measured, 4), **band_row(band, measured),
+                         "measured_cv": None if measured is None else round(measured, 4),
+                         **band_row(band, measured),
                          "model_c555_per_m": round(c555, 4),
                          "measured_c555_per_m": float(rec.beam_attenuation_555)})
     out = Path(out)
@@ -141,12 +149,13 @@ def run_darecki2011(
 def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.ndarray,
                   wanted: tuple[float, ...] | None, flag: tuple[str, str], *, frames: int,
                   frame_interval_s: float, workers: int, device: str | None, quick: bool, quiet: bool,
-                  force: bool, overrides: dict | None):
+                  force: bool, overrides: dict | None, unmeasured: bool = False):
     """What every Darecki comparison shares: SCENE checked against the record ``rec``, rendered with
     config ``key`` at each of the record's values ``have`` (or those ``wanted``; ``flag``: the
-    command's flag choosing them and what they are) as one resumable sweep, ``frames`` frames
-    ``frame_interval_s`` apart. Returns the scene's config and, per value, (value, its index in
-    ``have``, per band of the record the statistics of every frame)."""
+    command's flag choosing them and what they are; ``unmeasured``: values the record lacks too) as
+    one resumable sweep, ``frames`` frames ``frame_interval_s`` apart. Returns the scene's config
+    and, per value, (value, its index in ``have`` or None where the record lacks it, per band of the
+    record the statistics of every frame)."""
     from warpcaustics.scene import load_scene
 
     times = check_frames(frames, frame_interval_s)
@@ -156,14 +165,20 @@ def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.nd
     base = load_scene(scene_path, fixed)
     check_scene(base.config, rec)
     pyplot(PLOT_NEEDS)  # before the sweep, not after it
-    chosen = select_measured(have, wanted, *flag)
+    chosen = select_measured(have, wanted, *flag, unmeasured=unmeasured)
     if quick:
         chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
     sweep = render_points(scene_path, fixed, [{key: v} for v in chosen], times, out, workers=workers,
                           device=device, quiet=quiet, force=force)
-    points = [(v, int(np.argmin(np.abs(have - v))), band_statistics(sweep, out, {key: v}, rec.wavelengths_nm))
+    points = [(v, measured_index(have, v), band_statistics(sweep, out, {key: v}, rec.wavelengths_nm))
               for v in chosen]
     return base.config, points
+
+
+def measured_index(have: np.ndarray, value: float) -> int | None:
+    """The index of ``value`` in the record's ``have`` (None: not a measured value)."""
+    k = int(np.argmin(np.abs(np.asarray(have, np.float64) - value)))
+    return k if abs(float(have[k]) - value) < 1e-6 else None
 
 
 def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list[list[dict]]:
@@ -172,11 +187,11 @@ def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list
     return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
 
 
-def band_row(band: list[dict], measured: float) -> dict:
-    """One band's frames pooled, beside the measured CV: the columns every Darecki row shares. The
-    model's CV is the whole patch's (within the window and between the patch's windows,
-    :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has ``patch_windows``;
-    ``model_cv_window`` is the window's frames pooled alone."""
+def band_row(band: list[dict], measured: float | None) -> dict:
+    """One band's frames pooled, beside the measured CV (None: not measured there): the columns every
+    Darecki row shares. The model's CV is the whole patch's (within the window and between the
+    patch's windows, :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has
+    ``patch_windows``; ``model_cv_window`` is the window's frames pooled alone."""
     window = [(b["mean"], b["cv"]) for b in band]
     windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
     _, cv_window = pooled_statistics(window)
@@ -185,7 +200,7 @@ def band_row(band: list[dict], measured: float) -> dict:
         "model_cv": round(cv, 4),
         "model_cv_window": round(cv_window, 4),
         "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
-        "model_over_measured": round(cv / measured, 3),
+        "model_over_measured": None if measured is None else round(cv / measured, 3),
         "model_cv_continuous_sky": continuous_sky(band),
         "frames": len(band),
     }
@@ -199,7 +214,9 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
     for ax, nm in zip(axes[0], bands):
         rs = [r for r in rows if r["wavelength_nm"] == nm]
         z = [r["depth_m"] for r in rs]
-        ax.plot([r["measured_cv"] for r in rs], z, "ko-", label="Darecki et al. 2011 (Fig. 13a)")
+        measured = [r for r in rs if r["measured_cv"] is not None]
+        ax.plot([r["measured_cv"] for r in measured], [r["depth_m"] for r in measured], "ko-",
+                label="Darecki et al. 2011 (Fig. 13a)")
         ax.errorbar([r["model_cv"] for r in rs], z, xerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
                     color="tab:blue", capsize=3, label="model, the whole sea")
         if any(r["model_cv_window"] != r["model_cv"] for r in rs):
