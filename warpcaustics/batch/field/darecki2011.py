@@ -142,7 +142,7 @@ def run_darecki2011(
     out = Path(out)
     paths = {"csv": out / "darecki2011.csv", "png": out / "darecki2011.png"}
     write_csv(paths["csv"], rows)
-    _plot(rows, paths["png"], quick)
+    plot_profile(rows, paths["png"], quick)
     return paths
 
 
@@ -206,8 +206,9 @@ def band_row(band: list[dict], measured: float | None) -> dict:
     }
 
 
-def _plot(rows: list[dict], path: Path, quick: bool) -> None:
-    """CV(z), one panel per band: the measured profile and the model's."""
+def plot_profile(rows: list[dict], path: Path, quick: bool = False) -> None:
+    """CV(z), one panel per band: the measured profile and the model's, from the rows of
+    ``darecki2011.csv`` (its columns, numbers as floats; a depth not measured has ``measured_cv`` None)."""
     plt = pyplot(PLOT_NEEDS)
     bands = sorted({r["wavelength_nm"] for r in rows})
     fig, axes = plt.subplots(1, len(bands), figsize=(3.8 * len(bands), 4.2), sharey=True, squeeze=False)
@@ -226,6 +227,8 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
             ax.plot([r["model_cv_continuous_sky"] for r in rs], z, "D-", color="tab:purple",
                     label="model, the sky's continuum")
         ax.set_xscale("log")
+        ax.xaxis.set_major_locator(plt.LogLocator(subs=(1.0, 2.0, 5.0)))  # labels within a decade too
+        ax.xaxis.set_major_formatter(plt.FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(plt.NullFormatter())  # the minor ticks' labels overlap
         ax.set_title(f"{nm:g} nm")
         ax.set_xlabel("CV of Ed")
