@@ -259,13 +259,15 @@ def test_darecki_command_on_still_water_measures_no_fluctuation(tmp_path):
     flat.write_text(DARECKI.read_text().replace('model = "fft"', 'model = "flat"'))
     out = tmp_path / "o"
     assert main(["field", "darecki2011", str(flat), "--out", str(out), "--quick", "--frames", "1",
-                 "--depths", "9.58,0.5", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves"]) == 0
+                 "--depths", "9.58,0.5", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves",
+                 "--long-waves", "16"]) == 0
     rows = list(csv.DictReader((out / "darecki2011.csv").open()))
     assert all(float(r["model_cv_continuous_sky"]) < 1e-5 for r in rows)  # the sky drawn in halves
     rec = jerlov.darecki2011_irradiance_cv()
     assert [(float(r["depth_m"]), float(r["wavelength_nm"])) for r in rows] == [
         (d, float(w)) for d in (0.5, 9.58) for w in rec.wavelengths_nm]
-    assert all(float(r["model_cv"]) < 1e-5 and float(r["model_cv_window"]) < 1e-5 for r in rows)
+    columns = ("model_cv", "model_cv_window", "model_cv_long_waves")
+    assert all(float(r[c]) < 1e-5 for r in rows for c in columns)
     assert all(r["measured_cv"] == r["model_over_measured"] == "" for r in rows[:3])  # 0.5 m: not measured
     assert [float(r["measured_cv"]) for r in rows[3:]] == pytest.approx(rec.cv[-1].tolist(), abs=1e-4)
     assert (out / "darecki2011.png").stat().st_size > 0
@@ -357,13 +359,18 @@ def test_the_command_offers_every_registered_data_set_with_its_point_flags():
             assert getattr(args, flag) == "1"
 
 
-def test_long_waves_is_gernez2009s_flag(tmp_path, capsys):
-    """--long-waves reaches run_gernez2009's long_waves_m; on another data set it is a one-line error."""
+def test_long_waves_is_a_flag_of_gernez2009_and_darecki2011(tmp_path, capsys):
+    """--long-waves reaches run_gernez2009's and run_darecki2011's long_waves_m; on another data set
+    it is a one-line error."""
     from warpcaustics.cli import main
 
-    assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"),
+    assert main(["field", "darecki2011_wind", str(WIND), "--out", str(tmp_path / "o"),
                  "--long-waves", "64"]) == 2
-    assert "--long-waves is a flag of gernez2009, not of darecki2011" in capsys.readouterr().err
+    assert ("--long-waves is a flag of gernez2009 and darecki2011, not of darecki2011_wind"
+            in capsys.readouterr().err)
+    assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"),
+                 "--long-waves", "16"]) == 2
+    assert "--long-waves = 16 m must exceed water.extent_m = 32 m" in capsys.readouterr().err
     assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "g"),
                  "--long-waves", "2"]) == 2
     assert "--long-waves = 2 m must exceed water.extent_m = 4 m" in capsys.readouterr().err

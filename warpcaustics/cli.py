@@ -127,8 +127,9 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
     fd.add_argument("--long-waves", type=float, metavar="M",
-                    help="gernez2009: side [m] of a coarse patch of the waves longer than the scene's, "
-                         "rendered at each point too (default 128); 0: the scene's waves alone")
+                    help="gernez2009, darecki2011: side [m] of a coarse patch of the waves longer than "
+                         "the scene's, rendered at each point too (default: gernez2009 128, darecki2011 "
+                         "0); 0: the scene's waves alone")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
                     help="seconds between a point's frames (default: gernez2009 2, darecki2011 and "
@@ -171,7 +172,7 @@ def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
 
 def _field(args: argparse.Namespace) -> int:
     """``warpcaustics field``: each data set takes its own point flags; another's is an error."""
-    from warpcaustics.batch.field import DATASETS, POINT_FLAGS
+    from warpcaustics.batch.field import DATASETS, LONG_WAVES_DATASETS, POINT_FLAGS
 
     own = POINT_FLAGS[args.dataset]
     for name in sorted({flag for flags in POINT_FLAGS.values() for flag in flags}):
@@ -189,8 +190,9 @@ def _field(args: argparse.Namespace) -> int:
     if args.frame_interval is not None:  # else each data set's own default
         common["frame_interval_s"] = args.frame_interval
     if args.long_waves is not None:
-        if args.dataset != "gernez2009":
-            raise ConfigError(f"--long-waves is a flag of gernez2009, not of {args.dataset}")
+        if args.dataset not in LONG_WAVES_DATASETS:
+            raise ConfigError(f"--long-waves is a flag of {' and '.join(LONG_WAVES_DATASETS)}, not of "
+                              f"{args.dataset}")
         common["long_waves_m"] = args.long_waves
     paths = DATASETS[args.dataset](args.scene, args.out, **points, **common)
     print("wrote " + ", ".join(str(p) for p in paths.values()))

@@ -35,8 +35,13 @@ POINT_FLAGS = {"gernez2009": ("series", "zeniths", "sqrt_winds"), "darecki2011":
 """name → the keywords of its function that choose which of the record's points to render
 (``warpcaustics field``'s flags of the same names); each is a tuple, None for all."""
 
+LONG_WAVES_DATASETS = ("gernez2009", "darecki2011")
+"""The data sets whose function takes ``long_waves_m`` (``--long-waves``): a coarse patch of the
+waves longer than the scene's, nested with it (default: gernez2009 128 m, darecki2011 0, off)."""
+
 __all__ = [
-    "DATASETS", "POINT_FLAGS", "POINT_KEYS", "QUICK_OVERRIDES", "Point", "diffuse_fraction",
-    "direct_transmission", "gernez2009_points", "point_variants", "pooled_statistics", "run_darecki2011",
-    "run_darecki2011_wind", "run_gernez2009", "select_points", "nested_cv", "patch_variance",
+    "DATASETS", "LONG_WAVES_DATASETS", "POINT_FLAGS", "POINT_KEYS", "QUICK_OVERRIDES", "Point",
+    "diffuse_fraction", "direct_transmission", "gernez2009_points", "point_variants", "pooled_statistics",
+    "run_darecki2011", "run_darecki2011_wind", "run_gernez2009", "select_points", "nested_cv",
+    "patch_variance",
 ]

@@ -122,3 +122,38 @@ def patch_variance(window: list[tuple[float, float]], windows: list[tuple[float,
     within = float(np.mean([c * c for _, c in window]))
     between = pooled_statistics(windows)[1] ** 2
     return nested_cv(within, between) ** 2
+
+
+LONG_WAVES_OVERRIDES = {"water.resolution": 256, "caustics.map_resolution": 256}
+"""The grid of a patch of the waves longer than the scene's (``--long-waves``): 256² cells (50 cm
+over the Gernez comparison's 128 m, 16 or more a wave) and the floor map of the whole patch on
+texels as large (measured against finer grids: docs/validation.md); ``--quick`` uses 64 cells
+and texels."""
+
+LONG_WAVES_FOLDER = "long_waves"
+"""The long waves' sweep, inside the comparison's folder."""
+
+
+def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scene_path: Path) -> dict | None:
+    """The overrides of the long waves' patch at every point: ``extent_m`` wide, without the waves of
+    the scene's patch's side or shorter (which the scene holds), its floor map the whole patch;
+    None for ``extent_m`` = 0. A patch no larger than the scene's own is an error naming
+    --long-waves."""
+    from warpcaustics.scene import load_scene
+
+    if not (math.isfinite(extent_m) and extent_m >= 0.0):
+        raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
+                          "scene's waves alone")
+    if extent_m == 0.0:
+        return None
+    if extent_m <= config.water.extent_m:
+        raise ConfigError(f"--long-waves = {extent_m:g} m must exceed water.extent_m = "
+                          f"{config.water.extent_m:g} m (the scene's own patch), or be 0 for its waves alone")
+    grid = {"water.resolution": 64, "caustics.map_resolution": 64} if quick else LONG_WAVES_OVERRIDES
+    long = {**fixed, **grid, "water.extent_m": extent_m, "water.shortest_wave_m": config.water.extent_m,
+            "caustics.map_extent_m": 0.0}
+    try:
+        load_scene(scene_path, long)
+    except ConfigError as exc:
+        raise ConfigError(f"--long-waves = {extent_m:g} m: {exc}") from None
+    return long

@@ -25,10 +25,13 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics.batch.field.common import (
+    LONG_WAVES_FOLDER,
     check_frames,
     check_overrides,
     continuous_sky,
     frame_statistics_of,
+    long_waves_overrides,
+    nested_cv,
     patch_variance,
     pooled_statistics,
     render_points,
@@ -117,26 +120,31 @@ def run_darecki2011(
     quiet: bool = False,
     force: bool = False,
     overrides: dict | None = None,
+    long_waves_m: float = 0.0,
 ) -> dict[str, Path]:
     """Render SCENE at each of the record's depths (or at ``depths``: any positive depths, those the
     record lacks with no measured value beside them) as one resumable sweep into ``out``, pool each
     depth's frames per band and write ``darecki2011.csv`` and ``darecki2011.png``. ``overrides``:
     config keys set at every depth (``--set``). The frames are ``frame_interval_s`` apart, by
     default 5 s, longer than the peak waves' period (2.6 s at the record's wind): each frame is a
-    new realisation of the largest scales, which decide the CV at depth (docs/validation.md)."""
+    new realisation of the largest scales, which decide the CV at depth (docs/validation.md).
+    ``long_waves_m`` > 0: a coarse patch that wide of the waves longer than the scene's patch,
+    rendered at every depth too (into ``out/long_waves``) and nested with the scene's CV as in the
+    Gernez comparison (:func:`~warpcaustics.batch.field.common.nested_cv`); 0 (the default): the
+    scene's waves alone."""
     rec = record()
     config, points = render_record(
         scene, out, rec, POINT_KEYS[0], rec.depth_m, depths, ("--depths", "depth"), frames=frames,
         frame_interval_s=frame_interval_s, workers=workers, device=device, quick=quick, quiet=quiet,
-        force=force, overrides=overrides, unmeasured=True)
+        force=force, overrides=overrides, unmeasured=True, long_waves_m=long_waves_m)
     c555 = beam_attenuation(config, 555.0)
     rows = []
-    for depth, k, bands in points:
+    for depth, k, bands, longer in points:
         for j, band in enumerate(bands):
             measured = None if k is None else float(rec.cv[k, j])
             rows.append({"depth_m": depth, "wavelength_nm": float(rec.wavelengths_nm[j]),
                          "measured_cv": None if measured is None else round(measured, 4),
-                         **band_row(band, measured),
+                         **band_row(band, measured, None if longer is None else longer[j]),
                          "model_c555_per_m": round(c555, 4),
                          "measured_c555_per_m": float(rec.beam_attenuation_555)})
     out = Path(out)
@@ -149,13 +157,15 @@ def run_darecki2011(
 def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.ndarray,
                   wanted: tuple[float, ...] | None, flag: tuple[str, str], *, frames: int,
                   frame_interval_s: float, workers: int, device: str | None, quick: bool, quiet: bool,
-                  force: bool, overrides: dict | None, unmeasured: bool = False):
+                  force: bool, overrides: dict | None, unmeasured: bool = False, long_waves_m: float = 0.0):
     """What every Darecki comparison shares: SCENE checked against the record ``rec``, rendered with
     config ``key`` at each of the record's values ``have`` (or those ``wanted``; ``flag``: the
     command's flag choosing them and what they are; ``unmeasured``: values the record lacks too) as
-    one resumable sweep, ``frames`` frames ``frame_interval_s`` apart. Returns the scene's config
+    one resumable sweep, ``frames`` frames ``frame_interval_s`` apart, and with ``long_waves_m`` > 0
+    a second sweep of the waves longer than the scene's patch on a patch that wide
+    (:func:`~warpcaustics.batch.field.common.long_waves_overrides`). Returns the scene's config
     and, per value, (value, its index in ``have`` or None where the record lacks it, per band of the
-    record the statistics of every frame)."""
+    record the statistics of every frame, the same of the long waves' frames or None)."""
     from warpcaustics.scene import load_scene
 
     times = check_frames(frames, frame_interval_s)
@@ -168,9 +178,16 @@ def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.nd
     chosen = select_measured(have, wanted, *flag, unmeasured=unmeasured)
     if quick:
         chosen = [chosen[0], chosen[-1]] if len(chosen) > 1 else chosen
-    sweep = render_points(scene_path, fixed, [{key: v} for v in chosen], times, out, workers=workers,
-                          device=device, quiet=quiet, force=force)
-    points = [(v, measured_index(have, v), band_statistics(sweep, out, {key: v}, rec.wavelengths_nm))
+    long_fixed = long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
+    variants = [{key: v} for v in chosen]
+    sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
+                          quiet=quiet, force=force)
+    long_out = Path(out) / LONG_WAVES_FOLDER
+    long = None if long_fixed is None else render_points(
+        scene_path, long_fixed, variants, times, long_out, workers=workers, device=device, quiet=quiet,
+        force=force)
+    points = [(v, measured_index(have, v), band_statistics(sweep, out, {key: v}, rec.wavelengths_nm),
+               None if long is None else band_statistics(long, long_out, {key: v}, rec.wavelengths_nm))
               for v in chosen]
     return base.config, points
 
@@ -187,18 +204,24 @@ def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list
     return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
 
 
-def band_row(band: list[dict], measured: float | None) -> dict:
+def band_row(band: list[dict], measured: float | None, longer: list[dict] | None = None) -> dict:
     """One band's frames pooled, beside the measured CV (None: not measured there): the columns every
     Darecki row shares. The model's CV is the whole patch's (within the window and between the
     patch's windows, :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has
-    ``patch_windows``; ``model_cv_window`` is the window's frames pooled alone."""
+    ``patch_windows``, nested with that of the waves longer than the patch (``longer``: their
+    frames' statistics, or None); ``model_cv_window`` is the window's frames pooled alone,
+    ``model_cv_patch`` the scene's patch and ``model_cv_long_waves`` the long waves' alone."""
     window = [(b["mean"], b["cv"]) for b in band]
     windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
     _, cv_window = pooled_statistics(window)
-    cv = math.sqrt(patch_variance(window, windows if len(windows) == len(band) else None))
+    patch = patch_variance(window, windows if len(windows) == len(band) else None)
+    cv_long = None if longer is None else pooled_statistics([(b["mean"], b["cv"]) for b in longer])[1]
+    cv = math.sqrt(patch) if cv_long is None else nested_cv(patch, cv_long**2)
     return {
         "model_cv": round(cv, 4),
         "model_cv_window": round(cv_window, 4),
+        "model_cv_patch": round(math.sqrt(patch), 4),
+        "model_cv_long_waves": None if cv_long is None else round(cv_long, 4),
         "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
         "model_over_measured": None if measured is None else round(cv / measured, 3),
         "model_cv_continuous_sky": continuous_sky(band),

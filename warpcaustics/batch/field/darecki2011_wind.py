@@ -58,7 +58,7 @@ def run_darecki2011_wind(
         force=force, overrides=overrides)
     c555 = beam_attenuation(config, 555.0)
     rows = []
-    for wind, k, bands in points:
+    for wind, k, bands, _ in points:
         for j, band in enumerate(bands):
             measured = float(rec.cv[k, j])
             rows.append({"wind_m_s": wind, "day": rec.days[k], "wavelength_nm": float(rec.wavelengths_nm[j]),

@@ -35,10 +35,13 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics.batch.field.common import (
+    LONG_WAVES_FOLDER,
+    LONG_WAVES_OVERRIDES,  # noqa: F401 (the long waves' grid, as benchmarks/long_waves.py times it)
     check_frames,
     check_overrides,
     continuous_sky,
     frame_statistics_of,
+    long_waves_overrides,
     nested_cv,
     patch_variance,
     pooled_statistics,
@@ -87,11 +90,6 @@ LONG_WAVES_EXTENT_M = 128.0
 patch holds about half of a 5 m/s sea's elevation variance (its peak is 10 m long), and 128 m hold
 all of the wind series' (at 13 m/s over 20 km of fetch the peak is 25 m long; waves over 64 m
 carry none of the variance). At a low sun their tilts decide the light (docs/validation.md)."""
-
-LONG_WAVES_OVERRIDES = {"water.resolution": 256, "caustics.map_resolution": 256}
-"""The long waves' grid: 50 cm cells, 16 or more a wave, and the floor map of the whole patch on
-texels as large (measured against finer grids: docs/validation.md); ``--quick`` uses 64 cells
-and texels."""
 
 POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s", "sky.model",
               "sky.cie_type")
@@ -227,7 +225,7 @@ def run_gernez2009(
         ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1],
                 "overcast": lambda ps: ps[:1]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
-    long_fixed = _long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
+    long_fixed = long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
     overrides, variants = point_variants(points, base.config)
     out = Path(out)
     sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
@@ -242,35 +240,6 @@ def run_gernez2009(
     write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
     return paths
-
-
-LONG_WAVES_FOLDER = "long_waves"
-"""The long waves' sweep, inside the comparison's folder."""
-
-
-def _long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scene_path: Path) -> dict | None:
-    """The overrides of the long waves' patch at every point: ``extent_m`` wide, without the waves of
-    the scene's patch's side or shorter (which the scene holds), its floor map the whole patch;
-    None for ``extent_m`` = 0. A patch no larger than the scene's own is an error naming
-    --long-waves."""
-    from warpcaustics.scene import load_scene
-
-    if not (math.isfinite(extent_m) and extent_m >= 0.0):
-        raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
-                          "scene's waves alone")
-    if extent_m == 0.0:
-        return None
-    if extent_m <= config.water.extent_m:
-        raise ConfigError(f"--long-waves = {extent_m:g} m must exceed water.extent_m = "
-                          f"{config.water.extent_m:g} m (the scene's own patch), or be 0 for its waves alone")
-    grid = {"water.resolution": 64, "caustics.map_resolution": 64} if quick else LONG_WAVES_OVERRIDES
-    long = {**fixed, **grid, "water.extent_m": extent_m, "water.shortest_wave_m": config.water.extent_m,
-            "caustics.map_extent_m": 0.0}
-    try:
-        load_scene(scene_path, long)
-    except ConfigError as exc:
-        raise ConfigError(f"--long-waves = {extent_m:g} m: {exc}") from None
-    return long
 
 
 def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]:
