@@ -36,10 +36,11 @@ SQRT_WINDS = (1.2, 2.4, 3.6)
 
 BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform", "sky.sampling": "stratified",
           "optics.beam_spread": "wells", "water.extent_m": 32.0, "water.resolution": 1024,
-          "water.wind_direction_deg": 0.0}
+          "water.wind_direction_deg": 0.0, "sun.disk_samples": 16}
 """The set-up the budget starts from: configs/field/gernez2009.toml as it was before issue 27 (a
 JONSWAP sea, a uniform sky of 16 point directions, Wells's spread, 1024² cells over 32 m, the wind
-along the sun's azimuth); every row but the last changes one thing on top of it."""
+along the sun's azimuth, 16 directions over the sun's disk); every row but the last changes one
+thing on top of it."""
 
 WINDOW_CV = "model_cv_window"
 """The column every row's CV is read from (the window alone); a table written before it existed has

@@ -1,7 +1,7 @@
 """The cost of the waves longer than the field scene's patch: ``python -m benchmarks.long_waves``.
 
 ``warpcaustics field gernez2009`` renders, beside each frame of the scene (``configs/field/
-gernez2009.toml``: 2048² cells over 8 m, a 1 m window of 512² texels, 16 sun-disk and 16 sky
+gernez2009.toml``: 2048² cells over 8 m, a 1 m window of 512² texels, 8 sun-disk and 16 sky
 directions in cones, small-angle scattering), a frame of a 128 m patch of the waves longer than 8 m
 alone (``--long-waves``: 256² cells, the whole patch on 256² texels, ``water.shortest_wave_m`` = 8).
 This times a warm frame of each at an 85° sun (the paper's diffuse share), one core, and prints the
