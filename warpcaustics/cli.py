@@ -127,9 +127,8 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
     fd.add_argument("--long-waves", type=float, metavar="M",
-                    help="gernez2009, darecki2011: side [m] of a coarse patch of the waves longer than "
-                         "the scene's, rendered at each point too (default: gernez2009 128, darecki2011 "
-                         "0); 0: the scene's waves alone")
+                    help="gernez2009, darecki2011: side [m] of a patch of the waves longer than the "
+                         "scene's, rendered too (default 128 and 0); 0: the scene's waves alone")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
                     help="seconds between a point's frames (default: gernez2009 2, darecki2011 and "
