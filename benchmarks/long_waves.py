@@ -46,7 +46,8 @@ def statistics_cost(result, stats_cfg, repeats: int) -> tuple[float, float]:
 
 def run(quick: bool, device: str) -> dict:
     import warpcaustics as wc
-    from warpcaustics.batch.field.gernez2009 import LONG_WAVES_EXTENT_M, LONG_WAVES_OVERRIDES
+    from warpcaustics.batch.field.common import LONG_WAVES_OVERRIDES
+    from warpcaustics.batch.field.gernez2009 import LONG_WAVES_EXTENT_M
     repeats = 2 if quick else 3
     scene_overrides = {**POINT, **(QUICK if quick else {})}
     long_overrides = {**POINT, **LONG_WAVES_OVERRIDES, "water.extent_m": LONG_WAVES_EXTENT_M,

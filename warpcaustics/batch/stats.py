@@ -162,7 +162,9 @@ def patch_windows(result, views: dict | None = None) -> dict[str, dict]:
     views = views or {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     maps = {name: view(coarse) for name, view in views.items()}
     if result.coarse_sky_floor_irradiance is not None:
-        total = band_integrated(coarse, widths)
+        total = maps.get("irradiance_w_m2")
+        if total is None:
+            total = band_integrated(coarse, widths)
         maps["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
         maps["direct_irradiance_w_m2"] = total - maps["sky_irradiance_w_m2"]
     return {name: window_means(f, count) for name, f in maps.items()}

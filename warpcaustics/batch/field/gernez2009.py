@@ -36,7 +36,6 @@ import numpy as np
 
 from warpcaustics.batch.field.common import (
     LONG_WAVES_FOLDER,
-    LONG_WAVES_OVERRIDES,  # noqa: F401 (the long waves' grid, as benchmarks/long_waves.py times it)
     check_frames,
     check_overrides,
     continuous_sky,
