@@ -12,10 +12,15 @@ the cross-spectra of ``--seeds`` independent walks (all pairs averaged). Printed
 - ``surface factor``: the single-scattering map's power over the walk's with no water at all (water
   type ``none``, the same seeds): what the two methods' surfaces differ by (flat facets against the
   walk's bilinear normals), with no scattering in it;
-- ``small_angle / walk`` and the same over the surface factor: what is left is the small-angle
-  approximation's own error, and, in walk-noise units, whether it is noise.
+- ``small_angle / walk`` and the same over the surface factor — the band's, and each ring's of whole
+  cycles per patch (the factor falls across the finest band, 0.25–1 cycles per texel, where the
+  water weights its low end): what is left is the small-angle approximation's own error, and, in
+  units of its own standard error, whether it is noise. That error is the jackknife's over the
+  seeds (each seed left out in turn from both walks, the one in the water and the one without it,
+  whose noise the surface factor carries too), not one pair's spread scaled: four disjoint pairs
+  give a standard deviation itself uncertain by ~40 %.
 
-The figures are in docs/physics.md and docs/validation.md (issue 32 item 2). About a minute per
+The figures are in docs/physics.md and docs/validation.md (issue 32 item 2). About two minutes per
 geometry on one core with 8 seeds.
 """
 
@@ -35,14 +40,32 @@ SPREADS = ("wells", "walk")
 """The two ``optics.beam_spread`` transfers of the small-angle mode."""
 
 
-def cross_power(maps: list[np.ndarray], m: int, band_power, fluctuations) -> tuple[np.ndarray, np.ndarray]:
-    """((K, bands) the cross-power of all pairs of independent walks' maps, averaged, (K, bands) the
-    relative standard deviation of one pair's estimate, from disjoint pairs)."""
+def cross_power(maps: list[np.ndarray], reduce, fluctuations) -> tuple[np.ndarray, ...]:
+    """((K, ...) the cross-power of all pairs of independent walks' maps, averaged and summed by
+    ``reduce`` (over radial bands or rings), (n, K, ...) the same with each walk left out in turn (the
+    jackknife's samples), (K, ...) the relative standard deviation of one pair's estimate, from
+    disjoint pairs)."""
     f = [fluctuations(a) for a in maps]
-    every = np.mean([band_power((f[i] * np.conj(f[j])).real, m)
-                     for i, j in itertools.combinations(range(len(f)), 2)], axis=0)
-    disjoint = np.stack([band_power((f[i] * np.conj(f[i + 1])).real, m) for i in range(0, len(f) - 1, 2)])
-    return every, disjoint.std(axis=0, ddof=1) / every
+    n = len(f)
+    pairs = {(i, j): reduce((f[i] * np.conj(f[j])).real) for i, j in itertools.combinations(range(n), 2)}
+    every = np.mean(list(pairs.values()), axis=0)
+    left_out = np.stack([np.mean([p for ij, p in pairs.items() if k not in ij], axis=0) for k in range(n)])
+    disjoint = np.stack([pairs[i, i + 1] for i in range(0, n - 1, 2)])
+    with np.errstate(invalid="ignore", divide="ignore"):  # rings: k = 0 holds no power
+        return every, left_out, disjoint.std(axis=0, ddof=1) / every
+
+
+def rings(m: int) -> np.ndarray:
+    """(M, M) each frequency's ring: ⌈|k| M⌉, the whole cycles per patch it does not exceed, so that
+    every ring lies within one of the test's bands (their edges are whole cycles per patch)."""
+    k = np.fft.fftfreq(m)
+    return np.ceil(np.hypot(*np.meshgrid(k, k)) * m - 1e-9).astype(int)
+
+
+def jackknife_sd(samples: np.ndarray) -> np.ndarray:
+    """The jackknife's standard error of an estimate from its n leave-one-out values (axis 0)."""
+    n = len(samples)
+    return np.sqrt((n - 1) / n * ((samples - samples.mean(axis=0)) ** 2).sum(axis=0))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -58,6 +81,17 @@ def main(argv: list[str] | None = None) -> int:
     import warpcaustics as wc
 
     m = SCENE["caustics.map_resolution"]
+    ring = rings(m)
+
+    def by_ring(spectrum: np.ndarray) -> np.ndarray:
+        return np.stack([np.bincount(ring.ravel(), weights=a.ravel()) for a in spectrum])
+
+    def over_surface(power: np.ndarray, single0: np.ndarray, walk0: np.ndarray, walk: np.ndarray):
+        """(K, bands) each frequency's power over its ring's surface factor (single0 / walk0, by ring),
+        summed by band, over the walk's band power."""
+        factor = np.divide(walk0, single0, out=np.ones_like(walk0), where=single0 > 0)  # k = 0: none
+        return band_power(power * factor[:, ring], m) / walk
+
     seeds = range(1, args.seeds + 1)
 
     def floor(overrides: dict) -> np.ndarray:
@@ -71,24 +105,30 @@ def main(argv: list[str] | None = None) -> int:
         start = time.perf_counter()
         base = {**SCENE, "floor.depth_m": depth, "optics.phase_function": phase}
         bare = {**base, "optics.water_type": "none"}
-        walk, noise = cross_power([floor({**base, "optics.scattering": "multiple", "optics.mc_seed": s})
-                                   for s in seeds], m, band_power, fluctuations)
-        walk0, _ = cross_power([floor({**bare, "optics.scattering": "multiple", "optics.mc_seed": s})
-                                for s in seeds], m, band_power, fluctuations)
-        single0 = floor({**bare, "optics.scattering": "single"})
-        surface = band_power(np.abs(fluctuations(single0)) ** 2, m) / walk0
+        walk, walk_k, noise = cross_power(
+            [floor({**base, "optics.scattering": "multiple", "optics.mc_seed": s}) for s in seeds],
+            lambda a: band_power(a, m), fluctuations)
+        walk0, walk0_k, _ = cross_power(
+            [floor({**bare, "optics.scattering": "multiple", "optics.mc_seed": s}) for s in seeds],
+            by_ring, fluctuations)
+        single0 = by_ring(np.abs(fluctuations(floor({**bare, "optics.scattering": "single"}))) ** 2)
+        surface = band_power(single0[:, ring], m) / band_power(walk0[:, ring], m)
         print(f"\n{depth:g} m, {phase}, {args.seeds} seeds ({time.perf_counter() - start:.0f} s)")
         print("walk noise (one pair's relative sd):\n", noise)
         print("surface factor (single / walk, no water):\n", surface)
         for spread in SPREADS:
             mode = {**base, "optics.scattering": "small_angle", "optics.beam_spread": spread}
-            ratio = band_power(np.abs(fluctuations(floor(mode))) ** 2, m) / walk
-            left = ratio / surface
+            power = np.abs(fluctuations(floor(mode))) ** 2
+            ratio = band_power(power, m) / walk
+            left = over_surface(power, single0, walk0, walk)
+            samples = [over_surface(power, single0, a, b) for a, b in zip(walk0_k, walk_k)]
+            error = jackknife_sd(np.stack(samples))
             print(f"small_angle ({spread}) / walk:\n", ratio)
-            print(f"small_angle ({spread}) / walk over the surface factor:\n", left)
-            print("... its difference from 1 in units of the walk's noise of the averaged pairs:\n",
-                  (left - 1.0) / (noise / np.sqrt(args.seeds / 2)))
-            print(f"range over the surface factor ({spread}): {left.min():.3f}–{left.max():.3f}")
+            print(f"small_angle ({spread}) / walk, over the band's surface factor:\n", ratio / surface)
+            print(f"small_angle ({spread}) / walk, over each ring's surface factor:\n", left)
+            print("... its jackknife standard error (both walks' noise, over the seeds):\n", error)
+            print("... its difference from 1 in those units:\n", (left - 1.0) / error)
+            print(f"range over the rings' surface factor ({spread}): {left.min():.3f}–{left.max():.3f}")
     return 0
 
 
