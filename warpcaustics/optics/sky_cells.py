@@ -71,21 +71,55 @@ def floor_offsets(directions: np.ndarray, ior: float) -> tuple[np.ndarray, np.nd
 
 
 @functools.lru_cache(maxsize=16)
+def _partition(directions: tuple, points_per_cell: int) -> tuple[np.ndarray, np.ndarray]:
+    """(the dense stratified set (K × ``points_per_cell``, 3), (…,) the index of the direction of
+    ``directions`` nearest each of its points in the projected disk: the cell it falls in)."""
+    from scipy.spatial import cKDTree
+
+    d = np.asarray(directions, np.float64)
+    points = stratified_hemisphere(len(d) * points_per_cell, 0.5, 0.0)
+    _, nearest = cKDTree(d[:, :2]).query(points[:, :2])
+    return points, nearest
+
+
+@functools.lru_cache(maxsize=16)
 def sky_cells(directions: tuple, sky_type: int | None, sun_direction: tuple, ior: float,
               points_per_cell: int = POINTS_PER_CELL) -> tuple:
     """Per direction of ``directions`` (K tuples of 3, cosine-weighted stratified): (its cell's
     points (S_j, 3), their weights (S_j,)): the points of a stratified set of K × ``points_per_cell``
     nearest it in the projected disk, weighted by the sky's relative radiance (CIE type
     ``sky_type``, None: uniform) and the flat surface's Fresnel transmittance into water of ``ior``."""
-    from scipy.spatial import cKDTree
-
-    d = np.asarray(directions, np.float64)
-    dense = stratified_hemisphere(len(d) * points_per_cell, 0.5, 0.0)
-    _, nearest = cKDTree(d[:, :2]).query(dense[:, :2])
-    weight = fresnel_transmittance(dense[:, 2], 1.0 / ior)
+    points, nearest = _partition(directions, points_per_cell)
+    weight = fresnel_transmittance(points[:, 2], 1.0 / ior)
     if sky_type is not None:
-        weight = weight * cie_relative_radiance(sky_type, dense, np.asarray(sun_direction, np.float64))
-    return tuple((dense[nearest == j], weight[nearest == j]) for j in range(len(d)))
+        weight = weight * cie_relative_radiance(sky_type, points, np.asarray(sun_direction, np.float64))
+    return tuple((points[nearest == j], weight[nearest == j]) for j in range(len(directions)))
+
+
+def cell_shares(directions: tuple, sky_type: int | None, sun_direction: tuple, ior: float,
+                points_per_cell: int = POINTS_PER_CELL) -> np.ndarray:
+    """(K,) each direction's share of the sky's horizontal irradiance, such that through still water
+    it brings what its cell of the sky transmits: the sky's relative radiance L times the flat
+    surface's Fresnel transmittance T summed over the cell's points of the dense stratified set (each
+    cosine-weighted point stands for the same part of a uniform sky's horizontal irradiance), over
+    the direction's own T and over L summed on the whole sky,
+
+        share_j = Σ_{s ∈ j} L_s T_s / (T_j Σ_s L_s).
+
+    Not its own radiance over the directions' sum (``stratified``): the cells (nearest-direction
+    regions of the projected disk) hold 0.53–1.36× the disk's K-th part, and under the CIE clear sky
+    with a low sun the radiance at the outermost directions, near the bright horizon round the sun,
+    is 2.5–3× their cells' mean while T falls to 0 across the horizon's cells. Over still water the
+    cones' mean is then the continuum's, ∫ L cosθ T e^{−cD/cosθ_w} dΩ, but for the path's
+    attenuation across a cell (within 0.3–1 % at K = 8–64 and an 80°–85° sun, docs/physics.md)."""
+    points, nearest = _partition(directions, points_per_cell)
+    radiance = np.ones(len(points))
+    if sky_type is not None:
+        radiance = cie_relative_radiance(sky_type, points, np.asarray(sun_direction, np.float64))
+    transmitted = radiance * fresnel_transmittance(points[:, 2], 1.0 / ior)
+    held = np.bincount(nearest, weights=transmitted, minlength=len(directions))
+    own = fresnel_transmittance(np.asarray(directions, np.float64)[:, 2], 1.0 / ior)
+    return held / (own * radiance.sum())
 
 
 def cell_multiplier(direction: np.ndarray, points: np.ndarray, weights: np.ndarray, count: int,

@@ -15,11 +15,14 @@ from warpcaustics.config import (
     Config,
     FloorShape,
     SkyModel,
+    SkySampling,
     WaterModel,
     config_from_dict,
     read_toml,
 )
-from warpcaustics.optics.sky import stratified_hemisphere
+from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance, stratified_hemisphere
+from warpcaustics.optics.sky_cells import cell_shares
+from warpcaustics.optics.spectra import bins_for, refractive_index
 from warpcaustics.scene.heights import DEFAULT_RESOLUTION, load_heights
 from warpcaustics.scene.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
 
@@ -82,7 +85,13 @@ class Scene:
         sky's cosine-weighted mean radiance (rather than over the drawn directions' sum, which
         would tie the halves), so each half is an unbiased estimate of the sky's continuum and the
         two halves' errors are independent (their shares' horizontal parts sum to ½ each in
-        expectation; exactly for ``uniform``)."""
+        expectation; exactly for ``uniform``).
+
+        With ``sky.sampling = "cones"`` each direction stands for its cell of the sky (the
+        directions nearest it, :mod:`~warpcaustics.optics.sky_cells`) and brings the cell's light:
+        what the cell transmits through still water, over the direction's own transmittance
+        (:func:`~warpcaustics.optics.sky_cells.cell_shares`), not its own radiance; those shares'
+        horizontal parts sum to 1 within a few per cent."""
         sky = self.config.sky
         count = sky.directions
         if rng is None:
@@ -92,10 +101,12 @@ class Scene:
             for half in range(2):
                 d[half::2] = stratified_hemisphere(count // 2, rng.random(), 2.0 * math.pi * rng.random())
         cos_t = d[:, 2]
-        if sky.model in (SkyModel.CIE, SkyModel.CIE_CLEAR):
-            from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance
-
-            sky_type = CIE_CLEAR_TYPE if sky.model is SkyModel.CIE_CLEAR else sky.cie_type
+        sky_type = {SkyModel.CIE_CLEAR: CIE_CLEAR_TYPE, SkyModel.CIE: sky.cie_type}.get(sky.model)
+        if rng is None and sky.sampling is SkySampling.CONES:
+            sun = tuple(float(x) for x in self.sun_direction)
+            ior = float(refractive_index(self.config.optics, bins_for(self.config.optics))[0])  # the cones'
+            return d, cell_shares(tuple(tuple(float(v) for v in x) for x in d), sky_type, sun, ior) / cos_t
+        if sky_type is not None:
             radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
             if rng is None:
                 return d, radiance / (radiance.sum() * cos_t)
@@ -181,7 +192,5 @@ def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None 
 def _cie_mean_radiance(sky_type: int, sun_direction: tuple[float, float, float]) -> float:
     """A CIE sky's cosine-weighted mean relative radiance over the hemisphere (4096 stratified
     directions), computed once per sky and sun rather than every frame."""
-    from warpcaustics.optics.sky import cie_relative_radiance
-
     dense = stratified_hemisphere(4096, 0.5, 0.0)
     return float(cie_relative_radiance(sky_type, dense, np.asarray(sun_direction)).mean())
