@@ -25,6 +25,21 @@ FLAT = {"water.model": "flat", "water.extent_m": 4.0, "water.resolution": 8, "ca
         "sky.diffuse_fraction": 0.3, "sky.sampling": "cones"}
 
 
+def sixteen_directions(overrides: dict) -> tuple[np.ndarray, tuple, tuple]:
+    """The SEA's 16 stratified sky directions (16, 3), the sun's direction and the directions as the
+    cells' cache key (tuples)."""
+    scene = wc.load_scene(None, {**SEA, "sky.directions": 16, **overrides})
+    directions, _ = scene.sky_directions()
+    return (directions, tuple(float(v) for v in scene.sun_direction),
+            tuple(tuple(float(v) for v in d) for d in directions))
+
+
+def cosine_weighted(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(sinθ, φ) of n cosine-weighted random directions: uniform in the projected disk."""
+    rng = np.random.default_rng(seed)
+    return np.sqrt(rng.random(n)), 2 * math.pi * rng.random(n)
+
+
 @pytest.mark.parametrize("sky_type", [None, 12])
 def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
     """B̂_j(k) against a Monte Carlo written apart: 400 000 cosine-weighted random directions (uniform
@@ -35,14 +50,9 @@ def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
     Monte Carlo's standard error is ≤ 0.006; the multiplier's own error is its dense set's 256
     points a cell, which cut the cells' edges coarsely: against 3 million samples it is ≤ 0.016 at
     the horizon's cell (0.008 with 1024 points a cell), ≤ 0.005 elsewhere."""
-    scene = wc.load_scene(None, {**SEA, "sky.directions": 16})
-    directions, _ = scene.sky_directions()
-    sun = scene.sun_direction
-    key = tuple(tuple(float(v) for v in d) for d in directions)
-    cells = sky_cells(key, sky_type, tuple(float(v) for v in sun), IOR)
-    rng = np.random.default_rng(7)
-    n = 400_000
-    r, phi = np.sqrt(rng.random(n)), 2 * math.pi * rng.random(n)
+    directions, sun, key = sixteen_directions({})
+    cells = sky_cells(key, sky_type, sun, IOR)
+    r, phi = cosine_weighted(400_000, 7)
     p = np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
     owner = np.argmin(((p[:, None, :] - directions[None, :, :2]) ** 2).sum(-1), axis=1)
     theta = np.arcsin(r)
@@ -82,14 +92,9 @@ def test_a_cells_share_is_the_light_its_directions_transmit():
     sky's whole radiance, within 0.006 (the Monte Carlo's standard error ≤ 0.001; the dense set's
     256 points a cell cut the cells' edges coarsely). The shares differ from the directions' own
     radiance over their sum by up to 2.5× at the horizon's brightest cell."""
-    scene = wc.load_scene(None, {**SEA, "sky.directions": 16, "sky.model": "cie_clear"})
-    directions, _ = scene.sky_directions()
-    sun = scene.sun_direction
-    key = tuple(tuple(float(v) for v in d) for d in directions)
-    shares = cell_shares(key, CIE_CLEAR_TYPE, tuple(float(v) for v in sun), IOR)
-    rng = np.random.default_rng(11)
-    n = 400_000
-    r, phi = np.sqrt(rng.random(n)), 2 * math.pi * rng.random(n)
+    directions, sun, key = sixteen_directions({"sky.model": "cie_clear"})
+    shares = cell_shares(key, CIE_CLEAR_TYPE, sun, IOR)
+    r, phi = cosine_weighted(400_000, 11)
     up = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - r * r)], axis=1)
     owner = np.argmin(((up[:, None, :2] - directions[None, :, :2]) ** 2).sum(-1), axis=1)
     radiance = cie_relative_radiance(CIE_CLEAR_TYPE, up, sun)
@@ -129,10 +134,8 @@ def test_the_splatted_multiplier_is_the_sum_s():
     """Where the points' discs are under a few texels the multiplier comes from the points splatted on
     the grid (``SPLAT_ABOVE``): against the sum over points for three cells of 16 at 0.3, 1 and 3 m,
     within 0.05 at every frequency and 0.012 rms (measured ≤ 0.040 and 0.003–0.009)."""
-    scene = wc.load_scene(None, {**SEA, "sky.directions": 16})
-    directions, _ = scene.sky_directions()
-    key = tuple(tuple(float(v) for v in d) for d in directions)
-    cells = sky_cells(key, None, tuple(float(v) for v in scene.sun_direction), IOR)
+    directions, sun, key = sixteen_directions({})
+    cells = sky_cells(key, None, sun, IOR)
     for depth, texel, m in ((3.0, 0.02, 128), (1.0, 0.01, 128), (0.3, 0.004, 256)):
         for j in (0, 8, 15):
             summed = dense(cell_multiplier(directions[j], *cells[j], 16, depth, IOR, texel, m,
