@@ -104,7 +104,8 @@ class Scene:
         sky_type = {SkyModel.CIE_CLEAR: CIE_CLEAR_TYPE, SkyModel.CIE: sky.cie_type}.get(sky.model)
         if rng is None and sky.sampling is SkySampling.CONES:
             sun = tuple(float(x) for x in self.sun_direction)
-            ior = float(refractive_index(self.config.optics, bins_for(self.config.optics))[0])  # the cones'
+            # the first bin's index, as SkyCones (caustics/sky_cones.py) spreads the cells with it
+            ior = float(refractive_index(self.config.optics, bins_for(self.config.optics))[0])
             return d, cell_shares(tuple(tuple(float(v) for v in x) for x in d), sky_type, sun, ior) / cos_t
         if sky_type is not None:
             radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
