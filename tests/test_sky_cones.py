@@ -11,7 +11,7 @@ import warpcaustics as wc
 from warpcaustics.batch.stats import cross_band_power
 from warpcaustics.errors import ConfigError
 from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance
-from warpcaustics.optics.sky_cells import cell_multiplier, cell_shares, dense, sky_cells
+from warpcaustics.optics.sky_cells import cell_key, cell_multiplier, cell_shares, dense, sky_cells
 
 from helpers import fresnel_t_angles
 
@@ -30,8 +30,7 @@ def sixteen_directions(overrides: dict) -> tuple[np.ndarray, tuple, tuple]:
     cells' cache key (tuples)."""
     scene = wc.load_scene(None, {**SEA, "sky.directions": 16, **overrides})
     directions, _ = scene.sky_directions()
-    return (directions, tuple(float(v) for v in scene.sun_direction),
-            tuple(tuple(float(v) for v in d) for d in directions))
+    return directions, cell_key(scene.sun_direction), cell_key(directions)
 
 
 def cosine_weighted(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

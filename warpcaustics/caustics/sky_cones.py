@@ -10,9 +10,9 @@ import numpy as np
 
 from warpcaustics.caustics.cache import BoundedCache
 from warpcaustics.caustics.window import MapWindow
-from warpcaustics.config import Config, SkyModel
-from warpcaustics.optics.sky import CIE_CLEAR_TYPE
-from warpcaustics.optics.sky_cells import cell_multiplier, dense, sky_cells
+from warpcaustics.config import Config
+from warpcaustics.optics.sky import cie_sky_type
+from warpcaustics.optics.sky_cells import cell_key, cell_multiplier, dense, sky_cells
 from warpcaustics.optics.small_angle import transferred
 
 CACHE_BYTES = 256 << 20
@@ -39,9 +39,9 @@ class SkyCones:
 
     def __init__(self, cfg: Config, directions: np.ndarray, sun_direction: np.ndarray, ior: float):
         sky = cfg.sky
-        self.sky_type = {SkyModel.CIE_CLEAR: CIE_CLEAR_TYPE, SkyModel.CIE: sky.cie_type}.get(sky.model)
-        self.directions = tuple(tuple(round(float(v), 12) for v in d) for d in np.asarray(directions))
-        self.sun = tuple(round(float(v), 12) for v in np.asarray(sun_direction, np.float64))
+        self.sky_type = cie_sky_type(sky)
+        self.directions = cell_key(directions)
+        self.sun = cell_key(sun_direction)
         self.ior = float(ior)
         self.depth_m = float(cfg.floor.depth_m)
         self.window = MapWindow(cfg)

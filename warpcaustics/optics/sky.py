@@ -27,6 +27,14 @@ CIE_CLEAR_TYPE = 12
 """``sky.model = "cie_clear"``: the CIE standard clear sky of low turbidity (type 12)."""
 
 
+def cie_sky_type(sky) -> int | None:
+    """The CIE standard general sky's type that a sky config (``cfg.sky``) draws: ``CIE_CLEAR_TYPE``
+    for ``cie_clear``, ``sky.cie_type`` for ``cie``; None for a uniform sky or none."""
+    from warpcaustics.config import SkyModel
+
+    return {SkyModel.CIE_CLEAR: CIE_CLEAR_TYPE, SkyModel.CIE: sky.cie_type}.get(sky.model)
+
+
 @dataclass(frozen=True)
 class CieSkyType:
     number: int

@@ -70,6 +70,15 @@ def floor_offsets(directions: np.ndarray, ior: float) -> tuple[np.ndarray, np.nd
     return t, jacobian
 
 
+def cell_key(vectors: np.ndarray) -> tuple:
+    """Unit vectors (…, 3) as the cells' cache key: nested tuples rounded to 12 digits, so that the
+    same sky from the scene and from the renderer shares one entry."""
+    a = np.asarray(vectors, np.float64)
+    if a.ndim == 1:
+        return tuple(round(float(v), 12) for v in a)
+    return tuple(cell_key(v) for v in a)
+
+
 @functools.lru_cache(maxsize=16)
 def _partition(directions: tuple, points_per_cell: int) -> tuple[np.ndarray, np.ndarray]:
     """(the dense stratified set (K × ``points_per_cell``, 3), (…,) the index of the direction of

@@ -14,14 +14,13 @@ import numpy as np
 from warpcaustics.config import (
     Config,
     FloorShape,
-    SkyModel,
     SkySampling,
     WaterModel,
     config_from_dict,
     read_toml,
 )
-from warpcaustics.optics.sky import CIE_CLEAR_TYPE, cie_relative_radiance, stratified_hemisphere
-from warpcaustics.optics.sky_cells import cell_shares
+from warpcaustics.optics.sky import cie_relative_radiance, cie_sky_type, stratified_hemisphere
+from warpcaustics.optics.sky_cells import cell_key, cell_shares
 from warpcaustics.optics.spectra import bins_for, refractive_index
 from warpcaustics.scene.heights import DEFAULT_RESOLUTION, load_heights
 from warpcaustics.scene.receivers import load_floor_relief, load_receiver_mesh, receiver_albedos
@@ -101,12 +100,11 @@ class Scene:
             for half in range(2):
                 d[half::2] = stratified_hemisphere(count // 2, rng.random(), 2.0 * math.pi * rng.random())
         cos_t = d[:, 2]
-        sky_type = {SkyModel.CIE_CLEAR: CIE_CLEAR_TYPE, SkyModel.CIE: sky.cie_type}.get(sky.model)
+        sky_type = cie_sky_type(sky)
         if rng is None and sky.sampling is SkySampling.CONES:
-            sun = tuple(float(x) for x in self.sun_direction)
             # the first bin's index, as SkyCones (caustics/sky_cones.py) spreads the cells with it
             ior = float(refractive_index(self.config.optics, bins_for(self.config.optics))[0])
-            return d, cell_shares(tuple(tuple(float(v) for v in x) for x in d), sky_type, sun, ior) / cos_t
+            return d, cell_shares(cell_key(d), sky_type, cell_key(self.sun_direction), ior) / cos_t
         if sky_type is not None:
             radiance = cie_relative_radiance(sky_type, d, self.sun_direction)
             if rng is None:

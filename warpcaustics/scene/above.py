@@ -21,7 +21,7 @@ import math
 import numpy as np
 import warp as wp
 
-from warpcaustics.config import CausticsMethod, Config, SkyModel
+from warpcaustics.config import CausticsMethod, Config
 from warpcaustics.kernels.scene import camera as camera_kernels
 from warpcaustics.kernels.scene.camera import above as above_kernels
 from warpcaustics.optics.phase import PhaseFunction
@@ -88,11 +88,9 @@ class AboveWaterCamera:
         self.attenuation = np.asarray(light.attenuation_per_m, np.float64)
         self.sky_irradiance = sky_irradiance
         sky = cfg.sky
-        self.sky_type = None
-        if sky.model in (SkyModel.CIE, SkyModel.CIE_CLEAR):
-            from warpcaustics.optics.sky import CIE_CLEAR_TYPE
+        from warpcaustics.optics.sky import cie_sky_type
 
-            self.sky_type = CIE_CLEAR_TYPE if sky.model is SkyModel.CIE_CLEAR else sky.cie_type
+        self.sky_type = cie_sky_type(sky)
         self.samples = cfg.camera.shaft_samples
         self.scattering_per_m = wp.array(np.asarray(scattering_per_m, np.float32), dtype=wp.float32,
                                          device=device)
