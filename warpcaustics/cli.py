@@ -115,8 +115,8 @@ def _parser() -> argparse.ArgumentParser:
                     help="the scene of its conditions, e.g. configs/field/gernez2009.toml")
     fd.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
     fd.add_argument("--series", metavar="S",
-                    help="gernez2009: comma-separated: zenith (CV vs the sun's zenith), wind (CV vs √wind); "
-                         "default both")
+                    help="gernez2009: comma-separated of zenith, wind (CV vs √wind), overcast, water (CV vs "
+                         "Kd(490), the Jerlov types); default zenith,wind")
     fd.add_argument("--zeniths", metavar="LIST",
                     help="gernez2009: only these measured sun zeniths [deg], comma-separated (default all)")
     fd.add_argument("--sqrt-winds", metavar="LIST",

@@ -3,8 +3,9 @@
 Gernez, P. and Antoine, D. (2009), "Field characterization of wave-induced underwater light field
 fluctuations", J. Geophys. Res. 114, C06025, measured the coefficient of variation (CV = std/mean)
 of the downwelling irradiance at 510 nm, 2.7-3.7 m deep, with an 8 mm collector, at the BOUSSOLE
-buoy under clear skies, against the sun's zenith angle (their Fig. 8a) and against the wind
-(Fig. 8c). The measured values, and the diffuse share of the sky they print along Fig. 8a, come
+buoy under clear skies, against the sun's zenith angle (their Fig. 8a), against the wind (Fig. 8c)
+and against the water's Kd(490) (Fig. 8, the ``water`` series: the model in the Jerlov types). The
+measured values, and the diffuse share of the sky they print along Fig. 8a, come
 from the ``jerlov`` package (``gernez2009_cv_by_sun_zenith``, ``gernez2009_cv_by``,
 ``gernez2009_diffuse_share``), which read them off the figures and records how.
 
@@ -28,7 +29,7 @@ sun, where most of the variance lies at scales above the window, left it several
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 from pathlib import Path
 
@@ -47,13 +48,14 @@ from warpcaustics.batch.field.common import (
     render_points,
     with_background,
 )
-from warpcaustics.config import Scattering, SkyModel
+from warpcaustics.config import Scattering, SkyModel, WaterType
 from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
-SERIES = ("zenith", "wind", "overcast")
+SERIES = ("zenith", "wind", "overcast", "water")
 """zenith: Fig. 8a, CV against the sun's zenith under clear skies; wind: Fig. 8c, against √wind;
-overcast: Fig. 7a, against the sun's zenith under overcast skies (the sky's light alone)."""
+overcast: Fig. 7a, against the sun's zenith under overcast skies (the sky's light alone); water:
+Fig. 8, against the water's Kd(490), the model in the Jerlov types (:data:`WATER_TYPES`)."""
 
 DEFAULT_SERIES = ("zenith", "wind")
 """The series run unless ``--series`` names others: the clear skies of the paper's Fig. 8."""
@@ -69,6 +71,13 @@ compares the sky's part of the map alone (run.json's ``sky_irradiance_w_m2``).""
 WIND_SERIES_ZENITH_DEG = 40.0
 """Sun zenith of the wind series. The paper's Fig. 8c pools all zeniths; 40° is our choice, near the
 middle of the 20-85° range it reports."""
+
+WATER_TYPES = ("I", "IA", "IB", "II", "III")
+"""The water series' waters: the oceanic Jerlov types, whose Kd(490) (Jerlov 1976, from the ``jerlov``
+package: 0.023-0.115 1/m) spans the paper's classes (0.025-0.145); the model takes each type's a and
+b (``optics.jerlov_source``) at the wind series' sun zenith and the scene's wind. The paper's classes
+pool every sun zenith and wind, so the series compares how the CV falls as the water grows turbid;
+its level is the zenith and wind series' question."""
 
 MIN_SQRT_WIND = 1.2
 """The wind series starts at the class √U = 1.2 (1.44 m/s): below it a wind sea is nearly flat,
@@ -91,7 +100,7 @@ all of the wind series' (at 13 m/s over 20 km of fetch the peak is 25 m long; wa
 carry none of the variance). At a low sun their tilts decide the light (docs/validation.md)."""
 
 POINT_KEYS = ("sun.elevation_deg", "sky.diffuse_fraction", "water.wind_speed_m_s", "sky.model",
-              "sky.cie_type")
+              "sky.cie_type", "optics.water_type")
 """The keys a point may set (Point.overrides): a --set of one that the chosen points set would be
 overwritten (the sky's model and type only by the overcast series: the clear series take the
 scene's, which a row of the error budget sets)."""
@@ -108,11 +117,17 @@ class Point:
     diffuse_fraction: float
     measured_cv: float
     measured_cv_sd: float
+    water_type: str | None = None
+    """The water series' Jerlov type, ``optics.water_type``'s value (None: the scene's water)."""
+    kd490_per_m: float | None = None
+    """The water series' Kd(490) of that type [1/m], where the measured CV is read."""
 
     def overrides(self) -> dict:
         out = {"sun.elevation_deg": 90.0 - self.sun_zenith_deg, "sky.diffuse_fraction": self.diffuse_fraction}
         if self.wind_m_s is not None:
             out["water.wind_speed_m_s"] = self.wind_m_s
+        if self.water_type is not None:
+            out["optics.water_type"] = self.water_type
         if self.series == "overcast":
             out.update(OVERCAST_SKY)
         return out
@@ -147,6 +162,27 @@ def gernez2009_points(series: tuple[str, ...] = DEFAULT_SERIES) -> list[Point]:
         by_zenith = jerlov.gernez2009_cv_by("sun_zenith_deg", sky="overcast")
         for z, cv, sd in zip(by_zenith.x, by_zenith.cv, by_zenith.cv_sd):
             points.append(Point("overcast", float(z), None, OVERCAST_DIFFUSE_FRACTION, float(cv), float(sd)))
+    if "water" in series:
+        points += water_points()
+    return points
+
+
+def water_points() -> list[Point]:
+    """The water series: each Jerlov type of :data:`WATER_TYPES` at its Kd(490) (Jerlov 1976), the
+    measured CV (and its standard deviation) linear in Kd(490) between the medians of the paper's
+    classes (0.01 1/m wide, at their centres; held at the first class's below its centre), at the
+    wind series' sun zenith and the scene's wind."""
+    import jerlov
+
+    by_kd = jerlov.gernez2009_cv_by("kd490_per_m")
+    has_sd = ~np.isnan(by_kd.cv_sd)  # two classes print no spread
+    f = diffuse_fraction(WIND_SERIES_ZENITH_DEG)
+    points = []
+    for name in WATER_TYPES:
+        kd = float(jerlov.water(name, source="jerlov1976").kd(490.0))
+        cv = float(np.interp(kd, by_kd.x, by_kd.cv))
+        sd = float(np.interp(kd, by_kd.x[has_sd], by_kd.cv_sd[has_sd]))
+        points.append(Point("water", WIND_SERIES_ZENITH_DEG, None, f, cv, sd, f"jerlov_{name}", kd))
     return points
 
 
@@ -154,8 +190,8 @@ def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
                   sqrt_winds: tuple[float, ...] | None) -> list[Point]:
     """The points of the zenith and overcast series at ``zeniths`` [deg] and of the wind series at
     ``sqrt_winds`` [√(m/s)] (None: all of that series); a value the record does not hold is an error
-    naming them."""
-    chosen = []
+    naming them. The water series is kept whole."""
+    chosen = [p for p in points if p.series == "water"]
     flags = ((("zenith", "overcast"), zeniths, lambda p: p.sun_zenith_deg, "--zeniths"),
              (("wind",), sqrt_winds, lambda p: math.sqrt(p.wind_m_s), "--sqrt-winds"))
     for series, wanted, key, flag in flags:
@@ -219,10 +255,11 @@ def run_gernez2009(
     points = select_points(gernez2009_points(series), zeniths, sqrt_winds)
     if not points:
         raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
-    check_overrides(overrides, tuple({k for p in points for k in p.overrides()}), "--zeniths / --sqrt-winds")
+    check_overrides(overrides, tuple({k for p in points for k in p.overrides()}),
+                    "--zeniths / --sqrt-winds / --series")
     if quick:  # the first and last zenith, the first wind, the first overcast zenith
         ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1],
-                "overcast": lambda ps: ps[:1]}
+                "overcast": lambda ps: ps[:1], "water": lambda ps: ps[:1] + ps[1:][-1:]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
     long_fixed = long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
     overrides, variants = point_variants(points, base.config)
@@ -313,13 +350,15 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
 
     bins = bins_for(config.optics)
     band = int(np.argmin(np.abs(bins.centres_nm - 510.0)))
-    b = float(water_optics(config.optics, bins).scattering_per_m[band])
     rows = []
     for point, o in zip(points, overrides):
         stats = frame_statistics_of(*fine, o)
+        water = WaterType(o.get("optics.water_type", config.optics.water_type))
+        optics = replace(config.optics, water_type=water)
         # a map that holds the scattered light already (optics.scattering = "small_angle") adds none
         t = 1.0
         if config.optics.scattering is Scattering.SINGLE:
+            b = float(water_optics(optics, bins).scattering_per_m[band])
             t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
         overcast = point.series == "overcast"
         window = _columns(stats, t, overcast=overcast)
@@ -344,6 +383,8 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
                 "wind_m_s": round(wind, 4),
                 "sqrt_wind": round(math.sqrt(wind), 4),
                 "diffuse_fraction": round(point.diffuse_fraction, 4),
+                "water_type": optics.water_type.value,
+                "kd490_per_m": point.kd490_per_m,
                 "measured_cv": round(point.measured_cv, 4),
                 "measured_cv_sd": round(point.measured_cv_sd, 4),
                 **{name: round(cvs[name], 4) if name in cvs else None for name in CV_COLUMNS},
@@ -369,8 +410,14 @@ PLOT_NEEDS = "the comparison's plot needs"
 
 TITLES = {"zenith": "clear sky: CV at 510 nm, 3.2 m, 8 mm collector",
           "wind": f"clear sky: CV against the wind, sun zenith {WIND_SERIES_ZENITH_DEG:g}°",
-          "overcast": "overcast sky (CIE type 1): the sky's light alone"}
+          "overcast": "overcast sky (CIE type 1): the sky's light alone",
+          "water": f"clear sky: CV against Kd(490), Jerlov I-III, sun zenith {WIND_SERIES_ZENITH_DEG:g}°"}
 """Each series' panel."""
+
+X_COLUMNS = {"wind": "sqrt_wind", "water": "kd490_per_m"}
+X_LABELS = {"wind": "√(wind speed) [√(m/s)]",
+            "water": "Kd(490) [1/m] (the paper's classes; the model's Jerlov types)"}
+"""Each series' abscissa other than the sun's zenith."""
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:
@@ -379,7 +426,7 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
     fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 4.2), squeeze=False)
     for ax, s in zip(axes[0], series):
         rs = [r for r in rows if r["series"] == s]
-        x = [r["sqrt_wind"] if s == "wind" else r["sun_zenith_deg"] for r in rs]
+        x = [r[X_COLUMNS.get(s, "sun_zenith_deg")] for r in rs]
         ax.errorbar(x, [r["measured_cv"] for r in rs], yerr=[r["measured_cv_sd"] for r in rs], fmt="ko",
                     capsize=3, label="Gernez & Antoine 2009 (median ± sd)")
         ax.errorbar(x, [r["model_cv"] for r in rs], yerr=[r["model_cv_frame_sd"] for r in rs], fmt="s-",
@@ -396,7 +443,11 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
                 continue  # the window is the model
             if all(r[column] is not None for r in rs):
                 ax.plot(x, [r[column] for r in rs], style, color=colour, mfc="none", label=label)
-        ax.set_xlabel("√(wind speed) [√(m/s)]" if s == "wind" else "sun zenith angle [deg]")
+        if s == "water":  # name each model point's Jerlov type
+            for xi, r in zip(x, rs):
+                ax.annotate(r["water_type"].removeprefix("jerlov_"), (xi, r["model_cv"]), fontsize=8,
+                            textcoords="offset points", xytext=(4, 4))
+        ax.set_xlabel(X_LABELS.get(s, "sun zenith angle [deg]"))
         ax.set_title(TITLES[s])
         ax.set_ylabel("CV of downwelling irradiance")
         ax.set_ylim(bottom=0.0)
