@@ -257,7 +257,7 @@ def run_gernez2009(
         raise ConfigError("--zeniths / --sqrt-winds chose no point of the record: name at least one")
     check_overrides(overrides, tuple({k for p in points for k in p.overrides()}),
                     "--zeniths / --sqrt-winds / --series")
-    if quick:  # the first and last zenith, the first wind, the first overcast zenith
+    if quick:  # the first and last zenith, the first wind, the first overcast zenith, the two end waters
         ends = {"zenith": lambda ps: ps[:1] + ps[1:][-1:], "wind": lambda ps: ps[:1],
                 "overcast": lambda ps: ps[:1], "water": lambda ps: ps[:1] + ps[1:][-1:]}
         points = [p for s in series for p in ends[s]([q for q in points if q.series == s])]
