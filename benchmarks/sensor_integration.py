@@ -16,11 +16,12 @@ series); ``dt`` = 1/120 s, checked against 1/240 s at 20°. Frames ``--frames`` 
 ``--configured`` starts from the config as it is instead of ``BEFORE``, ``--set KEY=VALUE`` changes
 it further (converged cells: ``--set water.extent_m=8.0 --set water.resolution=2048``).
 
-``--series SECONDS``: the buoy's own statistic instead — E(t) sampled at 6 Hz for SECONDS at 8 × 8
-points of the window, its CV per point (median, 10th and 90th percentiles, and all samples pooled)
-beside the spatial CV of the same maps: when do the two agree? Also the period of the strongest
-fluctuation (the points' mean periodogram's peak; the paper's T_max, in the `jerlov` record) and
-the CV left after running means of 0.5, 1 and 2 s of the samples (what a slow sensor would read).
+``--series SECONDS`` (``--configured`` and ``--set`` as above): the buoy's own statistic instead —
+E(t) sampled at 6 Hz for SECONDS at 8 × 8 points of the window, its CV per point (median, 10th and
+90th percentiles, and all samples pooled) beside the spatial CV of the same maps: when do the two
+agree? Also the period of the strongest fluctuation (the points' mean periodogram's peak; the
+paper's T_max, in the `jerlov` record) and the CV left after running means of 0.5, 1 and 2 s of the
+samples (what a slow sensor would read).
 """
 
 from __future__ import annotations
@@ -96,12 +97,14 @@ def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, start: dict
     return rows
 
 
-def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quick: bool) -> dict:
+def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quick: bool,
+                start: dict | None = None, extra: dict | None = None) -> dict:
     """The buoy's statistic beside the model's: the CV of E(t) at ``probes``² points of the window
     (the collector-averaged map sampled at ``rate_hz`` for ``seconds``; the median over points and
     the CV of all samples pooled) against the spatial CV of the same maps pooled — equal for a
-    stationary, homogeneous sea once the record is long against the pattern's correlation time."""
-    renderer, cfg, texel, collector = field_window(zenith, quick)
+    stationary, homogeneous sea once the record is long against the pattern's correlation time.
+    ``start`` and ``extra``: as :func:`field_window`'s."""
+    renderer, cfg, texel, collector = field_window(zenith, quick, start, extra)
     m = cfg.caustics.map_resolution
     at = ((np.arange(probes) + 0.5) * m / probes).astype(int)  # probes spread evenly over the window
     start = time.perf_counter()
@@ -169,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.series > 0.0:
         for zenith in args.zeniths.split(","):
-            time_series(float(zenith), args.series, 6.0, 8, False)
+            time_series(float(zenith), args.series, 6.0, 8, False, start, extra)
         return 0
     measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False,
             start, extra)
