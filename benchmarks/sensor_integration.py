@@ -118,24 +118,32 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
     series = np.array(samples)  # (time, point)
     per_point = series.std(axis=0) / series.mean(axis=0)
     p10, p50, p90 = np.percentile(per_point, [10, 50, 90])
-    # the period of the strongest fluctuation (Gernez & Antoine's T_max): the peak of the points'
-    # mean periodogram, the mean removed
-    power = np.mean(np.abs(np.fft.rfft(series - series.mean(axis=0), axis=0)) ** 2, axis=1)
-    freq = np.fft.rfftfreq(series.shape[0], 1.0 / rate_hz)
     row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
            "cv_time_median": float(p50), "cv_time_p10": float(p10), "cv_time_p90": float(p90),
            "cv_time_pooled": float(series.std() / series.mean()),
            "cv_spatial": float(pooled_statistics(spatial)[1]),
-           "peak_period_s": float(1.0 / freq[1 + np.argmax(power[1:])])}
+           "peak_period_s": peak_period(series, rate_hz)}
     # the CV left after a running mean of the 6 Hz samples over n of them (a sensor's response of
-    # n/rate seconds, sampled as the buoy sampled: a coarse stand-in for a continuous average)
-    for n in (3, 6, 12):
+    # n/rate seconds, sampled as the buoy sampled: a coarse stand-in for a continuous average), and
+    # the period of its strongest fluctuation
+    for n in (2, 3, 6, 12):
+        if series.shape[0] < n + 2:  # too short a record to smooth over n (--quick)
+            continue
         kernel = np.ones(n) / n
         smooth = np.apply_along_axis(lambda x, k=kernel: np.convolve(x, k, mode="valid"), 0, series)
-        row[f"cv_time_mean_{n / rate_hz:g}s"] = float(np.median(smooth.std(axis=0) / smooth.mean(axis=0)))
+        row[f"cv_time_mean_{n / rate_hz:.3g}s"] = float(np.median(smooth.std(axis=0) / smooth.mean(axis=0)))
+        row[f"peak_period_mean_{n / rate_hz:.3g}s"] = peak_period(smooth, rate_hz)
     row["wall_s"] = time.perf_counter() - start
     _print(row)
     return row
+
+
+def peak_period(series: np.ndarray, rate_hz: float) -> float:
+    """The period [s] of the strongest fluctuation of (time, point) samples: the peak of the points'
+    mean periodogram, each point's mean removed (Gernez & Antoine's T_max)."""
+    power = np.mean(np.abs(np.fft.rfft(series - series.mean(axis=0), axis=0)) ** 2, axis=1)
+    freq = np.fft.rfftfreq(series.shape[0], 1.0 / rate_hz)
+    return float(1.0 / freq[1 + np.argmax(power[1:])])
 
 
 def _print(row: dict) -> None:
