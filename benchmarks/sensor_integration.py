@@ -20,8 +20,8 @@ it further (converged cells: ``--set water.extent_m=8.0 --set water.resolution=2
 E(t) sampled at 6 Hz for SECONDS at 8 × 8 points of the window, its CV per point (median, 10th and
 90th percentiles, and all samples pooled) beside the spatial CV of the same maps: when do the two
 agree? Also the period of the strongest fluctuation (the points' mean periodogram's peak; the
-paper's T_max, in the `jerlov` record) and the CV left after running means of 0.5, 1 and 2 s of the
-samples (what a slow sensor would read).
+paper's T_max, in the `jerlov` record) and the CV and that period left after running means of 1/3,
+1/2, 1 and 2 s of the samples (what a slow sensor would read).
 """
 
 from __future__ import annotations
