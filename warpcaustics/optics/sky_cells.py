@@ -92,16 +92,26 @@ def _partition(directions: tuple, points_per_cell: int) -> tuple[np.ndarray, np.
 
 
 @functools.lru_cache(maxsize=16)
+def _cell_light(directions: tuple, sky_type: int | None, sun_direction: tuple, ior: float,
+                points_per_cell: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The partition's points and cells (:func:`_partition`), the sky's relative radiance L at each
+    point (CIE type ``sky_type``, None: uniform, 1) and what it transmits into water of ``ior``
+    through a flat surface, L T: the one computation behind the cells' spreads and their shares."""
+    points, nearest = _partition(directions, points_per_cell)
+    radiance = np.ones(len(points))
+    if sky_type is not None:
+        radiance = cie_relative_radiance(sky_type, points, np.asarray(sun_direction, np.float64))
+    return points, nearest, radiance, radiance * fresnel_transmittance(points[:, 2], 1.0 / ior)
+
+
+@functools.lru_cache(maxsize=16)
 def sky_cells(directions: tuple, sky_type: int | None, sun_direction: tuple, ior: float,
               points_per_cell: int = POINTS_PER_CELL) -> tuple:
     """Per direction of ``directions`` (K tuples of 3, cosine-weighted stratified): (its cell's
     points (S_j, 3), their weights (S_j,)): the points of a stratified set of K × ``points_per_cell``
     nearest it in the projected disk, weighted by the sky's relative radiance (CIE type
     ``sky_type``, None: uniform) and the flat surface's Fresnel transmittance into water of ``ior``."""
-    points, nearest = _partition(directions, points_per_cell)
-    weight = fresnel_transmittance(points[:, 2], 1.0 / ior)
-    if sky_type is not None:
-        weight = weight * cie_relative_radiance(sky_type, points, np.asarray(sun_direction, np.float64))
+    points, nearest, _, weight = _cell_light(directions, sky_type, sun_direction, ior, points_per_cell)
     return tuple((points[nearest == j], weight[nearest == j]) for j in range(len(directions)))
 
 
@@ -121,11 +131,7 @@ def cell_shares(directions: tuple, sky_type: int | None, sun_direction: tuple, i
     is 2.5–3× their cells' mean while T falls to 0 across the horizon's cells. Over still water the
     cones' mean is then the continuum's, ∫ L cosθ T e^{−cD/cosθ_w} dΩ, but for the path's
     attenuation across a cell (within 0.3–1 % at K = 8–64 and an 80°–85° sun, docs/physics.md)."""
-    points, nearest = _partition(directions, points_per_cell)
-    radiance = np.ones(len(points))
-    if sky_type is not None:
-        radiance = cie_relative_radiance(sky_type, points, np.asarray(sun_direction, np.float64))
-    transmitted = radiance * fresnel_transmittance(points[:, 2], 1.0 / ior)
+    _, nearest, radiance, transmitted = _cell_light(directions, sky_type, sun_direction, ior, points_per_cell)
     held = np.bincount(nearest, weights=transmitted, minlength=len(directions))
     own = fresnel_transmittance(np.asarray(directions, np.float64)[:, 2], 1.0 / ior)
     return held / (own * radiance.sum())

@@ -26,6 +26,7 @@ from warpcaustics.kernels.scene import camera as camera_kernels
 from warpcaustics.kernels.scene.camera import above as above_kernels
 from warpcaustics.optics.phase import PhaseFunction
 from warpcaustics.optics.refraction import still_water_refraction
+from warpcaustics.optics.sky import cie_sky_type, sky_radiance
 from warpcaustics.optics.snell import fresnel_transmittance
 from warpcaustics.scene.camera import pinhole
 from warpcaustics.scene.receivers import Receivers
@@ -87,10 +88,7 @@ class AboveWaterCamera:
         self.ray_ior = float(light.group_ior[0])
         self.attenuation = np.asarray(light.attenuation_per_m, np.float64)
         self.sky_irradiance = sky_irradiance
-        sky = cfg.sky
-        from warpcaustics.optics.sky import cie_sky_type
-
-        self.sky_type = cie_sky_type(sky)
+        self.sky_type = cie_sky_type(cfg.sky)
         self.samples = cfg.camera.shaft_samples
         self.scattering_per_m = wp.array(np.asarray(scattering_per_m, np.float32), dtype=wp.float32,
                                          device=device)
@@ -213,8 +211,6 @@ class AboveWaterCamera:
         (uniform, E_sun / Ω; a point sun draws none)."""
         out = np.zeros((len(self.sun_irradiance),) + directions.shape[:2])
         if self.sky_irradiance is not None:
-            from warpcaustics.optics.sky import sky_radiance
-
             sky = sky_radiance(self.sky_type, directions, self.sun_direction, self.sky_irradiance)
             out += np.moveaxis(sky, -1, 0)
         radius = 0.5 * math.radians(self.config.sun.angular_diameter_deg)
