@@ -310,3 +310,31 @@ def test_every_band_has_its_patch_windows():
         assert windows["cv"] == pytest.approx(fine.std() / fine.mean(), rel=1e-9), key
         total += windows["mean"] * r.bin_widths_nm[k]
     assert total == pytest.approx(s["irradiance_w_m2"]["patch_windows"]["mean"], rel=1e-9)
+
+
+def test_every_band_has_its_sky_and_direct_parts():
+    """stats.per_band under a sky: each band's sky part (``bands_sky``) and direct sun's
+    (``bands_direct``) have statistics of their own, whose means add up to the band's (1e-9), the
+    sky's being the mean of that band of RenderResult.sky_floor_irradiance after the collector
+    (numpy, 1e-9); and so do their ``patch_windows``, the sky's from the coarse sky map."""
+    from warpcaustics.batch.stats import collector_average, frame_statistics
+
+    scene = wc.load_scene(CONFIGS / "field" / "darecki2011.toml", {
+        "water.resolution": 64, "water.extent_m": 8.0, "caustics.map_resolution": 40,
+        "sun.disk_samples": 2, "sky.directions": 2, "optics.beam_spread": "wells"})
+    r = wc.render(scene, device="cpu")
+    s = frame_statistics(r, scene.config.stats)
+    assert list(s["bands_sky"]) == list(s["bands_direct"]) == list(s["bands"])
+    texel = r.map_extent_m / r.floor_irradiance.shape[-1]
+    for k, key in enumerate(s["bands"]):
+        band, sky, direct = s["bands"][key], s["bands_sky"][key], s["bands_direct"][key]
+        assert sky["mean"] + direct["mean"] == pytest.approx(band["mean"], rel=1e-9), key
+        own = collector_average(np.asarray(r.sky_floor_irradiance[k], np.float64), texel,
+                                scene.config.stats.collector_mm * 1e-3, periodic=r.map_periodic)
+        assert sky["mean"] == pytest.approx(own.mean(), rel=1e-9) and sky["cv"] == pytest.approx(
+            own.std() / own.mean(), rel=1e-6), key
+        assert 0.0 < sky["cv"] and 0.0 < direct["cv"], key
+        windows = [part["patch_windows"]["mean"] for part in (sky, direct, band)]
+        assert windows[0] + windows[1] == pytest.approx(windows[2], rel=1e-9), key
+        assert windows[0] == pytest.approx(float(np.mean(r.coarse_sky_floor_irradiance[k], dtype=np.float64)),
+                                           rel=1e-6), key

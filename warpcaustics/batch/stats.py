@@ -144,13 +144,29 @@ def window_means(coarse: np.ndarray, count: int) -> dict:
     return {"count": count * count, "mean": mean, "cv": float(means.std() / mean) if mean > 0.0 else 0.0}
 
 
-def patch_windows(result, views: dict | None = None) -> dict[str, dict]:
+def sky_parts(result, per_band: bool) -> dict:
+    """{field: a function of the (K, M, M) total and sky maps giving the field's (M, M) map}: the
+    band-integrated sky's part and the direct sun's (the rest), and with ``per_band`` each band's
+    (``bands_sky/…``, ``bands_direct/…``, keyed as ``bands/…``)."""
+    widths = result.bin_widths_nm
+    parts = {"sky_irradiance_w_m2": lambda total, sky: band_integrated(sky, widths),
+             "direct_irradiance_w_m2": (
+                 lambda total, sky: band_integrated(total, widths) - band_integrated(sky, widths))}
+    if per_band:
+        for k, nm in enumerate(result.wavelengths_nm):
+            parts[f"bands_sky/{nm:g}nm_w_m2_nm"] = lambda total, sky, k=k: np.asarray(sky[k], np.float64)
+            parts[f"bands_direct/{nm:g}nm_w_m2_nm"] = (
+                lambda total, sky, k=k: np.asarray(total[k], np.float64) - np.asarray(sky[k], np.float64))
+    return parts
+
+
+def patch_windows(result, views: dict | None = None, parts: dict | None = None) -> dict[str, dict]:
     """{field: :func:`window_means` of its coarse map of the whole patch} where the map is a window
     of a periodic sea whose side divides the patch's
     (:attr:`~warpcaustics.result.RenderResult.coarse_floor_irradiance`), else {}: for each of
     ``views`` ({field: a function of a (K, M, M) map giving the field's (M, M) map}, as
     :func:`frame_statistics` takes them; by default the band-integrated irradiance) and, with a sky,
-    the band-integrated sky and direct parts."""
+    each of ``parts`` (:func:`sky_parts`; by default the band-integrated sky and direct parts)."""
     coarse = result.coarse_floor_irradiance
     if coarse is None:
         return {}
@@ -161,21 +177,20 @@ def patch_windows(result, views: dict | None = None) -> dict[str, dict]:
     widths = result.bin_widths_nm
     views = views or {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     maps = {name: view(coarse) for name, view in views.items()}
-    if result.coarse_sky_floor_irradiance is not None:
-        total = maps.get("irradiance_w_m2")
-        if total is None:
-            total = band_integrated(coarse, widths)
-        maps["sky_irradiance_w_m2"] = band_integrated(result.coarse_sky_floor_irradiance, widths)
-        maps["direct_irradiance_w_m2"] = total - maps["sky_irradiance_w_m2"]
+    coarse_sky = result.coarse_sky_floor_irradiance
+    if coarse_sky is not None:
+        parts = sky_parts(result, per_band=False) if parts is None else parts
+        maps.update({name: part(coarse, coarse_sky) for name, part in parts.items()})
     return {name: window_means(f, count) for name, f in maps.items()}
 
 
 def frame_statistics(result, cfg: StatsConfig) -> dict:
     """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
     direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
-    band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``), after the
-    collector. Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each
-    of these but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
+    band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``; with a sky, each
+    band's sky and direct-sun parts too, ``bands_sky`` and ``bands_direct``), after the collector.
+    Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each of these
+    but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
     its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
     (:func:`continuous_sky_cv`). Where the map is a window of a periodic sea that tiles the patch,
     every field also has ``patch_windows``: the means over the whole patch's windows, from its
@@ -197,9 +212,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     fields = {name: view(result.floor_irradiance) for name, view in views.items()}
     sky = result.sky_floor_irradiance
     halves = {}  # field → (its sky part, the sky's even half)
+    parts = sky_parts(result, cfg.per_band)
     if sky is not None:  # the direct sun's part and the sky's, each alone
-        fields["sky_irradiance_w_m2"] = band_integrated(sky, widths)
-        fields["direct_irradiance_w_m2"] = fields["irradiance_w_m2"] - fields["sky_irradiance_w_m2"]
+        fields.update({name: part(result.floor_irradiance, sky) for name, part in parts.items()})
         even = result.sky_floor_irradiance_even
         if even is not None:
             halves = {name: (view(sky), view(even)) for name, view in views.items()}
@@ -215,7 +230,7 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
         "pdf_edges": PDF_EDGES.tolist(),
         "par_band_nm": covered,
     }
-    patch = patch_windows(result, views)
+    patch = patch_windows(result, views, parts)
     for name, f in fields.items():
         averaged = collector(f)
         stats = field_statistics(averaged, cfg.flash_threshold)
