@@ -408,13 +408,13 @@ def test_the_command_offers_every_registered_data_set_with_its_point_flags():
 
 
 def test_long_waves_is_a_flag_of_gernez2009_and_darecki2011(tmp_path, capsys):
-    """--long-waves reaches run_gernez2009's and run_darecki2011's long_waves_m; on another data set
-    it is a one-line error."""
+    """--long-waves reaches the long_waves_m of run_gernez2009, run_gernez2009_bands and
+    run_darecki2011; on another data set it is a one-line error."""
     from warpcaustics.cli import main
 
     assert main(["field", "darecki2011_wind", str(WIND), "--out", str(tmp_path / "o"),
                  "--long-waves", "64"]) == 2
-    assert ("--long-waves is a flag of gernez2009 and darecki2011, not of darecki2011_wind"
+    assert ("--long-waves is a flag of gernez2009, gernez2009_bands, darecki2011, not of darecki2011_wind"
             in capsys.readouterr().err)
     assert main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"),
                  "--long-waves", "16"]) == 2

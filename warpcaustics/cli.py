@@ -12,7 +12,7 @@ from warpcaustics import __version__
 from warpcaustics.batch.compare import FLOOR_METHODS
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
-FIELD_DATASETS = ("gernez2009", "darecki2011", "darecki2011_wind")
+FIELD_DATASETS = ("gernez2009", "gernez2009_bands", "darecki2011", "darecki2011_wind")
 """The names of ``warpcaustics.batch.field.DATASETS``, spelled here because importing that package
 costs 0.7 s (scipy) at every start of the command (tests/test_field.py checks that they agree)."""
 
@@ -118,7 +118,8 @@ def _parser() -> argparse.ArgumentParser:
                     help="gernez2009: comma-separated of zenith, wind (CV vs √wind), overcast, water (CV vs "
                          "Kd(490), the Jerlov types); default zenith,wind")
     fd.add_argument("--zeniths", metavar="LIST",
-                    help="gernez2009: only these measured sun zeniths [deg], comma-separated (default all)")
+                    help="gernez2009(_bands): only these measured sun zeniths [deg], comma-separated "
+                         "(default all)")
     fd.add_argument("--sqrt-winds", metavar="LIST",
                     help="gernez2009: only these measured √wind classes [√(m/s)], comma-separated")
     fd.add_argument("--depths", metavar="LIST",
@@ -127,11 +128,11 @@ def _parser() -> argparse.ArgumentParser:
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
     fd.add_argument("--long-waves", type=float, metavar="M",
-                    help="gernez2009, darecki2011: side [m] of a patch of the waves longer than the "
+                    help="gernez2009(_bands), darecki2011: side [m] of a patch of the waves longer than the "
                          "scene's, rendered too (default 128 and 0); 0: the scene's waves alone")
     fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
-                    help="seconds between a point's frames (default: gernez2009 2, darecki2011 and "
+                    help="seconds between a point's frames (default: gernez2009(_bands) 2, darecki2011 and "
                          "darecki2011_wind 5); "
                          "frames further apart than the waves' periods are independent samples")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
@@ -190,7 +191,7 @@ def _field(args: argparse.Namespace) -> int:
         common["frame_interval_s"] = args.frame_interval
     if args.long_waves is not None:
         if args.dataset not in LONG_WAVES_DATASETS:
-            raise ConfigError(f"--long-waves is a flag of {' and '.join(LONG_WAVES_DATASETS)}, not of "
+            raise ConfigError(f"--long-waves is a flag of {', '.join(LONG_WAVES_DATASETS)}, not of "
                               f"{args.dataset}")
         common["long_waves_m"] = args.long_waves
     paths = DATASETS[args.dataset](args.scene, args.out, **points, **common)

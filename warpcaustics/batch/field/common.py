@@ -157,3 +157,54 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     except ConfigError as exc:
         raise ConfigError(f"--long-waves = {extent_m:g} m: {exc}") from None
     return long
+
+
+def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list[list[dict]]:
+    """Per band of ``wavelengths_nm``, the statistics of every frame rendered at ``point``."""
+    stats = frame_statistics_of(sweep, out, point)
+    return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
+
+
+def band_row(band: list[dict], measured: float | None, longer: list[dict] | None = None) -> dict:
+    """One band's frames pooled, beside the measured CV (None: not measured there): the columns every
+    Darecki row shares. The model's CV is the whole patch's (within the window and between the
+    patch's windows, :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has
+    ``patch_windows``, nested with that of the waves longer than the patch (``longer``: their
+    frames' statistics, or None); ``model_cv_window`` is the window's frames pooled alone,
+    ``model_cv_patch`` the scene's patch and ``model_cv_long_waves`` the long waves' alone."""
+    window = [(b["mean"], b["cv"]) for b in band]
+    windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
+    _, cv_window = pooled_statistics(window)
+    patch = patch_variance(window, windows if len(windows) == len(band) else None)
+    cv_long = None if longer is None else pooled_statistics([(b["mean"], b["cv"]) for b in longer])[1]
+    cv = math.sqrt(patch) if cv_long is None else nested_cv(patch, cv_long**2)
+    return {
+        "model_cv": round(cv, 4),
+        "model_cv_window": round(cv_window, 4),
+        "model_cv_patch": round(math.sqrt(patch), 4),
+        "model_cv_long_waves": None if cv_long is None else round(cv_long, 4),
+        "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
+        "model_over_measured": None if measured is None else round(cv / measured, 3),
+        "model_cv_continuous_sky": continuous_sky(band),
+        "frames": len(band),
+    }
+
+
+def select_measured(have_values: np.ndarray, wanted: tuple[float, ...] | None, flag: str,
+                    what: str, *, unmeasured: bool = False) -> list[float]:
+    """The record's values (depths, winds) at ``wanted`` (None: all); one the record lacks is an
+    error naming ``flag``, unless ``unmeasured``: then ``wanted`` as asked, in increasing order
+    (positive; a duplicate once)."""
+    have = [float(d) for d in have_values]
+    if wanted is None:
+        return have
+    if unmeasured:
+        bad = [d for d in wanted if not (math.isfinite(d) and d > 0.0)]
+        if bad:
+            raise ConfigError(f"{flag}: {bad[0]:g} must be a {what} above 0, e.g. {flag} 0.5,1,2")
+        return sorted(set(float(d) for d in wanted))
+    for d in wanted:
+        if not any(abs(d - h) < 1e-6 for h in have):
+            raise ConfigError(f"{flag}: {d:g} is not a measured {what}; the record holds "
+                              + ", ".join(f"{h:g}" for h in have))
+    return [h for h in have if any(abs(d - h) < 1e-6 for d in wanted)]

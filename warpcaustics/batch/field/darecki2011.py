@@ -26,15 +26,13 @@ import numpy as np
 
 from warpcaustics.batch.field.common import (
     LONG_WAVES_FOLDER,
+    band_row,
+    band_statistics,
     check_frames,
     check_overrides,
-    continuous_sky,
-    frame_statistics_of,
     long_waves_overrides,
-    nested_cv,
-    patch_variance,
-    pooled_statistics,
     render_points,
+    select_measured,
 )
 from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
@@ -70,26 +68,6 @@ def beam_attenuation(config, wavelength_nm: float) -> float:
     optics = replace(config.optics, wavelengths=replace(config.optics.wavelengths, list_nm=(wavelength_nm,)))
     o = water_optics(optics, bins_for(optics))
     return float(o.absorption_per_m[0] + o.scattering_per_m[0])
-
-
-def select_measured(have_values: np.ndarray, wanted: tuple[float, ...] | None, flag: str,
-                    what: str, *, unmeasured: bool = False) -> list[float]:
-    """The record's values (depths, winds) at ``wanted`` (None: all); one the record lacks is an
-    error naming ``flag``, unless ``unmeasured``: then ``wanted`` as asked, in increasing order
-    (positive; a duplicate once)."""
-    have = [float(d) for d in have_values]
-    if wanted is None:
-        return have
-    if unmeasured:
-        bad = [d for d in wanted if not (math.isfinite(d) and d > 0.0)]
-        if bad:
-            raise ConfigError(f"{flag}: {bad[0]:g} must be a {what} above 0, e.g. {flag} 0.5,1,2")
-        return sorted(set(float(d) for d in wanted))
-    for d in wanted:
-        if not any(abs(d - h) < 1e-6 for h in have):
-            raise ConfigError(f"{flag}: {d:g} is not a measured {what}; the record holds "
-                              + ", ".join(f"{h:g}" for h in have))
-    return [h for h in have if any(abs(d - h) < 1e-6 for d in wanted)]
 
 
 def check_scene(config, rec) -> None:
@@ -196,37 +174,6 @@ def measured_index(have: np.ndarray, value: float) -> int | None:
     """The index of ``value`` in the record's ``have`` (None: not a measured value)."""
     k = int(np.argmin(np.abs(np.asarray(have, np.float64) - value)))
     return k if abs(float(have[k]) - value) < 1e-6 else None
-
-
-def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list[list[dict]]:
-    """Per band of ``wavelengths_nm``, the statistics of every frame rendered at ``point``."""
-    stats = frame_statistics_of(sweep, out, point)
-    return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
-
-
-def band_row(band: list[dict], measured: float | None, longer: list[dict] | None = None) -> dict:
-    """One band's frames pooled, beside the measured CV (None: not measured there): the columns every
-    Darecki row shares. The model's CV is the whole patch's (within the window and between the
-    patch's windows, :func:`~warpcaustics.batch.field.common.patch_variance`) where every frame has
-    ``patch_windows``, nested with that of the waves longer than the patch (``longer``: their
-    frames' statistics, or None); ``model_cv_window`` is the window's frames pooled alone,
-    ``model_cv_patch`` the scene's patch and ``model_cv_long_waves`` the long waves' alone."""
-    window = [(b["mean"], b["cv"]) for b in band]
-    windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
-    _, cv_window = pooled_statistics(window)
-    patch = patch_variance(window, windows if len(windows) == len(band) else None)
-    cv_long = None if longer is None else pooled_statistics([(b["mean"], b["cv"]) for b in longer])[1]
-    cv = math.sqrt(patch) if cv_long is None else nested_cv(patch, cv_long**2)
-    return {
-        "model_cv": round(cv, 4),
-        "model_cv_window": round(cv_window, 4),
-        "model_cv_patch": round(math.sqrt(patch), 4),
-        "model_cv_long_waves": None if cv_long is None else round(cv_long, 4),
-        "model_cv_frame_sd": round(float(np.std([b["cv"] for b in band])), 4),
-        "model_over_measured": None if measured is None else round(cv / measured, 3),
-        "model_cv_continuous_sky": continuous_sky(band),
-        "frames": len(band),
-    }
 
 
 def plot_profile(rows: list[dict], path: Path, quick: bool = False) -> None:

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from warpcaustics.batch.field.darecki2011 import PLOT_NEEDS, band_row, beam_attenuation, render_record
+from warpcaustics.batch.field.common import band_row
+from warpcaustics.batch.field.darecki2011 import PLOT_NEEDS, beam_attenuation, render_record
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 POINT_KEYS = ("water.wind_speed_m_s",)

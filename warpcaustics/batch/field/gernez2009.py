@@ -288,9 +288,8 @@ def point_variants(points: list[Point], config) -> tuple[list[dict], list[dict]]
 
 
 def _check_scene(config) -> None:
-    """The comparison needs one band at the paper's 510 nm (its CV is of that band), a sky that can
-    take the paper's diffuse share (uniform or a CIE sky, scaled to it) and a stateless sea (each
-    frame pooled is its own task)."""
+    """The comparison needs one band at the paper's 510 nm (its CV is of that band) and the
+    conditions of :func:`check_conditions`."""
     wl = config.optics.wavelengths
     one_band = (wl.list_nm == (510.0,)) or (
         not wl.list_nm and wl.bins == 1 and wl.min_nm <= 510.0 <= wl.max_nm
@@ -299,6 +298,12 @@ def _check_scene(config) -> None:
         raise ConfigError(
             "the Gernez 2009 comparison is of one band at 510 nm: set optics.wavelengths = [510.0]"
         )
+    check_conditions(config)
+
+
+def check_conditions(config) -> None:
+    """Every Gernez comparison needs a stateless sea (each frame pooled is its own task) and a sky
+    that can take the paper's diffuse share (uniform or a CIE sky, scaled to it)."""
     if config.water.stateful:
         raise ConfigError(
             f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
@@ -360,21 +365,9 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
         if config.optics.scattering is Scattering.SINGLE:
             b = float(water_optics(optics, bins).scattering_per_m[band])
             t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
-        overcast = point.series == "overcast"
-        window = _columns(stats, t, overcast=overcast)
-        windows = _columns(stats, t, overcast=overcast, key=lambda s: s.get("patch_windows"))
-        mean, cv_window = pooled_statistics(window["model_cv"])
-        per_frame = [c for _, c in window["model_cv"]]
-        # the scene's patch: within the window, and between the windows of the whole patch
-        patch = {name: patch_variance(frames, None if windows is None else windows[name])
-                 for name, frames in window.items()}
-        cvs = {name: math.sqrt(r) for name, r in patch.items()}
-        cv_long = None
-        if long is not None:  # and the waves longer than the patch
-            waves = _columns(frame_statistics_of(*long, o), t, overcast=overcast)
-            longer = {name: pooled_statistics(frames)[1] for name, frames in waves.items()}
-            cvs = {name: nested_cv(patch[name], longer[name] ** 2) for name in patch}
-            cv_long = round(longer["model_cv"], 4)
+        sea = whole_sea(stats, None if long is None else frame_statistics_of(*long, o), t,
+                        overcast=point.series == "overcast")
+        mean = sea.pop("model_mean_w_m2")
         wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s
         rows.append(
             {
@@ -387,11 +380,7 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
                 "kd490_per_m": point.kd490_per_m,
                 "measured_cv": round(point.measured_cv, 4),
                 "measured_cv_sd": round(point.measured_cv_sd, 4),
-                **{name: round(cvs[name], 4) if name in cvs else None for name in CV_COLUMNS},
-                "model_cv_window": round(cv_window, 4),
-                "model_cv_patch": round(math.sqrt(patch["model_cv"]), 4),
-                "model_cv_long_waves": cv_long,
-                "model_cv_frame_sd": round(float(np.std(per_frame)), 4),
+                **sea,
                 "model_cv_continuous_sky": continuous_sky([s["irradiance_w_m2"] for s in stats]),
                 "direct_transmission": round(t, 4),
                 "frames": len(stats),
@@ -399,6 +388,36 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
             }
         )
     return rows
+
+
+def whole_sea(stats: list[dict], longer: list[dict] | None, t: float, *, overcast: bool = False) -> dict:
+    """The model's columns at one point from its frames' statistics (``stats``: each frame's fields
+    :data:`STAT_FIELDS`) and, where rendered, the longer waves' (``longer``): each of
+    :data:`CV_COLUMNS` over the whole sea (:func:`_columns` with the sun's direct transmission ``t``,
+    pooled within the window and between the patch's windows, nested with the longer waves), the
+    window alone, the patch, the longer waves alone, the frames' spread of the window's CV and its
+    mean."""
+    window = _columns(stats, t, overcast=overcast)
+    windows = _columns(stats, t, overcast=overcast, key=lambda s: s.get("patch_windows"))
+    mean, cv_window = pooled_statistics(window["model_cv"])
+    # the scene's patch: within the window, and between the windows of the whole patch
+    patch = {name: patch_variance(frames, None if windows is None else windows[name])
+             for name, frames in window.items()}
+    cvs = {name: math.sqrt(r) for name, r in patch.items()}
+    cv_long = None
+    if longer is not None:  # and the waves longer than the patch
+        waves = _columns(longer, t, overcast=overcast)
+        pooled = {name: pooled_statistics(frames)[1] for name, frames in waves.items()}
+        cvs = {name: nested_cv(patch[name], pooled[name] ** 2) for name in patch}
+        cv_long = round(pooled["model_cv"], 4)
+    return {
+        **{name: round(cvs[name], 4) if name in cvs else None for name in CV_COLUMNS},
+        "model_cv_window": round(cv_window, 4),
+        "model_cv_patch": round(math.sqrt(patch["model_cv"]), 4),
+        "model_cv_long_waves": cv_long,
+        "model_cv_frame_sd": round(float(np.std([c for _, c in window["model_cv"]])), 4),
+        "model_mean_w_m2": mean,
+    }
 
 
 CV_COLUMNS = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered")
