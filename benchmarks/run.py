@@ -295,6 +295,9 @@ def main(argv: list[str] | None = None) -> int:
     # The field comparison's long waves against its scene's frame (benchmarks/long_waves.py).
     long_waves = _in_child("run", args.quick, args.device, module="long_waves")
 
+    # The Gernez comparison's six bands against its one (benchmarks/field_bands.py).
+    field_bands = _in_child("run", args.quick, args.device, module="field_bands")
+
     # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
     spectra = _in_child("run", args.quick, args.device, module="spectra")
 
@@ -336,6 +339,7 @@ def main(argv: list[str] | None = None) -> int:
         "small_angle": small_angle,
         "spectra": spectra,
         "long_waves": long_waves,
+        "field_bands": field_bands,
         "sweep": sweeps,
         "memory": memory,
     }

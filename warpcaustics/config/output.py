@@ -59,7 +59,8 @@ class StatsConfig:
     wavelength_nm: float | None = field(default=None, metadata=_range(100.0, 5000.0))
     """Also report the statistics of the band holding this wavelength (e.g. 510 nm) [nm]."""
     per_band: bool = False
-    """Also report the statistics of every band, each after the collector (run.json's ``bands``):
+    """Also report the statistics of every band, each after the collector (run.json's ``bands``;
+    with a sky, each band's sky and direct-sun parts too, ``bands_sky`` and ``bands_direct``):
     spectral CVs, e.g. Darecki et al. (2011)'s 443/532/670 nm."""
     probes: tuple[ProbeConfig, ...] = ()
     """Floor points whose irradiance over an animation is reported (``[[stats.probes]]`` tables
