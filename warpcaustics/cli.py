@@ -106,6 +106,21 @@ def _parser() -> argparse.ArgumentParser:
                         description="Print DIR/summary.csv and write DIR/summary.png.")
     rp.add_argument("out", metavar="DIR", help="the folder of a sweep")
 
+    _field_parser(sub)
+
+    cf = sub.add_parser("config", help="print a scene's resolved configuration (a dry run)",
+                        description="Validate CONFIG with its --set overrides and print every key with "
+                                    "its value as TOML; nothing is rendered or written.")
+    cf.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
+    _set_arg(cf)
+
+    sub.add_parser("info", help="versions and the devices Warp sees",
+                   description="Print package versions and the compute devices Warp can use.")
+    return p
+
+
+def _field_parser(sub) -> None:
+    """``warpcaustics field``: a data set, its scene and each data set's own point flags."""
     fd = sub.add_parser("field", help="compare the model with field measurements (Gernez & Antoine 2009, "
                                       "Darecki et al. 2011)",
                         description="Render SCENE at the conditions of a field data set (a resumable sweep "
@@ -142,16 +157,6 @@ def _parser() -> argparse.ArgumentParser:
                     help="a coarse run of two or three points, to check the command (not a comparison)")
     fd.add_argument("--quiet", action="store_true", help="no progress lines")
     fd.add_argument("--force", action="store_true", help="add this run to a folder holding another one")
-
-    cf = sub.add_parser("config", help="print a scene's resolved configuration (a dry run)",
-                        description="Validate CONFIG with its --set overrides and print every key with "
-                                    "its value as TOML; nothing is rendered or written.")
-    cf.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
-    _set_arg(cf)
-
-    sub.add_parser("info", help="versions and the devices Warp sees",
-                   description="Print package versions and the compute devices Warp can use.")
-    return p
 
 
 def _overrides(args: argparse.Namespace) -> dict:
