@@ -3,6 +3,7 @@ and its bands rendered together against each band alone."""
 
 import csv
 import json
+import math
 
 import numpy as np
 import pytest
@@ -39,14 +40,17 @@ def test_the_record_is_fig_10a_and_its_510_nm_line_is_fig_8a():
 def test_command_on_still_water_measures_no_fluctuation_per_band(tmp_path, capsys):
     """End to end (--quick: the first and last zenith): under still water every band's CV is 0,
     beside the record's values in its order; each band's sky share follows the sky's spectrum, bluer
-    than the sun's, and over the six bands they hold the paper's diffuse share; a rerun resumes."""
+    than the sun's, and over the six bands they hold the paper's diffuse share; at the sensor each
+    band's sky share is that of a float64 quadrature of the uniform sky through the flat surface
+    (Fresnel, the slant paths' attenuation; 2e-3); a rerun resumes."""
     pytest.importorskip("matplotlib")
     from warpcaustics.optics import spectra
     from warpcaustics.scene import load_scene
 
     out = tmp_path / "o"
+    # --quick, but with 64 sky directions instead of its 2 (a quadrature of the sky: below)
     args = ["field", "gernez2009_bands", str(_scene(tmp_path)), "--out", str(out), "--quick", "--frames", "1",
-            "--device", "cpu", "--quiet"]
+            "--set", "sky.directions=64", "--device", "cpu", "--quiet"]
     assert main(args) == 0
     rows = list(csv.DictReader((out / "gernez2009_bands.csv").open()))
     rec = bands.record()
@@ -66,10 +70,45 @@ def test_command_on_still_water_measures_no_fluctuation_per_band(tmp_path, capsy
         f = field.diffuse_fraction(z)
         assert float(np.sum(sky * bins.widths_nm) / np.sum((sky + beam) * bins.widths_nm)) == pytest.approx(
             f, abs=2e-4)
+        # at the sensor: the sky's share after Fresnel and the slant paths, against a float64 quadrature
+        optics = spectra.water_optics(scene.config.optics, bins)
+        c = optics.absorption_per_m + optics.scattering_per_m
+        ior = spectra.refractive_index(scene.config.optics, bins)
+        below = [float(r["model_sky_share_at_depth"]) for r in rs]
+        assert below == pytest.approx(_sky_share_at_depth(share, z, c, ior, 3.2).tolist(), abs=2e-3)
+        # in the red the longer slant path loses more: the sky's at a high sun, the sun's at a low one
+        assert (below[-1] < share[-1]) if z == 20.0 else (below[-1] > share[-1])
     assert (out / "gernez2009_bands.png").read_bytes()[:4] == b"\x89PNG"
     capsys.readouterr()
     assert main(args[:-1]) == 0
     assert "done 0, skipped 2" in capsys.readouterr().out
+
+
+def _fresnel_t(cos_i: float, n: float) -> float:
+    """Unpolarised Fresnel transmittance from air into water of index n (float64)."""
+    sin_t = math.sqrt(1.0 - cos_i * cos_i) / n
+    cos_t = math.sqrt(1.0 - sin_t * sin_t)
+    rs = (cos_i - n * cos_t) / (cos_i + n * cos_t)
+    rp = (n * cos_i - cos_t) / (n * cos_i + cos_t)
+    return 1.0 - 0.5 * (rs * rs + rp * rp)
+
+
+def _sky_share_at_depth(share, zenith_deg, c, ior, depth_m):
+    """Under still water at ``depth_m``, per band: the uniform sky's share of the downwelling light,
+    its horizontal irradiance above ``share``/(1 − ``share``) of the sun's beam's, the sky's below
+    (1/π)∫ T(θ) cosθ e^{−c D/cosθ_w} dΩ of it, the sun's T(θ_s) e^{−c D/cosθ_ws}."""
+    from scipy.integrate import quad
+
+    out = []
+    for s, ck, n in zip(share, c, ior):
+        def slant(cos_i, ck=ck, n=n):
+            cos_w = math.sqrt(1.0 - (1.0 - cos_i * cos_i) / (n * n))
+            return _fresnel_t(cos_i, n) * math.exp(-ck * depth_m / cos_w)
+
+        sky = s / (1.0 - s) * 2.0 * quad(lambda u: slant(u) * u, 0.0, 1.0, epsabs=0, epsrel=1e-10)[0]
+        sun = slant(math.cos(math.radians(zenith_deg)))
+        out.append(sky / (sky + sun))
+    return np.array(out)
 
 
 def test_bands_rendered_together_are_each_band_rendered_alone(tmp_path):

@@ -153,7 +153,8 @@ def _zenith_rows(scene, zenith: float, wavelengths_nm, measured, stats: list[dic
                  longer: list[dict] | None) -> list[dict]:
     """One row per band at one zenith (``scene``: the scene at that point): the measured CV beside
     the model's columns over the whole sea (:func:`~warpcaustics.batch.field.gernez2009.whole_sea`),
-    and each CV over the reference band's at that zenith."""
+    the sky's share of the light above the water (``sky_share``) and at the sensor
+    (``model_sky_share_at_depth``), and each CV over the reference band's at that zenith."""
     from warpcaustics.optics.spectra import bins_for, water_optics
 
     config = scene.config
@@ -168,13 +169,17 @@ def _zenith_rows(scene, zenith: float, wavelengths_nm, measured, stats: list[dic
             t = direct_transmission(zenith, config.floor.depth_m, float(config.optics.ior),
                                     float(scattering[j]))
         sea = whole_sea(frames, None if longer is None else band_frames(longer, float(nm)), t)
+        mean = sea.pop("model_mean_w_m2")  # of the band: W m⁻² nm⁻¹
+        sky = float(np.mean([f["sky_irradiance_w_m2"]["mean"] for f in frames]))
         cv = float(measured[j])
         rows.append({"sun_zenith_deg": zenith, "wavelength_nm": float(nm),
                      "diffuse_fraction": round(config.sky.diffuse_fraction, 4),
                      "sky_share": round(float(shares[j]), 4), "measured_cv": round(cv, 4), **sea,
                      "model_over_measured": round(sea["model_cv"] / cv, 3),
                      "model_cv_continuous_sky": continuous_sky([f["irradiance_w_m2"] for f in frames]),
-                     "direct_transmission": round(t, 4), "frames": len(frames)})
+                     "direct_transmission": round(t, 4), "frames": len(frames),
+                     "model_mean_w_m2_nm": mean,
+                     "model_sky_share_at_depth": round(sky / mean, 4) if mean else None})
     ref = int(np.argmin(np.abs(np.asarray(wavelengths_nm, np.float64) - REFERENCE_NM)))
     for r in rows:
         for name in RATIO_COLUMNS:
