@@ -193,12 +193,11 @@ RATIO_COLUMNS = ("measured_cv", "model_cv", "model_cv_uniform_sky", "model_cv_wi
 
 
 def _plot(rows: list[dict], path: Path, quick: bool) -> None:
-    """Left: CV against the sun's zenith per band, measured and model. Right: CV(λ)/CV(510 nm)
-    against the wavelength per zenith."""
+    """Left: CV against the sun's zenith per band, measured and model. Right: each band's CV over
+    510 nm's against the sun's zenith, measured and model."""
     plt = pyplot(PLOT_NEEDS)
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 4.4))
     bands = sorted({r["wavelength_nm"] for r in rows})
-    zeniths = sorted({r["sun_zenith_deg"] for r in rows})
     colours = plt.get_cmap("turbo")(np.linspace(0.08, 0.95, len(bands)))
     for nm, colour in zip(bands, colours):
         rs = [r for r in rows if r["wavelength_nm"] == nm]
@@ -208,18 +207,18 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
     left.set_xlabel("sun zenith angle [deg]")
     left.set_ylabel("CV of downwelling irradiance")
     left.set_title("clear sky, 3.2 m: Gernez & Antoine 2009 Fig. 10a (dots), model (squares)")
-    shades = plt.get_cmap("viridis")(np.linspace(0.0, 0.85, len(zeniths)))
-    for z, colour in zip(zeniths, shades):
-        rs = sorted((r for r in rows if r["sun_zenith_deg"] == z), key=lambda r: r["wavelength_nm"])
-        x = [r["wavelength_nm"] for r in rs]
-        right.plot(x, [r["measured_cv_over_510"] for r in rs], "o--", color=colour,
-                   label=f"{z:g}° measured")
+    for nm, colour in zip(bands, colours):
+        rs = [r for r in rows if r["wavelength_nm"] == nm]
+        if nm == REFERENCE_NM or any(r["model_cv_over_510"] is None for r in rs):
+            continue
+        x = [r["sun_zenith_deg"] for r in rs]
+        right.plot(x, [r["measured_cv_over_510"] for r in rs], "o", color=colour, label=f"{nm:g} nm measured")
         right.plot(x, [r["model_cv_over_510"] for r in rs], "s-", color=colour, mfc="none",
-                   label=f"{z:g}° model")
+                   label=f"{nm:g} nm model")
     right.axhline(1.0, color="k", lw=0.5)
-    right.set_xlabel("wavelength [nm]")
+    right.set_xlabel("sun zenith angle [deg]")
     right.set_ylabel("CV / CV at 510 nm")
-    right.set_title("each band's CV over 510 nm's, per sun zenith")
+    right.set_title("each band's CV over 510 nm's (measured: dots; model: squares)")
     for ax in (left, right):
         ax.set_ylim(bottom=0.0)
         ax.grid(alpha=0.3)
