@@ -209,12 +209,13 @@ def _plot(rows: list[dict], path: Path, quick: bool) -> None:
     left.set_title("clear sky, 3.2 m: Gernez & Antoine 2009 Fig. 10a (dots), model (squares)")
     for nm, colour in zip(bands, colours):
         rs = [r for r in rows if r["wavelength_nm"] == nm]
-        if nm == REFERENCE_NM or any(r["model_cv_over_510"] is None for r in rs):
+        if nm == REFERENCE_NM:
             continue
         x = [r["sun_zenith_deg"] for r in rs]
         right.plot(x, [r["measured_cv_over_510"] for r in rs], "o", color=colour, label=f"{nm:g} nm measured")
-        right.plot(x, [r["model_cv_over_510"] for r in rs], "s-", color=colour, mfc="none",
-                   label=f"{nm:g} nm model")
+        if all(r["model_cv_over_510"] is not None for r in rs):  # none where 510 nm's CV is 0
+            right.plot(x, [r["model_cv_over_510"] for r in rs], "s-", color=colour, mfc="none",
+                       label=f"{nm:g} nm model")
     right.axhline(1.0, color="k", lw=0.5)
     right.set_xlabel("sun zenith angle [deg]")
     right.set_ylabel("CV / CV at 510 nm")
