@@ -25,6 +25,7 @@ paths, the water's scattering.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -74,8 +75,6 @@ def sky_shares(scene) -> np.ndarray:
     """(K,) each band's share of the above-water global horizontal irradiance that comes from the
     sky, E_sky / (E_sky + E_sun sin(elevation)), as the scene lights it (``sky.diffuse_fraction``
     over all its bands, shaped by ``sky.spectrum``)."""
-    import math
-
     from warpcaustics.optics import spectra
 
     bins = spectra.bins_for(scene.config.optics)
@@ -131,9 +130,9 @@ def run_gernez2009_bands(
     for z, variant in zip(chosen, variants):
         stats = frame_statistics_of(sweep, out, variant)
         longer = None if long is None else frame_statistics_of(long, long_out, variant)
-        scene = load_scene(scene_path, {**fixed, **variant})
+        at_point = load_scene(scene_path, {**fixed, **variant})
         k = int(np.argmin(np.abs(rec.x - z)))
-        rows += _zenith_rows(scene, z, rec.wavelengths_nm, rec.cv[k], stats, longer)
+        rows += _zenith_rows(at_point, z, rec.wavelengths_nm, rec.cv[k], stats, longer)
     paths = {"csv": out / "gernez2009_bands.csv", "png": out / "gernez2009_bands.png"}
     write_csv(paths["csv"], rows)
     _plot(rows, paths["png"], quick)
