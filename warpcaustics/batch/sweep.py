@@ -254,8 +254,16 @@ def read_manifest(out_dir: Path) -> dict[str, dict]:
 
 
 def _append(out_dir: Path, record: dict) -> None:
-    with open(out_dir / MANIFEST, "a", encoding="utf-8") as fh:
-        fh.write(json.dumps(record, default=str) + "\n")
+    """Add ``record`` as a line of the manifest. A line a killed driver left cut (no newline at the
+    end of the file) is ended first, so that this record stands on a line of its own rather than
+    merging into the cut one, where :func:`read_manifest` would lose it too."""
+    line = json.dumps(record, default=str) + "\n"
+    with open(out_dir / MANIFEST, "a+b") as fh:
+        if fh.seek(0, os.SEEK_END) > 0:
+            fh.seek(-1, os.SEEK_END)
+            if fh.read(1) != b"\n":
+                line = "\n" + line
+        fh.write(line.encode("utf-8"))  # appended at the end whatever the position
         fh.flush()
         os.fsync(fh.fileno())
 
