@@ -11,6 +11,8 @@ import pytest
 from warpcaustics.cli import main
 from warpcaustics.errors import ConfigError
 
+from helpers import fresnel_t_angles
+
 jerlov = pytest.importorskip("jerlov")
 field = pytest.importorskip("warpcaustics.batch.field")
 bands = pytest.importorskip("warpcaustics.batch.field.gernez2009_bands")
@@ -84,15 +86,6 @@ def test_command_on_still_water_measures_no_fluctuation_per_band(tmp_path, capsy
     assert "done 0, skipped 2" in capsys.readouterr().out
 
 
-def _fresnel_t(cos_i: float, n: float) -> float:
-    """Unpolarised Fresnel transmittance from air into water of index n (float64)."""
-    sin_t = math.sqrt(1.0 - cos_i * cos_i) / n
-    cos_t = math.sqrt(1.0 - sin_t * sin_t)
-    rs = (cos_i - n * cos_t) / (cos_i + n * cos_t)
-    rp = (n * cos_i - cos_t) / (n * cos_i + cos_t)
-    return 1.0 - 0.5 * (rs * rs + rp * rp)
-
-
 def _sky_share_at_depth(share, zenith_deg, c, ior, depth_m):
     """Under still water at ``depth_m``, per band: the uniform sky's share of the downwelling light,
     its horizontal irradiance above ``share``/(1 − ``share``) of the sun's beam's, the sky's below
@@ -103,7 +96,7 @@ def _sky_share_at_depth(share, zenith_deg, c, ior, depth_m):
     for s, ck, n in zip(share, c, ior):
         def slant(cos_i, ck=ck, n=n):
             cos_w = math.sqrt(1.0 - (1.0 - cos_i * cos_i) / (n * n))
-            return _fresnel_t(cos_i, n) * math.exp(-ck * depth_m / cos_w)
+            return float(fresnel_t_angles(math.acos(cos_i), 1.0, n)) * math.exp(-ck * depth_m / cos_w)
 
         sky = s / (1.0 - s) * 2.0 * quad(lambda u: slant(u) * u, 0.0, 1.0, epsabs=0, epsrel=1e-10)[0]
         sun = slant(math.cos(math.radians(zenith_deg)))

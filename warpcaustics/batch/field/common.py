@@ -165,6 +165,19 @@ def band_statistics(sweep, out: str | Path, point: dict, wavelengths_nm) -> list
     return [[s["bands"][f"{nm:g}nm_w_m2_nm"] for s in stats] for nm in wavelengths_nm]
 
 
+def sea_cv(window: list[tuple[float, float]], windows: list[tuple[float, float]] | None,
+           longer: list[tuple[float, float]] | None) -> tuple[float, float, float | None]:
+    """One field's CV over the whole sea from its frames' (mean, CV): of the ``window``, of the
+    means of the patch's ``windows`` (None: none, :func:`patch_variance`) and of the ``longer``
+    waves' patch (None: not rendered), nested (:func:`nested_cv`). Returns (that CV, the scene's
+    patch's relative variance, the longer waves' own CV or None)."""
+    patch = patch_variance(window, windows)
+    if longer is None:
+        return math.sqrt(patch), patch, None
+    cv_long = pooled_statistics(longer)[1]
+    return nested_cv(patch, cv_long**2), patch, cv_long
+
+
 def band_row(band: list[dict], measured: float | None, longer: list[dict] | None = None) -> dict:
     """One band's frames pooled, beside the measured CV (None: not measured there): the columns every
     Darecki row shares. The model's CV is the whole patch's (within the window and between the
@@ -175,9 +188,8 @@ def band_row(band: list[dict], measured: float | None, longer: list[dict] | None
     window = [(b["mean"], b["cv"]) for b in band]
     windows = [(b["patch_windows"]["mean"], b["patch_windows"]["cv"]) for b in band if "patch_windows" in b]
     _, cv_window = pooled_statistics(window)
-    patch = patch_variance(window, windows if len(windows) == len(band) else None)
-    cv_long = None if longer is None else pooled_statistics([(b["mean"], b["cv"]) for b in longer])[1]
-    cv = math.sqrt(patch) if cv_long is None else nested_cv(patch, cv_long**2)
+    cv, patch, cv_long = sea_cv(window, windows if len(windows) == len(band) else None,
+                                None if longer is None else [(b["mean"], b["cv"]) for b in longer])
     return {
         "model_cv": round(cv, 4),
         "model_cv_window": round(cv_window, 4),

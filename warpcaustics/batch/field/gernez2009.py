@@ -42,10 +42,9 @@ from warpcaustics.batch.field.common import (
     continuous_sky,
     frame_statistics_of,
     long_waves_overrides,
-    nested_cv,
-    patch_variance,
     pooled_statistics,
     render_points,
+    sea_cv,
     with_background,
 )
 from warpcaustics.config import Scattering, SkyModel, WaterType
@@ -399,22 +398,17 @@ def whole_sea(stats: list[dict], longer: list[dict] | None, t: float, *, overcas
     mean."""
     window = _columns(stats, t, overcast=overcast)
     windows = _columns(stats, t, overcast=overcast, key=lambda s: s.get("patch_windows"))
+    waves = None if longer is None else _columns(longer, t, overcast=overcast)
     mean, cv_window = pooled_statistics(window["model_cv"])
-    # the scene's patch: within the window, and between the windows of the whole patch
-    patch = {name: patch_variance(frames, None if windows is None else windows[name])
-             for name, frames in window.items()}
-    cvs = {name: math.sqrt(r) for name, r in patch.items()}
-    cv_long = None
-    if longer is not None:  # and the waves longer than the patch
-        waves = _columns(longer, t, overcast=overcast)
-        pooled = {name: pooled_statistics(frames)[1] for name, frames in waves.items()}
-        cvs = {name: nested_cv(patch[name], pooled[name] ** 2) for name in patch}
-        cv_long = round(pooled["model_cv"], 4)
+    # within the window, between the windows of the whole patch, and over the longer waves' patch
+    sea = {name: sea_cv(frames, None if windows is None else windows[name],
+                        None if waves is None else waves[name]) for name, frames in window.items()}
+    cv_long = sea["model_cv"][2]
     return {
-        **{name: round(cvs[name], 4) if name in cvs else None for name in CV_COLUMNS},
+        **{name: round(sea[name][0], 4) if name in sea else None for name in CV_COLUMNS},
         "model_cv_window": round(cv_window, 4),
-        "model_cv_patch": round(math.sqrt(patch["model_cv"]), 4),
-        "model_cv_long_waves": cv_long,
+        "model_cv_patch": round(math.sqrt(sea["model_cv"][1]), 4),
+        "model_cv_long_waves": None if cv_long is None else round(cv_long, 4),
         "model_cv_frame_sd": round(float(np.std([c for _, c in window["model_cv"]])), 4),
         "model_mean_w_m2": mean,
     }
