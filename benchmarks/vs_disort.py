@@ -13,15 +13,15 @@ docs/validation.md; the tests (tests/test_walk_boundaries.py) check two geometri
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
 # one core, as the figures say: the solver's many small products on a multi-threaded BLAS ran 10×
 # slower on a loaded 2-core machine (set before numpy is imported; a user's own setting wins)
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+from warpcaustics.batch.threads import one_blas_thread  # imports nothing heavy
+
+one_blas_thread()
 
 ROOT = Path(__file__).resolve().parents[1]
 

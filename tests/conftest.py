@@ -5,13 +5,12 @@ pytest's to load, not a module to import."""
 
 from __future__ import annotations
 
-import os
-
 # One BLAS thread per test process: xdist's workers are the parallelism, and a worker's BLAS threads
 # spinning against the others' on a 2-core runner made PythonicDISORT's solves 10× slower. Set here,
 # before pytest-xdist starts its workers, so that their numpy reads it at import.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+from warpcaustics.batch.threads import one_blas_thread  # imports nothing heavy
+
+one_blas_thread()
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402

@@ -282,7 +282,7 @@ def test_ray_executor_gives_the_local_results(tmp_path):
 def test_workers_get_one_blas_thread_unless_the_user_chose(monkeypatch):
     """While the local pool runs, the variables that size numpy's BLAS thread pool read 1 for the
     workers it spawns, except one the user set; afterwards the environment is as it was."""
-    from warpcaustics.batch.executors import NUMERIC_THREADS, one_blas_thread_per_worker
+    from warpcaustics.batch.threads import NUMERIC_THREADS, one_blas_thread_per_worker
 
     for var in NUMERIC_THREADS:
         monkeypatch.delenv(var, raising=False)

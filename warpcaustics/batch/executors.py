@@ -7,13 +7,13 @@ manifest.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from warpcaustics.batch.threads import one_blas_thread_per_worker
 from warpcaustics.batch.worker import run_task
 from warpcaustics.errors import WarpcausticsError
 
@@ -42,24 +42,6 @@ def die_with_parent(parent_pid: int) -> None:
             time.sleep(0.5)
 
     threading.Thread(target=watch, daemon=True).start()
-
-
-NUMERIC_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-"""The environment variables that set numpy's and scipy's BLAS threads, read at import."""
-
-
-@contextlib.contextmanager
-def one_blas_thread_per_worker():
-    """While the pool starts its workers, their BLAS on one thread each (unless the user chose):
-    the workers are the parallelism, and a worker's BLAS threads spinning against the other workers
-    on the same cores made a solver's many small products 10× slower (PythonicDISORT on 2 cores)."""
-    added = [var for var in NUMERIC_THREADS if var not in os.environ]
-    os.environ.update(dict.fromkeys(added, "1"))
-    try:
-        yield
-    finally:
-        for var in added:
-            os.environ.pop(var, None)
 
 
 def run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
