@@ -1,0 +1,95 @@
+"""The sky's cones against the sky's continuum in float64: ``python -m benchmarks.sky_continuum``.
+
+The floor's sky part at 510 and 670 nm (Jerlov IB) by ``sky.sampling = "cones"`` (8 to 256 cones)
+and by point directions (``stratified``), against the float64 integration over the directions the
+light arrives from in the water (``tests/sky_continuum.py``, written apart from the package), at
+16 × 16 floor points, under a uniform sky and the CIE overcast sky (type 1):
+
+- ``sea``: ``tests/test_sky_continuum.py``'s scene (Elfouhaily at 5 m/s, 256² over 4 m, 3.2 m deep),
+  at more points and a finer quadrature than the test's;
+- ``gernez``: the Gernez comparison's own sea (``configs/field/gernez2009.toml``: 2048² over 8 m,
+  3.2 m deep) under the overcast sky, the whole patch as the map (512² texels), the scattered light
+  left out (``optics.scattering = "single"``): is the model's red, a quarter as rough as its green
+  there, what the continuum gives?
+
+Printed per case: each band's mean and CV over the points, the CV over the continuum's, the red's CV
+over the green's, the correlation with the continuum point by point, and the seconds of each render
+and of the reference (one core). ``--quick``: the ``sea`` scene with the test's 8 × 8 points and
+coarse quadrature, 16 and 64 cones. Figures in docs/validation.md (issue 32's sky, issue 27's
+overcast red); about 25 minutes in full.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the test's scene and points, 16 and 64 cones")
+    parser.add_argument("--cases", default="sea,gernez", help="comma-separated of sea, gernez (default both)")
+    args = parser.parse_args(argv)
+    sys.path.insert(0, str(ROOT / "tests"))
+    from sky_continuum import (  # noqa: I001 (the tests' folder, put on the path above)
+        CIE_SKIES, PeriodicHeights, cie_azimuthally_uniform_sky, floor_irradiance, uniform_sky)
+    from test_sky_continuum import SEA
+
+    import warpcaustics as wc
+
+    if not CIE_SKIES.exists():
+        parser.error(f"needs the CIE skies' table at {CIE_SKIES} (../shared/data/sky beside the checkout)")
+    skies = {"uniform": ({"sky.model": "uniform"}, uniform_sky),
+             "cie_overcast": ({"sky.model": "cie", "sky.cie_type": 1}, cie_azimuthally_uniform_sky(1))}
+    gernez = {"sun.elevation_deg": 50.0, "sun.disk_samples": 1, "sky.diffuse_fraction": 0.99,
+              "optics.scattering": "single", "optics.beam_spread": "wells",
+              "optics.wavelengths": [510.0, 670.0], "caustics.map_extent_m": 8.0, "optics.ior": 1.333}
+    every = [("cones", 8), ("cones", 16), ("cones", 32), ("cones", 64), ("cones", 256), ("stratified", 1024)]
+    cases = {
+        "sea": (None, SEA, 4.0, SEA["caustics.map_resolution"] * (1 if args.quick else 2), list(skies),
+                [("cones", 16), ("cones", 64)] if args.quick else every),
+        "gernez": (ROOT / "configs" / "field" / "gernez2009.toml", gernez, 8.0, 512, ["cie_overcast"],
+                   [("cones", 16), ("cones", 64)]),
+    }
+    points_a_side, quadrature = (8, 96) if args.quick else (16, 160)
+    for name in args.cases.split(","):
+        config, overrides, extent, texels, sky_names, samplings = cases[name]
+        step = texels // points_a_side
+        idx = np.arange(step // 2, texels, step)
+        xs = (idx + 0.5) * extent / texels - extent / 2
+        where = np.array([(x, y) for y in xs for x in xs])
+        for sky_name in sky_names:
+            sky, radiance = skies[sky_name]
+            print(f"\n{name}, {sky_name} sky: {len(where)} points")
+            rows = []
+            for sampling, directions in samplings:
+                scene = wc.load_scene(config, {**overrides, **sky, "caustics.map_resolution": texels,
+                                               "sky.sampling": sampling, "sky.directions": directions})
+                start = time.perf_counter()
+                r = wc.render(scene, device="cpu")
+                seconds = time.perf_counter() - start
+                sky_map = r.sky_floor_irradiance / scene.sky_irradiance(r.sun_irradiance)[:, None, None]
+                rows.append((f"{sampling} {directions}", sky_map[:, idx][:, :, idx].reshape(2, -1), seconds))
+            start = time.perf_counter()
+            heights = PeriodicHeights(r.surface_positions[..., 2], extent)
+            continuum = floor_irradiance(heights, where, scene.config.floor.depth_m, float(r.ior[0]),
+                                         r.attenuation_per_m, radiance, quadrature, quadrature).T
+            rows.insert(0, ("continuum", continuum, time.perf_counter() - start))
+            exact = continuum.std(axis=1) / continuum.mean(axis=1)
+            for label, values, seconds in rows:
+                cv = values.std(axis=1) / values.mean(axis=1)
+                corr = [np.corrcoef(values[k], continuum[k])[0, 1] for k in range(2)]
+                print(f"  {label:16s} mean {values.mean(axis=1).round(5)}  CV {cv.round(5)}  "
+                      f"/ continuum {(cv / exact).round(3)}  670/510 {cv[1] / cv[0]:.3f}  "
+                      f"corr {np.round(corr, 3)}  {seconds:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
