@@ -47,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"needs the CIE skies' table at {CIE_SKIES} (../shared/data/sky beside the checkout)")
     skies = {"uniform": ({"sky.model": "uniform"}, uniform_sky),
              "cie_overcast": ({"sky.model": "cie", "sky.cie_type": 1}, cie_azimuthally_uniform_sky(1))}
-    gernez = {"sun.elevation_deg": 50.0, "sun.disk_samples": 1, "sky.diffuse_fraction": 0.99,
+    gernez = {"sun.elevation_deg": 50.0, "sun.angular_diameter_deg": 0.0, "sky.diffuse_fraction": 0.99,
               "optics.scattering": "single", "optics.beam_spread": "wells",
               "optics.wavelengths": [510.0, 670.0], "caustics.map_extent_m": 8.0, "optics.ior": 1.333}
     every = [("cones", 8), ("cones", 16), ("cones", 32), ("cones", 64), ("cones", 256), ("stratified", 1024)]
