@@ -6,7 +6,7 @@ apart from the package), on an Elfouhaily sea at 510 and 670 nm (Jerlov IB: c = 
 Measured on this scene (2026-12-06; the full-size figures, 16 × 16 points on the same sea and on the
 Gernez comparison's own 8 m sea, are ``python -m benchmarks.sky_continuum``'s, docs/validation.md):
 64 cones read the continuum's mean to 0.35 % and its CV 2–7 % high, correlated 0.90–0.95 with it
-point by point; 16 cones read the CV 7–27 % high; 64 point directions 5–11× (their own patterns).
+point by point; 16 cones read the CV 7–27 % high; 64 point directions 5–12× (their own patterns).
 """
 
 import numpy as np
