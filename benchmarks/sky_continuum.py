@@ -11,6 +11,8 @@ light arrives from in the water (``tests/sky_continuum.py``, written apart from 
   3.2 m deep) under the overcast sky, the whole patch as the map (512² texels), the scattered light
   left out (``optics.scattering = "single"``): is the model's red, a quarter as rough as its green
   there, what the continuum gives?
+- ``gernez_low_sun``: the same sea under the CIE clear sky (type 12, the config's) with the sun 80°
+  from the zenith: the sky's part of a low sun's CV, 16 and 64 cones against the continuum;
 
 Printed per case: each band's mean and CV over the points, the CV over the continuum's, the red's CV
 over the green's, the correlation with the continuum point by point, and the seconds of each render
@@ -34,19 +36,22 @@ ROOT = Path(__file__).resolve().parents[1]
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the test's scene and points, 16 and 64 cones")
-    parser.add_argument("--cases", default="sea,gernez", help="comma-separated of sea, gernez (default both)")
+    parser.add_argument("--cases", default="sea,gernez,gernez_low_sun",
+                        help="comma-separated of sea, gernez, gernez_low_sun (default all)")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT / "tests"))
     from sky_continuum import (  # noqa: I001 (the tests' folder, put on the path above)
-        CIE_SKIES, PeriodicHeights, cie_azimuthally_uniform_sky, floor_irradiance, uniform_sky)
+        CIE_SKIES, PeriodicHeights, cie_sky, floor_irradiance, uniform_sky)
     from test_sky_continuum import SEA
 
     import warpcaustics as wc
 
     if not CIE_SKIES.exists():
         parser.error(f"needs the CIE skies' table at {CIE_SKIES} (../shared/data/sky beside the checkout)")
-    skies = {"uniform": ({"sky.model": "uniform"}, uniform_sky),
-             "cie_overcast": ({"sky.model": "cie", "sky.cie_type": 1}, cie_azimuthally_uniform_sky(1))}
+    skies = {"uniform": ({"sky.model": "uniform"}, lambda sun: uniform_sky),
+             "cie_overcast": ({"sky.model": "cie", "sky.cie_type": 1}, lambda sun: cie_sky(1, sun)),
+             "cie_clear_sun_80": ({"sky.model": "cie", "sky.cie_type": 12, "sun.elevation_deg": 10.0},
+                                  lambda sun: cie_sky(12, sun))}
     gernez = {"sun.elevation_deg": 50.0, "sun.angular_diameter_deg": 0.0, "sky.diffuse_fraction": 0.99,
               "optics.scattering": "single", "optics.beam_spread": "wells",
               "optics.wavelengths": [510.0, 670.0], "caustics.map_extent_m": 8.0, "optics.ior": 1.333}
@@ -56,6 +61,8 @@ def main(argv: list[str] | None = None) -> int:
                 [("cones", 16), ("cones", 64)] if args.quick else every),
         "gernez": (ROOT / "configs" / "field" / "gernez2009.toml", gernez, 8.0, 512, ["cie_overcast"],
                    [("cones", 16), ("cones", 64)]),
+        "gernez_low_sun": (ROOT / "configs" / "field" / "gernez2009.toml", gernez, 8.0, 512,
+                           ["cie_clear_sun_80"], [("cones", 16), ("cones", 64)]),
     }
     points_a_side, quadrature = (8, 96) if args.quick else (16, 160)
     for name in args.cases.split(","):
@@ -65,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
         xs = (idx + 0.5) * extent / texels - extent / 2
         where = np.array([(x, y) for y in xs for x in xs])
         for sky_name in sky_names:
-            sky, radiance = skies[sky_name]
+            sky, make_radiance = skies[sky_name]
             print(f"\n{name}, {sky_name} sky: {len(where)} points")
             rows = []
             for sampling, directions in samplings:
@@ -79,7 +86,8 @@ def main(argv: list[str] | None = None) -> int:
             start = time.perf_counter()
             heights = PeriodicHeights(r.surface_positions[..., 2], extent)
             continuum = floor_irradiance(heights, where, scene.config.floor.depth_m, float(r.ior[0]),
-                                         r.attenuation_per_m, radiance, quadrature, quadrature).T
+                                         r.attenuation_per_m, make_radiance(scene.sun_direction), quadrature,
+                                         quadrature).T
             rows.insert(0, ("continuum", continuum, time.perf_counter() - start))
             exact = continuum.std(axis=1) / continuum.mean(axis=1)
             for label, values, seconds in rows:

@@ -83,6 +83,35 @@ def cie_azimuthally_uniform_sky(sky_type: int):
     return radiance
 
 
+def cie_sky(sky_type: int, sun_direction: np.ndarray):
+    """L / E_sky of any CIE standard general sky with the sun towards ``sun_direction`` (unit, z up),
+    from the shared table's a–e: L ∝ f(χ) φ(Z), φ(Z) = 1 + a e^{b / cos Z}, f(χ) = 1 + c (e^{dχ} −
+    e^{dπ/2}) + e cos²χ (χ the angle from the sun), normalised by its own ∫ L cos Z dΩ (midpoint
+    rule, 2000 × 4000 in zenith and azimuth)."""
+    with open(CIE_SKIES, encoding="utf-8", newline="") as fh:
+        row = next(r for r in csv.DictReader(fh) if int(r["sky_type"]) == sky_type)
+    a, b, c, d, e = (float(row[k]) for k in "abcde")
+    sun = np.asarray(sun_direction, np.float64) / np.linalg.norm(sun_direction)
+
+    def relative(direction: np.ndarray) -> np.ndarray:
+        cos_z = np.maximum(direction[2], 1e-12)
+        chi = np.arccos(np.clip(sun[0] * direction[0] + sun[1] * direction[1] + sun[2] * direction[2], -1, 1))
+        return ((1 + a * np.exp(b / cos_z))
+                * (1 + c * (np.exp(d * chi) - math.exp(d * math.pi / 2)) + e * np.cos(chi) ** 2))
+
+    nz, na = 2000, 4000
+    z = (np.arange(nz) + 0.5) * (math.pi / 2) / nz
+    az = (np.arange(na) + 0.5) * (2 * math.pi) / na
+    zz, aa = np.meshgrid(z, az, indexing="ij")
+    grid = np.stack([np.sin(zz) * np.cos(aa), np.sin(zz) * np.sin(aa), np.cos(zz)])
+    norm = np.sum(relative(grid) * np.cos(zz) * np.sin(zz)) * (math.pi / 2 / nz) * (2 * math.pi / na)
+
+    def radiance(direction: np.ndarray) -> np.ndarray:
+        return relative(direction) / norm
+
+    return radiance
+
+
 def floor_irradiance(heights: PeriodicHeights, points: np.ndarray, depth_m: float, n: float,
                      attenuation_per_m, radiance, rings: int = 160, azimuths: int = 160,
                      air_steps: int = 160) -> np.ndarray:
