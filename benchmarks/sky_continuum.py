@@ -41,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT / "tests"))
     from sky_continuum import (  # noqa: I001 (the tests' folder, put on the path above)
-        CIE_SKIES, PeriodicHeights, cie_sky, floor_irradiance, uniform_sky)
+        CIE_SKIES, PeriodicHeights, cie_sky, floor_irradiance, texel_points, uniform_sky)
     from test_sky_continuum import SEA
 
     import warpcaustics as wc
@@ -67,10 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     points_a_side, quadrature = (8, 96) if args.quick else (16, 160)
     for name in args.cases.split(","):
         config, overrides, extent, texels, sky_names, samplings = cases[name]
-        step = texels // points_a_side
-        idx = np.arange(step // 2, texels, step)
-        xs = (idx + 0.5) * extent / texels - extent / 2
-        where = np.array([(x, y) for y in xs for x in xs])
+        idx, where = texel_points(texels, texels // points_a_side, extent)
         for sky_name in sky_names:
             sky, make_radiance = skies[sky_name]
             print(f"\n{name}, {sky_name} sky: {len(where)} points")

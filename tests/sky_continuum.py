@@ -63,26 +63,6 @@ def uniform_sky(a: np.ndarray) -> np.ndarray:
     return np.full(a.shape[1:], 1.0 / math.pi)
 
 
-def cie_azimuthally_uniform_sky(sky_type: int):
-    """L / E_sky of a CIE standard general sky whose indicatrix is 1 (c = e = 0: types 1 and 3, the
-    overcast skies uniform in azimuth), from the shared table's a and b: L ∝ 1 + a e^{b / cos Z},
-    normalised by its own ∫ L cos Z dΩ (midpoint rule, 200 000 rings)."""
-    with open(CIE_SKIES, encoding="utf-8", newline="") as fh:
-        row = next(r for r in csv.DictReader(fh) if int(r["sky_type"]) == sky_type)
-    if float(row["c"]) != 0.0 or float(row["e"]) != 0.0:
-        raise ValueError(f"CIE sky {sky_type} is not uniform in azimuth")
-    a, b = float(row["a"]), float(row["b"])
-    rings = 200_000
-    dz = (math.pi / 2) / rings
-    z = (np.arange(rings) + 0.5) * dz
-    norm = 2 * math.pi * np.sum((1 + a * np.exp(b / np.cos(z))) * np.cos(z) * np.sin(z)) * dz
-
-    def radiance(d: np.ndarray) -> np.ndarray:
-        return (1 + a * np.exp(b / np.maximum(d[2], 1e-12))) / norm
-
-    return radiance
-
-
 def cie_sky(sky_type: int, sun_direction: np.ndarray):
     """L / E_sky of any CIE standard general sky with the sun towards ``sun_direction`` (unit, z up),
     from the shared table's a–e: L ∝ f(χ) φ(Z), φ(Z) = 1 + a e^{b / cos Z}, f(χ) = 1 + c (e^{dχ} −
@@ -110,6 +90,14 @@ def cie_sky(sky_type: int, sun_direction: np.ndarray):
         return relative(direction) / norm
 
     return radiance
+
+
+def texel_points(texels: int, step: int, extent_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """(every ``step``-th texel index of a map ``texels`` wide over a patch ``extent_m`` wide, starting
+    half a step in; (P, 2) their centres [m], row (y) by row, as ``map[:, idx][:, :, idx]`` reads them)."""
+    idx = np.arange(step // 2, texels, step)
+    xs = (idx + 0.5) * extent_m / texels - extent_m / 2
+    return idx, np.array([(x, y) for y in xs for x in xs])
 
 
 def floor_irradiance(heights: PeriodicHeights, points: np.ndarray, depth_m: float, n: float,
