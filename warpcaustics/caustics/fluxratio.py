@@ -73,6 +73,19 @@ def needs_coarse(cfg) -> bool:
     return cfg.optics.scattering is Scattering.SMALL_ANGLE or sky_in_cones(cfg)
 
 
+def reached_runs(reach: np.ndarray, cells: int, quads: int) -> np.ndarray:
+    """(R, 2) int32 (iy, first ix) of every row of every block of ``cells`` × ``cells`` quads that
+    ``reach`` (blocks × blocks, non-zero: reached) marks, in row-major order of the quads (row by row,
+    then the blocks along it), the rows cut at ``quads``."""
+    rows, columns = np.nonzero(reach)
+    runs = []
+    for block_row in np.unique(rows):
+        starts = columns[rows == block_row] * cells
+        iy = block_row * cells + np.arange(min(cells, quads - block_row * cells))
+        runs.append(np.stack(np.broadcast_arrays(iy[:, None], starts[None, :]), axis=-1).reshape(-1, 2))
+    return np.concatenate(runs).astype(np.int32) if runs else np.zeros((0, 2), np.int32)
+
+
 class FloorCaustics:
     """Owns the floor stage's device buffers, reused from frame to frame."""
 
@@ -182,19 +195,27 @@ class FloorCaustics:
         quads = self.flux.shape[0]
         k, m = self.irradiance.shape[0], self.irradiance.shape[1]
         floor_map = self.floor_map(float(surface.extent_m))
-        if self.reach_cells:
-            wp.launch(cover_kernels.block_reach, dim=self.reach.shape,
-                      inputs=[refracted.hit_xy, self.reach_cells, float(surface.extent_m), floor_map],
-                      outputs=[self.reach], device=self.device)
         if clear:
             self.cover.zero_()
             self.carry.zero_()
             self.texels.zero_()
             self.coarse_count.zero_()
-        wp.launch(cover_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
-                  inputs=[refracted.hit_xy, self.flux, k // groups, float(surface.extent_m),
-                          int(surface.periodic), floor_map, self.reach, self.reach_cells],
-                  outputs=[self.cover, self.carry, self.texels, self.coarse_count], device=self.device)
+        common = [k // groups, float(surface.extent_m), int(surface.periodic), floor_map]
+        outputs = [self.cover, self.carry, self.texels, self.coarse_count]
+        if not self.reach_cells:
+            wp.launch(cover_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
+                      inputs=[refracted.hit_xy, self.flux, *common], outputs=outputs, device=self.device)
+        else:  # the triangles of the blocks whose footprints may reach the window, and no others
+            wp.launch(cover_kernels.block_reach, dim=self.reach.shape,
+                      inputs=[refracted.hit_xy, self.reach_cells, float(surface.extent_m), floor_map],
+                      outputs=[self.reach], device=self.device)
+            reach = self.reach.numpy()
+            for g in range(groups):
+                runs = reached_runs(reach[g], self.reach_cells, quads)
+                if len(runs):
+                    wp.launch(cover_kernels.deposit_reached, dim=(len(runs), self.reach_cells, 2),
+                              inputs=[wp.array(runs, dtype=wp.vec2i, device=self.device), g, refracted.hit_xy,
+                                      self.flux, *common], outputs=outputs, device=self.device)
         if bands:
             wp.launch(cover_kernels.cover_to_bands, dim=(m, k), inputs=[self.cover, self.carry, self.texels],
                       outputs=[self.irradiance], device=self.device)
