@@ -162,13 +162,23 @@ def cell_multiplier(direction: np.ndarray, points: np.ndarray, weights: np.ndarr
     rows, cols = np.nonzero(keep)
     if len(rows) * len(w) > splat_above:
         return _splatted(shift, cov, w, k, texel_m, m)
-    qx, qy = k[cols], k[rows]
-    total = np.zeros(len(rows), np.complex128)
+    # B̂(−k) = conj B̂(k), the transform of a real distribution: half the frequencies are summed and
+    # the rest mirrored (the mask is symmetric). A Nyquist row's or column's mirror on the grid is not
+    # −k (fftfreq gives −π/τ both), so those, and k = 0, keep their own sums.
+    flat, mirror = rows * m + cols, ((-rows) % m) * m + (-cols) % m
+    own = (flat == mirror) | (2 * rows == m) | (2 * cols == m)
+    half = own | (flat < mirror)
+    qx, qy = k[cols[half]], k[rows[half]]
+    total = np.zeros(len(qx), np.complex128)
     for s in range(len(w)):
         exponent = (1j * (qx * shift[s, 0] + qy * shift[s, 1])
                     - 0.5 * (qx * qx * cov[s, 0, 0] + 2.0 * qx * qy * cov[s, 0, 1] + qy * qy * cov[s, 1, 1]))
         total += w[s] * np.exp(exponent)
-    return rows, cols, total.astype(np.complex64)
+    values = np.zeros(m * m, np.complex128)
+    mirrored = ~own[half]
+    values[mirror[half][mirrored]] = np.conj(total[mirrored])
+    values[flat[half]] = total
+    return rows, cols, values[flat].astype(np.complex64)
 
 
 def _splatted(shift: np.ndarray, cov: np.ndarray, w: np.ndarray, k: np.ndarray, texel_m: float, m: int
