@@ -77,3 +77,18 @@ def subnormal_count(a: np.ndarray) -> int:
     """How many entries of ``a`` are float32 subnormals (non-zero, smaller than the smallest normal):
     the values that slow a CPU's arithmetic down by orders of magnitude."""
     return int(np.count_nonzero((np.abs(a) < np.finfo(np.float32).tiny) & (a != 0)))
+
+
+def low_pass(field: np.ndarray, m: int, extent: float) -> np.ndarray:
+    """A periodic field on an N×N cell-centred grid, cut to the wavenumbers an M×M grid holds (its
+    Nyquist row and column dropped) and evaluated at that grid's cell centres, in float64 numpy."""
+    n = field.shape[0]
+    keep = np.r_[0:m // 2, n - m // 2 + 1:n]
+    spectrum = np.fft.fft2(field.astype(np.float64))[np.ix_(keep, keep)] * (m / n) ** 2
+    k = 2 * np.pi * np.fft.fftfreq(m, extent / m)[np.r_[0:m // 2, m // 2 + 1:m]]
+    kx, ky = np.meshgrid(k, k)
+    shift = 0.5 * extent / m - 0.5 * extent / n  # the coarse cells' centres from the fine ones'
+    full = np.zeros((m, m), complex)
+    index = np.r_[0:m // 2, m // 2 + 1:m]
+    full[np.ix_(index, index)] = spectrum * np.exp(1j * (kx + ky) * shift)
+    return np.fft.ifft2(full).real

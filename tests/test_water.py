@@ -7,7 +7,7 @@ import warp as wp
 from warpcaustics import water
 from warpcaustics.kernels.water import heightfield as hf_kernels
 
-from helpers import CONFIGS, subnormal_count
+from helpers import CONFIGS, low_pass, subnormal_count
 
 
 @pytest.mark.parametrize("n", [64, 256])
@@ -449,3 +449,38 @@ def test_a_long_wave_patch_holds_the_waves_longer_than_its_cut():
     s = (b_long + b_short) / kk**3
     assert long_part == pytest.approx(np.trapezoid(s[kk < cut], kk[kk < cut]), rel=0.02)
     assert 0.3 < long_part / total < 0.7
+
+
+@pytest.mark.parametrize("choppiness", [0.0, 0.8])
+def test_a_truncated_ocean_is_the_full_one_s_low_pass(device, choppiness):
+    """``FFTOcean.truncated(M)`` (the sky's coarser surface, ``sky.surface_resolution``) is the same
+    sea without its shorter waves: its heights, horizontal displacements and (linear sea) normals
+    equal the full ocean's, low-passed to the M-grid's wavenumbers in float64 numpy and evaluated at
+    its cell centres, to float32 rounding (≤ 1e-5 of the height's scale), at two times."""
+    n, m, extent = 128, 32, 10.0
+    ocean = _ocean(n, device, extent=extent, choppiness=choppiness)
+    coarse = ocean.truncated(m)
+    x_fine = (np.arange(n) + 0.5) * extent / n - extent / 2
+    x_coarse = (np.arange(m) + 0.5) * extent / m - extent / 2
+    for t in (0.0, 2.7):
+        fine, cut = ocean.at(t), coarse.at(t)
+        pos, expected = cut.positions.numpy(), fine.positions.numpy().astype(np.float64)
+        scale = np.abs(expected[..., 2]).max()
+        np.testing.assert_allclose(pos[..., 2], low_pass(expected[..., 2], m, extent), atol=1e-5 * scale)
+        displaced = expected[..., :2] - np.stack(np.meshgrid(x_fine, x_fine), axis=-1)
+        grid = np.stack(np.meshgrid(x_coarse, x_coarse), axis=-1)
+        for axis in range(2):
+            np.testing.assert_allclose(pos[..., axis] - grid[..., axis],
+                                       low_pass(displaced[..., axis], m, extent), atol=1e-5 * scale)
+        if choppiness == 0.0:  # the slopes, from the low-passed heights' own spectrum
+            heights = low_pass(expected[..., 2], m, extent)
+            k = water.wavenumbers(m, extent)
+            spectrum = np.fft.fft2(heights)
+            sx = np.fft.ifft2(1j * k[None, :] * spectrum).real
+            sy = np.fft.ifft2(1j * k[:, None] * spectrum).real
+            normal = np.stack([-sx, -sy, np.ones_like(sx)], axis=-1)
+            normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+            np.testing.assert_allclose(cut.normals.numpy(), normal, atol=1e-5)
+    assert coarse.resolution == m and coarse.extent_m == extent
+    with pytest.raises(ValueError, match="power of two"):
+        ocean.truncated(48)

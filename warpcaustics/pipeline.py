@@ -48,8 +48,12 @@ def scene_bytes(scene: Scene, device: str = "cuda") -> int:
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     groups = k if cfg.optics.dispersion else 1
     stage = METHODS[cfg.caustics.method].bytes_needed(scene, k, groups)
-    shading = horizon_bytes(n) if WATER_MODELS[cfg.water.model].periodic else 0  # the sweep's lattice
-    return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, n, keeps_sky_shading(cfg)) + shading
+    ns = scene.sky_resolution
+    periodic = WATER_MODELS[cfg.water.model].periodic
+    shading = horizon_bytes(n) if periodic else 0  # the sweep's lattice
+    if ns != n:  # the sky's own surface (its waves cut to a coarser grid) and its sweep
+        shading += water_bytes(cfg, ns, device) + horizon_bytes(ns)
+    return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, ns, keeps_sky_shading(cfg)) + shading
 
 
 HOST_BYTES_PER_PIXEL = 200
@@ -97,6 +101,10 @@ class Renderer:
             n = scene.water_resolution
             self.visible = wp.empty((n, n), dtype=wp.float32, device=self.device)
             self.horizon = horizon_buffer(n, self.device) if self.water.periodic else None
+            ns = scene.sky_resolution
+            self.sky_water = self.water if ns == n else self.water.truncated(ns)
+            """The surface the sky's directions are refracted through (``sky.surface_resolution``)."""
+            self.sky_horizon = self.horizon if ns == n else horizon_buffer(ns, self.device)
             self.light = Lighting.prepare(scene, self.device, keep_sky_shading=keeps_sky_shading(cfg))
             self.method = METHODS[cfg.caustics.method](scene, self.water, self.light, self.device)
 
@@ -128,6 +136,15 @@ class Renderer:
         read-backs, the colour conversion, the writers) — becomes one line that states the need."""
         return _memory_errors(self.device, self.bytes_needed + self.host_bytes, self.memory_fix)
 
+    def check_above_floor(self, lowest: float, time_s: float) -> None:
+        """Refuse a frame whose surface reaches down to the floor (``lowest`` its lowest point [m])."""
+        floor_z = self.method.floor_top_z
+        if lowest <= floor_z:
+            raise WarpcausticsError(
+                f"floor.depth_m = {self.scene.config.floor.depth_m} is too shallow: the water surface "
+                f"reaches z = {lowest:.3f} m at t = {time_s:g} s, the floor z = {floor_z:.3f} m; "
+                "make the floor deeper or the waves lower")
+
     def _render(self, time_s: float) -> RenderResult:
         cfg = self.scene.config
         dev = self.device
@@ -135,11 +152,15 @@ class Renderer:
         with watch.stage("water"):
             surface = self.water.at(time_s)
             lowest, highest = height_range(surface, dev)
-        if lowest <= self.method.floor_top_z:
-            raise WarpcausticsError(
-                f"floor.depth_m = {cfg.floor.depth_m} is too shallow: the water surface reaches "
-                f"z = {lowest:.3f} m at t = {time_s:g} s, the floor z = {self.method.floor_top_z:.3f} m; "
-                "make the floor deeper or the waves lower")
+        self.check_above_floor(lowest, time_s)
+        sky = None
+        if self.sky_water is not self.water:
+            with watch.stage("sky_water"):
+                sky_surface = self.sky_water.at(time_s)
+                sky_range = height_range(sky_surface, dev)
+            self.check_above_floor(sky_range[0], time_s)
+            sky = Frame(surface=sky_surface, visible=None, time_s=time_s, lowest=sky_range[0],
+                        highest=sky_range[1], watch=watch, horizon=self.sky_horizon)
         with watch.stage("shading"):
             blocks = None if surface.periodic else height_blocks(surface, dev)  # the march's, on walled water
             visible = sun_visibility(surface, self.scene.sun_direction, highest, dev, out=self.visible,
@@ -147,7 +168,7 @@ class Renderer:
         if cfg.sky.sampling is SkySampling.HALVES:  # the config check ensures a sky
             self.light.draw_sky(self.scene, time_s, dev)
         frame = Frame(surface=surface, visible=visible, time_s=time_s, lowest=lowest, highest=highest,
-                      watch=watch, height_blocks=blocks, horizon=self.horizon)
+                      watch=watch, height_blocks=blocks, horizon=self.horizon, sky=sky)
         self.method.check_frame(frame)
         out = self.method.render(frame)
         check_finite(out, time_s)

@@ -271,9 +271,18 @@ class FluxRatioStage(CausticStage):
             self.cones = SkyCones(cfg, light.sky_directions, scene.sun_direction, float(light.group_ior[0]))
         coarse = coarse_resolution(cfg, water.periodic) if needs_coarse(cfg) else 0
         disk_share = light.sun_irradiance / len(light.sun_directions)
-        self.floor = FloorCaustics(n, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
-                                   device, periodic=water.periodic, window=window,
-                                   groups=len(light.group_ior), coarse_resolution=coarse)
+
+        def floor(vertices: int) -> FloorCaustics:
+            return FloorCaustics(vertices, cfg.caustics.map_resolution, disk_share, light.attenuation_per_m,
+                                 device, periodic=water.periodic, window=window,
+                                 groups=len(light.group_ior), coarse_resolution=coarse)
+
+        self.floor = floor(n)
+        # the sky's passes on a surface of their own (``sky.surface_resolution``), with its buffers
+        ns = scene.sky_resolution
+        groups = len(light.group_ior)
+        self.sky_refracted = self.refracted if ns == n else Refracted.allocate(groups, ns, device)
+        self.sky_floor = self.floor if ns == n else floor(ns)
 
     @classmethod
     def bytes_needed(cls, scene, k: int, groups: int) -> int:
@@ -281,7 +290,9 @@ class FluxRatioStage(CausticStage):
         m = cfg.caustics.map_resolution
         walk = k * m * m * 4 if cfg.optics.scattering is not Scattering.SINGLE else 0  # the walk's texels
         coarse = k * coarse_resolution(cfg, cfg.water.periodic) ** 2 * 8 if needs_coarse(cfg) else 0
-        return floor_bytes(scene.water_resolution, m, k, groups) + walk + coarse
+        n, ns = scene.water_resolution, scene.sky_resolution
+        sky = floor_bytes(ns, m, k, groups) + coarse if ns != n else 0  # the sky's surface's own buffers
+        return floor_bytes(n, m, k, groups) + walk + coarse + sky
 
     def render(self, frame: Frame) -> StageOutput:
         floor, transmitted, extra, single = self.flux_ratio(frame)
@@ -307,7 +318,7 @@ class FluxRatioStage(CausticStage):
         with watch.stage("readback"):
             # .copy(): on the CPU device .numpy() is a view of a buffer the next frame reuses.
             floor_np = floor.numpy().copy()
-        coarse = self._coarse(frame)  # the sun's, on the whole patch beside a window
+        coarse = self._coarse(self.floor, frame)  # the sun's, on the whole patch beside a window
         if self.small_angle is not None:
             self.small_angle.reset(frame.surface.positions.numpy()[..., 2])
             with watch.stage("small_angle"):  # the disk's directions share one transfer, its centre's
@@ -336,7 +347,7 @@ class FluxRatioStage(CausticStage):
             if self.scene.config.sky.sampling is SkySampling.HALVES:  # this frame's directions
                 self.multiple.set_sky(self.light.sky_directions, np.stack(self.light.sky_irradiance_np))
             with watch.stage("sky"):
-                sky_np, walk["sky"] = self.multiple.run_sky(frame.surface, self.light.sky_visible)
+                sky_np, walk["sky"] = self.multiple.run_sky(frame.for_sky().surface, self.light.sky_visible)
             extra["sky_floor_irradiance"] = sky_np
             extra["sky_floor_irradiance_even"] = None  # the walk's sky is one estimate
             floor_np = floor_np + sky_np
@@ -378,6 +389,7 @@ class FluxRatioStage(CausticStage):
         back and given its own transfer (its own path), its scattered light reported by half; with
         ``sky.sampling = "cones"`` it is read back and spread over its cell of the sky first."""
         light = self.light
+        sky = frame.for_sky()  # the surface its passes take (sky.surface_resolution)
         transmitted = 0.0
         total = even = total_coarse = None
         separate = self.small_angle is not None or self.cones is not None
@@ -388,13 +400,13 @@ class FluxRatioStage(CausticStage):
             direction, irradiance = light.sky_directions[i], light.sky_irradiance_per_dir[i]
             with frame.watch.stage("sky"):
                 out = light.sky_visible[i] if light.sky_visible.ndim == 3 else light.sky_visible
-                visible = frame.shade(direction, self.device, out)
+                visible = sky.shade(direction, self.device, out)
             read = separate or n == count - 1 or (halves and n == count // 2 - 1)  # this map is read next
-            floor, flux = self._deposit(frame, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
-                                        irradiance=irradiance, bands=read)
+            floor, flux = self._deposit(sky, visible, direction, ("sky", "sky"), clear=n == 0 or separate,
+                                        irradiance=irradiance, bands=read, sky=True)
             transmitted = transmitted + flux
             if separate:
-                one, coarse = floor.numpy().copy(), self._coarse(frame)
+                one, coarse = floor.numpy().copy(), self._coarse(self.sky_floor, frame)
                 if self.cones is not None:
                     with frame.watch.stage("sky_cones"):
                         one, coarse = self.cones.spread(i, one, coarse)
@@ -408,30 +420,34 @@ class FluxRatioStage(CausticStage):
             if halves and n == count // 2 - 1:  # the last of the even-numbered directions
                 even = total.copy() if separate else floor.numpy().copy()
         if not separate:
-            total_coarse = self._coarse(frame)
+            total_coarse = self._coarse(self.sky_floor, frame)
         return (floor.numpy().copy() if total is None else total), transmitted, even, total_coarse
 
-    def _coarse(self, frame: Frame) -> np.ndarray | None:
-        """The whole patch's light on coarse texels since the last clearing pass (K, Mc, Mc), or None
-        where the map is the whole patch."""
-        if self.floor.coarse is None:
+    def _coarse(self, floor: FloorCaustics, frame: Frame) -> np.ndarray | None:
+        """The whole patch's light on ``floor``'s coarse texels since its last clearing pass
+        (K, Mc, Mc), or None where the map is the whole patch."""
+        if floor.coarse is None:
             return None
-        return self.floor.coarse_irradiance(float(frame.surface.extent_m))
+        return floor.coarse_irradiance(float(frame.surface.extent_m))
 
     def _deposit(self, frame: Frame, visible, direction, stages: tuple[str, str], *, clear: bool,
-                 irradiance: wp.array | None = None, bands: bool = True) -> tuple[wp.array3d, np.ndarray]:
+                 irradiance: wp.array | None = None, bands: bool = True,
+                 sky: bool = False) -> tuple[wp.array3d, np.ndarray]:
         """One flux-ratio pass for light arriving from ``direction`` (the sun's centre, a point of
-        its disk or of the sky): refraction, then the deposit added to the map unless ``clear``;
-        returns the map and the pass's (2, K) flux per band entering the water and delivered to the
-        floor [W nm^-1] (host read-backs; a device-side sum would spare them on CUDA)."""
+        its disk or of the sky): refraction through ``frame``'s surface, then the deposit added to
+        the map unless ``clear``; returns the map and the pass's (2, K) flux per band entering the
+        water and delivered to the floor [W nm^-1] (host read-backs; a device-side sum would spare
+        them on CUDA). ``sky``: the sky surface's buffers (the sun's otherwise; the same where the
+        sky takes the water's surface)."""
+        out, floor_caustics = (self.sky_refracted, self.sky_floor) if sky else (self.refracted, self.floor)
         with frame.watch.stage(stages[0]):
             refracted = refract_to_floor(frame.surface, visible, self.light.group_ior, direction,
-                                         -self.scene.config.floor.depth_m, self.device, out=self.refracted)
+                                         -self.scene.config.floor.depth_m, self.device, out=out)
         with frame.watch.stage(stages[1]):
-            floor = self.floor.run(frame.surface, refracted, direction, clear=clear, irradiance=irradiance,
-                                   bands=bands)
-            flux = np.stack([self.floor.entering_flux(),
-                             self.floor.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
+            floor = floor_caustics.run(frame.surface, refracted, direction, clear=clear,
+                                       irradiance=irradiance, bands=bands)
+            flux = np.stack([floor_caustics.entering_flux(),
+                             floor_caustics.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
         return floor, flux
 
 

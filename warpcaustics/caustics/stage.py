@@ -65,7 +65,8 @@ class Lighting:
     sky_irradiance_per_dir: list = field(default_factory=list)
     """The same as device arrays."""
     sky_visible: wp.array | None = None
-    """The crests' shading from each sky direction: one (N, N) buffer reused, or (S, N, N)."""
+    """The crests' shading from each sky direction: one (N, N) buffer reused, or (S, N, N), N the sky's
+    surface's (:attr:`~warpcaustics.scene.Scene.sky_resolution`)."""
 
     @property
     def attenuation_per_m(self) -> np.ndarray:
@@ -85,7 +86,7 @@ class Lighting:
         if cfg.sky.model is not SkyModel.NONE:
             light.sky_irradiance_horizontal = scene.sky_irradiance(sun)
             light.set_sky(*scene.sky_directions(), device)
-            n = scene.water_resolution
+            n = scene.sky_resolution
             shape = (len(light.sky_directions), n, n) if keep_sky_shading else (n, n)
             light.sky_visible = wp.empty(shape, dtype=wp.float32, device=device)
         return light
@@ -141,6 +142,13 @@ class Frame:
     horizon: wp.array2d | None = None
     """A periodic surface's :func:`~warpcaustics.optics.refraction.horizon_buffer`, which every
     light direction's sweep reuses (None: each allocates its own)."""
+    sky: Frame | None = None
+    """The frame of the surface the sky's directions are refracted through where it is not this one
+    (``sky.surface_resolution``: the same waves cut to a coarser grid; its ``visible`` is None)."""
+
+    def for_sky(self) -> Frame:
+        """The frame the sky's passes take: :attr:`sky`, or this one."""
+        return self.sky or self
 
     def shade(self, direction: np.ndarray, device: str, out: wp.array2d) -> wp.array2d:
         """(N, N) the crests' shading of this frame's surface from ``direction`` (towards the light)

@@ -160,6 +160,16 @@ def _check_sky(cfg: Config) -> None:
             raise ConfigError(f"sky.sampling = \"cones\" spreads each direction's light over a periodic sea, "
                               f"not water.model = {cfg.water.model.value!r}; use water.model = \"fft\" or "
                               "sky.sampling = \"stratified\"")
+    _check_sky_surface(cfg)
+
+
+def _check_sky_surface(cfg: Config) -> None:
+    """``sky.surface_resolution``: a power of two (it applies to cones on an FFT ocean and is left
+    aside elsewhere, so that a field config's row with point directions or another sea still loads)."""
+    ns = cfg.sky.surface_resolution
+    if ns and (ns & (ns - 1) or ns < 4):
+        raise ConfigError(f"sky.surface_resolution = {ns} must be a power of two of at least 4 (e.g. "
+                          f"{max(4, 1 << round(math.log2(max(ns, 1))))}); 0 = the water's own grid")
 
 
 def _check_scattering(cfg: Config) -> None:

@@ -14,6 +14,7 @@ import numpy as np
 from warpcaustics.config import (
     Config,
     FloorShape,
+    SkyModel,
     SkySampling,
     WaterModel,
     config_from_dict,
@@ -45,6 +46,15 @@ class Scene:
     @property
     def water_resolution(self) -> int:
         return self.config.water.resolution
+
+    @property
+    def sky_resolution(self) -> int:
+        """Vertices a side of the surface the sky's directions are refracted through: the water's
+        own, or ``sky.surface_resolution`` where the sky is in cones over an FFT ocean of a finer grid."""
+        cfg = self.config
+        applies = (cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
+                   and cfg.water.model is WaterModel.FFT and cfg.sky.surface_resolution)
+        return min(cfg.sky.surface_resolution, self.water_resolution) if applies else self.water_resolution
 
     def sun_disk_directions(self) -> np.ndarray:
         """(S, 3) unit directions over the sun's disk, each standing for an equal solid angle: a

@@ -125,6 +125,15 @@ def _fft2(data: wp.array2d, row_kernel, scratch: wp.array2d | None) -> wp.array2
     return data
 
 
+def vertex_shift(n: int, extent_m: float) -> np.ndarray:
+    """e^{i k·x0}, FFT order: vertex (ix, iy) lies at x0 + ix L/N, x0 = −L/2 + L/(2N), which
+    :class:`FFTOcean` folds into h̃0."""
+    k = wavenumbers(n, extent_m)
+    kx, ky = np.meshgrid(k, k)
+    x0 = -0.5 * extent_m + 0.5 * extent_m / n
+    return np.exp(1j * (kx + ky) * x0)
+
+
 def dispersion(k: np.ndarray, depth_m: float) -> np.ndarray:
     """Angular frequency of gravity waves over a floor at depth h: ω² = g k tanh(k h) (Tessendorf
     eq. 19) [rad/s]."""
@@ -142,14 +151,14 @@ class FFTOcean:
         n = h0.shape[0]
         self.device = device
         self.extent_m = extent_m
+        self.depth_m = float(depth_m)
         self.choppiness = float(choppiness)
         k = wavenumbers(n, extent_m)
         kx, ky = np.meshgrid(k, k)
         omega = dispersion(np.hypot(kx, ky), depth_m)
         h0_minus = h0[(-np.arange(n)) % n][:, (-np.arange(n)) % n]
         # Vertex (ix, iy) is at x0 + ix L/N with x0 = -L/2 + L/(2N): fold e^{i k·x0} into h̃0.
-        x0 = -0.5 * extent_m + 0.5 * extent_m / n
-        shift = np.exp(1j * (kx + ky) * x0)
+        shift = vertex_shift(n, extent_m)
         self.h0 = to_vec2(negligible_to_zero(h0 * shift), device)
         self.h0_minus_conj = to_vec2(negligible_to_zero(np.conj(h0_minus) * shift), device)
         self.omega = wp.array(omega.astype(np.float32), dtype=wp.float32, device=device)
@@ -169,6 +178,21 @@ class FFTOcean:
         spectrum = ocean_spectrum(cfg, *np.meshgrid(k, k))
         return cls(initial_spectrum(spectrum, w.extent_m, seed=w.seed), w.extent_m, wave_depth_m(cfg),
                    device, choppiness=w.choppiness)
+
+    def truncated(self, n: int) -> FFTOcean:
+        """The same ocean on an N×N grid (N a power of two up to :attr:`resolution`): its waves
+        whose wavenumbers the coarser grid holds, each with its own amplitude and phase, the shorter
+        ones (and the coarser grid's Nyquist row and column, as :func:`initial_spectrum`) left out.
+        Its heights are the spectral low-pass of this ocean's at every time."""
+        big = self.resolution
+        if n > big or n & (n - 1) or n < 2:
+            raise ValueError(f"a truncated ocean needs a power of two up to {big}, got {n}")
+        h0 = from_vec2(self.h0) * np.conj(vertex_shift(big, self.extent_m))  # the unshifted h̃0
+        index = np.r_[0:n // 2, big - n // 2:big]  # the coarse grid's wavenumbers in the fine FFT order
+        coarse = h0[np.ix_(index, index)]
+        coarse[n // 2, :] = 0.0
+        coarse[:, n // 2] = 0.0
+        return FFTOcean(coarse, self.extent_m, self.depth_m, self.device, choppiness=self.choppiness)
 
     @staticmethod
     def device_bytes(n: int, device) -> int:
