@@ -35,12 +35,17 @@ ZENITHS = (20.0, 50.0, 80.0)
 SQRT_WINDS = (1.2, 2.4, 3.6)
 
 BEFORE = {"water.spectrum": "jonswap", "sky.model": "uniform", "sky.sampling": "stratified",
-          "optics.beam_spread": "wells", "water.extent_m": 32.0, "water.resolution": 1024,
-          "water.wind_direction_deg": 0.0, "sun.disk_samples": 16}
+          "sky.directions": 16, "optics.beam_spread": "wells", "water.extent_m": 32.0,
+          "water.resolution": 1024, "water.wind_direction_deg": 0.0, "sun.disk_samples": 16}
 """The set-up the budget starts from: configs/field/gernez2009.toml as it was before issue 27 (a
 JONSWAP sea, a uniform sky of 16 point directions, Wells's spread, 1024² cells over 32 m, the wind
 along the sun's azimuth, 16 directions over the sun's disk); every row but the last changes one
 thing on top of it."""
+
+SKY_16_CONES = {"sky.directions": 16, "sky.surface_resolution": 0}
+"""The config's sky until 2026-12-06 (late): 16 cones refracted through the whole 2048² sea, as the
+figures of the benchmarks that take it (cones_attenuation, long_waves, field_bands) were measured;
+the config now has 64 cones on its waves cut to 1024²."""
 
 WINDOW_CV = "model_cv_window"
 """The column every row's CV is read from (the window alone); a table written before it existed has

@@ -298,6 +298,9 @@ def main(argv: list[str] | None = None) -> int:
     # The Gernez comparison's six bands against its one (benchmarks/field_bands.py).
     field_bands = _in_child("run", args.quick, args.device, module="field_bands")
 
+    # The sky's cones on the sea's waves cut to a coarser grid (benchmarks/sky_surface.py).
+    sky_surface = _in_child("run", args.quick, args.device, module="sky_surface")
+
     # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
     spectra = _in_child("run", args.quick, args.device, module="spectra")
 
@@ -340,6 +343,7 @@ def main(argv: list[str] | None = None) -> int:
         "spectra": spectra,
         "long_waves": long_waves,
         "field_bands": field_bands,
+        "sky_surface": sky_surface,
         "sweep": sweeps,
         "memory": memory,
     }
