@@ -298,8 +298,11 @@ def main(argv: list[str] | None = None) -> int:
     # The Gernez comparison's six bands against its one (benchmarks/field_bands.py).
     field_bands = _in_child("run", args.quick, args.device, module="field_bands")
 
-    # The sky's cones on the sea's waves cut to a coarser grid (benchmarks/sky_surface.py).
-    sky_surface = _in_child("run", args.quick, args.device, module="sky_surface")
+    # The sky's cones on the sea's waves cut to a coarser grid (benchmarks/sky_surface.py), in this
+    # process: it runs each case in a child of its own (a pool's worker may not start one).
+    from benchmarks import sky_surface as sky_surface_bench
+
+    sky_surface = sky_surface_bench.run(args.quick, args.device)
 
     # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
     spectra = _in_child("run", args.quick, args.device, module="spectra")
