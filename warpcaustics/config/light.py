@@ -101,5 +101,5 @@ class SkyConfig:
     grid (the same waves, the shorter ones left out). A cone spreads its direction's
     light over its cell of the sky, tens of centimetres on the floor, where the shorter waves'
     patterns are gone: on the Gernez sea (3.9 mm cells) half the grid, 1024², moves the sky's
-    float64 continuum by 2–5 % in CV and under 0.2 % in mean (docs/physics.md, "The sky's
+    float64 continuum by 2–6 % in CV and under 0.2 % in mean (docs/physics.md, "The sky's
     surface"), at a quarter of the cost of each sky pass. 0 = the water's own grid [-]."""
