@@ -256,12 +256,10 @@ def cover_triangle(dep: CoverDeposit, q0: wp.vec2, e1: wp.vec2, e2: wp.vec2, m: 
     cover_edge(dep, q2 - corner, q0 - corner, weight, col0, row0, m, wrap)
 
 
-@wp.func
-def deposit_triangle(
+@wp.kernel
+def deposit_footprints(
+    runs: wp.array[wp.vec2i],
     g: int,
-    iy: int,
-    ix: int,
-    half: int,
     hit_xy: wp.array3d[wp.vec2],
     flux_w_nm: wp.array4d[wp.float32],
     wavelengths_per_group: int,
@@ -277,7 +275,20 @@ def deposit_triangle(
     differences into ``cover`` (M, M, K) and ``carry`` (M, K), small footprints straight into
     ``texels`` (M, M, K) (:func:`cover_to_bands` sums them):
     texel (ty, tx) spans ``origin + [tx, tx+1] / scale`` in x. On a window of a periodic sea each
-    footprint is taken at its periodic image nearest the window."""
+    footprint is taken at its periodic image nearest the window.
+
+    The triangles are those of rows of quads: thread (r, cx, half) takes quad
+    ``runs[r] + (0, cx)`` (iy, first ix + cx), past the last column none. The runs are every row of
+    the blocks :func:`block_reach` found near the window (on the CPU a thread that returns at once
+    still costs its launch, and the culled ones took most of a window's deposit), or every whole
+    row, in row-major order either way, so that on the CPU, where a launch runs its threads in
+    order, the map is the same to the bit whichever blocks are culled."""
+    r, cx, half = wp.tid()
+    run = runs[r]
+    iy = run[0]
+    ix = run[1] + cx
+    if ix >= flux_w_nm.shape[1]:
+        return
     m = cover.shape[0]
     k_begin = g * wavelengths_per_group
     if carries_flux(flux_w_nm, iy, ix, half, k_begin, wavelengths_per_group) == 0:
@@ -295,55 +306,6 @@ def deposit_triangle(
     q0, e1, e2 = footprint(hit_xy, g, iy, ix, half, extent_m, periodic, floor_map, m)
     scale = floor_map.scale
     cover_triangle(dep, q0, e1, e2, m, floor_map.wrap, floor_map.max_clipped, scale * scale, coarse_count)
-
-
-@wp.kernel
-def deposit_footprints(
-    hit_xy: wp.array3d[wp.vec2],
-    flux_w_nm: wp.array4d[wp.float32],
-    wavelengths_per_group: int,
-    extent_m: float,
-    periodic: int,
-    floor_map: FloorMap,
-    cover: wp.array3d[wp.float32],
-    carry: wp.array2d[wp.float64],
-    texels: wp.array3d[wp.float32],
-    coarse_count: wp.array[wp.int32],
-):
-    """:func:`deposit_triangle` for every triangle (g, iy, ix, half)."""
-    g, iy, ix, half = wp.tid()
-    deposit_triangle(g, iy, ix, half, hit_xy, flux_w_nm, wavelengths_per_group, extent_m, periodic, floor_map,
-                     cover, carry, texels, coarse_count)
-
-
-@wp.kernel
-def deposit_reached(
-    runs: wp.array[wp.vec2i],
-    g: int,
-    hit_xy: wp.array3d[wp.vec2],
-    flux_w_nm: wp.array4d[wp.float32],
-    wavelengths_per_group: int,
-    extent_m: float,
-    periodic: int,
-    floor_map: FloorMap,
-    cover: wp.array3d[wp.float32],
-    carry: wp.array2d[wp.float64],
-    texels: wp.array3d[wp.float32],
-    coarse_count: wp.array[wp.int32],
-):
-    """:func:`deposit_triangle` for the triangles of the blocks :func:`block_reach` found near the
-    window, index group g: ``runs[r]`` = (iy, first ix) of the r-th row of such a block, in the order
-    :func:`deposit_footprints` takes them (row by row, then along the row), so the map is its own to
-    the bit on the CPU, where a launch runs its threads in that order. A launch of only those
-    triangles: on the CPU, where a thread that returns at once still costs its launch, the culled
-    ones took most of a window's deposit."""
-    r, cx, half = wp.tid()
-    run = runs[r]
-    ix = run[1] + cx
-    if ix >= flux_w_nm.shape[1]:
-        return
-    deposit_triangle(g, run[0], ix, half, hit_xy, flux_w_nm, wavelengths_per_group, extent_m, periodic,
-                     floor_map, cover, carry, texels, coarse_count)
 
 
 @wp.func

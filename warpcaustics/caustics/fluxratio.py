@@ -200,22 +200,22 @@ class FloorCaustics:
             self.carry.zero_()
             self.texels.zero_()
             self.coarse_count.zero_()
-        common = [k // groups, float(surface.extent_m), int(surface.periodic), floor_map]
-        outputs = [self.cover, self.carry, self.texels, self.coarse_count]
-        if not self.reach_cells:
-            wp.launch(cover_kernels.deposit_footprints, dim=(groups, quads, quads, 2),
-                      inputs=[refracted.hit_xy, self.flux, *common], outputs=outputs, device=self.device)
-        else:  # the triangles of the blocks whose footprints may reach the window, and no others
+        if self.reach_cells:  # the triangles of the blocks whose footprints may reach the window
             wp.launch(cover_kernels.block_reach, dim=self.reach.shape,
                       inputs=[refracted.hit_xy, self.reach_cells, float(surface.extent_m), floor_map],
                       outputs=[self.reach], device=self.device)
-            reach = self.reach.numpy()
-            for g in range(groups):
-                runs = reached_runs(reach[g], self.reach_cells, quads)
-                if len(runs):
-                    wp.launch(cover_kernels.deposit_reached, dim=(len(runs), self.reach_cells, 2),
-                              inputs=[wp.array(runs, dtype=wp.vec2i, device=self.device), g, refracted.hit_xy,
-                                      self.flux, *common], outputs=outputs, device=self.device)
+            reach, cells = self.reach.numpy(), self.reach_cells
+        else:  # every triangle: one block of every quad
+            reach, cells = np.ones((groups, 1, 1), np.int32), quads
+        for g in range(groups):
+            runs = reached_runs(reach[g], cells, quads)
+            if len(runs):
+                wp.launch(cover_kernels.deposit_footprints, dim=(len(runs), cells, 2),
+                          inputs=[wp.array(runs, dtype=wp.vec2i, device=self.device), g, refracted.hit_xy,
+                                  self.flux, k // groups, float(surface.extent_m), int(surface.periodic),
+                                  floor_map],
+                          outputs=[self.cover, self.carry, self.texels, self.coarse_count],
+                          device=self.device)
         if bands:
             wp.launch(cover_kernels.cover_to_bands, dim=(m, k), inputs=[self.cover, self.carry, self.texels],
                       outputs=[self.irradiance], device=self.device)
