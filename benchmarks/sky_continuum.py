@@ -68,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
                            ["cie_clear_sun_80"], on_coarser),
     }
     if "surface" in args.cases.split(","):
-        surface_case(gernez, CIE_SKIES, cie_sky, PeriodicHeights, floor_irradiance, texel_points)
+        surface_case(gernez)
     points_a_side, quadrature = (8, 96) if args.quick else (16, 160)
     for name in (c for c in args.cases.split(",") if c != "surface"):
         config, overrides, extent, texels, sky_names, samplings = cases[name]
@@ -106,13 +106,14 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def surface_case(overrides: dict, table, cie_sky, PeriodicHeights, floor_irradiance, texel_points) -> None:
+def surface_case(overrides: dict) -> None:
     """``--cases surface``: the sky's float64 continuum on the Gernez sea and on the same sea without
     its waves shorter than a 1024² or 512² grid holds, sampled on that grid (what sky.surface_resolution
-    refracts the cones through, low-passed here in numpy), under the
-    CIE overcast sky and the clear sky with the sun 80° and 40° from the zenith, at 8 × 8 points 1 m
-    apart, 160² directions. Nothing of the package but the sea's heights and the water's c(λ)."""
+    refracts the cones through, low-passed here in numpy), under the CIE overcast sky and the clear
+    sky with the sun 80° and 40° from the zenith, at 8 × 8 points 1 m apart, 160² directions. Nothing
+    of the package but the sea's heights and the water's c(λ)."""
     from helpers import low_pass  # noqa: I001 (the tests' folder, put on the path in main)
+    from sky_continuum import PeriodicHeights, cie_sky, floor_irradiance, texel_points
 
     import warpcaustics as wc
     from warpcaustics.optics import spectra
