@@ -49,11 +49,11 @@ def scene_bytes(scene: Scene, device: str = "cuda") -> int:
     groups = k if cfg.optics.dispersion else 1
     stage = METHODS[cfg.caustics.method].bytes_needed(scene, k, groups)
     ns = scene.sky_resolution
-    periodic = WATER_MODELS[cfg.water.model].periodic
-    shading = horizon_bytes(n) if periodic else 0  # the sweep's lattice
-    if ns != n:  # the sky's own surface (its waves cut to a coarser grid) and its sweep
-        shading += water_bytes(cfg, ns, device) + horizon_bytes(ns)
-    return water_bytes(cfg, n, device) + stage + sky_bytes(cfg, ns, keeps_sky_shading(cfg)) + shading
+    shading = horizon_bytes(n) if WATER_MODELS[cfg.water.model].periodic else 0  # the sweep's lattice
+    # the sky's own surface (its waves cut to a coarser grid) and its sweep's lattice
+    sky_surface = water_bytes(cfg, ns, device) + horizon_bytes(ns) if ns != n else 0
+    sky = sky_bytes(cfg, ns, keeps_sky_shading(cfg)) + sky_surface
+    return water_bytes(cfg, n, device) + stage + sky + shading
 
 
 HOST_BYTES_PER_PIXEL = 200
