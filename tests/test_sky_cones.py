@@ -39,8 +39,9 @@ def cosine_weighted(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(rng.random(n)), 2 * math.pi * rng.random(n)
 
 
-@pytest.mark.parametrize("sky_type", [None, 12])
-def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
+@pytest.mark.parametrize("sky_type, depth, texel, m, step", [(None, 3.0, 0.1, 64, 2), (12, 3.0, 0.1, 64, 2),
+                                                             (None, 1.0, 0.5, 8, 1)])
+def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type, depth, texel, m, step):
     """B̂_j(k) against a Monte Carlo written apart: 400 000 cosine-weighted random directions (uniform
     in the projected disk), each in the cell of its nearest stratified direction of 16, weighted by
     the sky's radiance and the angle form of Fresnel's transmittance, refracted by Snell's law in
@@ -48,7 +49,10 @@ def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
     half-way, by the horizon) and frequencies where |B̂| runs from ~0.9 to ~0.1: within 0.03. The
     Monte Carlo's standard error is ≤ 0.006; the multiplier's own error is its dense set's 256
     points a cell, which cut the cells' edges coarsely: against 3 million samples it is ≤ 0.016 at
-    the horizon's cell (0.008 with 1024 points a cell), ≤ 0.005 elsewhere."""
+    the horizon's cell (0.008 with 1024 points a cell), ≤ 0.005 elsewhere. The frequencies of all
+    four quadrants are checked: the multiplier sums half of them and mirrors the rest (B̂(−k) =
+    conj B̂(k)); on an 8² grid whose Nyquist row and column (which keep their own sums: their
+    mirror on the grid is not −k) hold values in that range too."""
     directions, sun, key = sixteen_directions({})
     cells = sky_cells(key, sky_type, sun, IOR)
     r, phi = cosine_weighted(400_000, 7)
@@ -61,19 +65,22 @@ def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
         weight = weight * cie_relative_radiance(sky_type, up, sun)
     theta_w = np.arcsin(r / IOR)
     offset = np.tan(theta_w)[:, None] * p / np.maximum(r, 1e-300)[:, None]  # along the light's azimuth
-    depth, texel, m = 3.0, 0.1, 64  # frequencies 0.98 rad/m apart
-    k = 2 * math.pi * np.fft.fftfreq(m, texel)
+    k = 2 * math.pi * np.fft.fftfreq(m, texel)  # 0.98 rad/m apart on the 64² grids
+    quadrants = set()
     for j in (0, 8, 15):
         mine = owner == j
         theta_j = math.asin(math.hypot(*directions[j, :2]))
         t_j = math.tan(math.asin(math.sin(theta_j) / IOR)) * directions[j, :2] / math.sin(theta_j)
         table = dense(cell_multiplier(directions[j], *cells[j], 16, depth, IOR, texel, m), m)
         checked = 0
-        for iy in range(0, 12, 2):
-            for ix in range(0, 12, 2):
+        reach = min(12, m // 2 + 1)
+        for iy in range(-reach + 1, reach, step):
+            for ix in range(-reach + 1, reach, step):
+                iy, ix = iy % m, ix % m  # numpy's fft2 order: m // 2 is the Nyquist row or column
                 b = table[iy, ix]
                 if not 0.1 < abs(b) < 0.95:
                     continue
+                quadrants.add((k[iy] > 0, k[ix] > 0) if 2 * iy != m and 2 * ix != m else "nyquist")
                 phase = np.exp(1j * depth * (k[ix] * (offset[mine, 0] - t_j[0])
                                              + k[iy] * (offset[mine, 1] - t_j[1])))
                 mc = np.sum(weight[mine] * phase) / np.sum(weight[mine])
@@ -81,6 +88,7 @@ def test_a_cells_multiplier_is_its_directions_mean_shift(sky_type):
                 checked += 1
         assert checked >= 3, j
         assert table[0, 0] == pytest.approx(1.0, abs=1e-6)
+    assert len(quadrants) == (5 if m == 8 else 4), quadrants
 
 
 def test_a_cells_share_is_the_light_its_directions_transmit():
