@@ -20,8 +20,11 @@ the cross-spectra of ``--seeds`` independent walks (all pairs averaged). Printed
   whose noise the surface factor carries too), not one pair's spread scaled: four disjoint pairs
   give a standard deviation itself uncertain by ~40 %.
 
-The figures are in docs/physics.md and docs/validation.md (issue 32 item 2). About two minutes per
-geometry on one core with 8 seeds.
+``--set`` changes the scene for every map alike: the walked spread's photons
+(``optics.beam_spread_photons``: its own Monte Carlo noise is a fixed realisation per seed, which the
+walks' jackknife does not hold) or the waves' amplitude (``water.phillips_amplitude``: does a residual
+grow with the slopes?). The figures are in docs/physics.md and docs/validation.md (issue 32 item 2).
+About two minutes per geometry on one core with 8 seeds.
 """
 
 from __future__ import annotations
@@ -71,15 +74,25 @@ def jackknife_sd(samples: np.ndarray) -> np.ndarray:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=8, help="independent walks (even, ≥ 4; default 8)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a config override on top of the test's scene, for every map alike "
+                             "(repeatable), e.g. optics.beam_spread_photons=2097152")
     args = parser.parse_args(argv)
     if args.seeds < 4 or args.seeds % 2:
         parser.error("--seeds: give an even number of at least 4")
+    from warpcaustics.config import parse_override
+
+    extra = dict(parse_override(text) for text in args.set)
     sys.path.insert(0, str(ROOT / "tests"))
     from helpers import CONFIGS  # noqa: I001 (the tests' folder, put on the path above)
     from test_small_angle import BANDS, SCENE, band_power, fluctuations
 
     import warpcaustics as wc
 
+    try:  # a bad --set fails in one line before anything renders
+        wc.load_scene(CONFIGS / "ocean.toml", {**SCENE, **extra})
+    except wc.ConfigError as exc:
+        parser.error(f"--set: {exc}")
     m = SCENE["caustics.map_resolution"]
     ring = rings(m)
 
@@ -103,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     print("rows: the 450, 550 and 650 nm bands of the map (optics.wavelengths = rgb)")
     for depth, phase in GEOMETRIES:
         start = time.perf_counter()
-        base = {**SCENE, "floor.depth_m": depth, "optics.phase_function": phase}
+        base = {**SCENE, "floor.depth_m": depth, "optics.phase_function": phase, **extra}
         bare = {**base, "optics.water_type": "none"}
         walk, walk_k, noise = cross_power(
             [floor({**base, "optics.scattering": "multiple", "optics.mc_seed": s}) for s in seeds],
