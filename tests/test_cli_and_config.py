@@ -122,6 +122,20 @@ def test_python_overrides_and_errors():
     assert scene.config.sun.elevation_deg == 45.0
     with pytest.raises(ConfigError, match="nearest valid key: 'sun.elevation_deg'"):
         wc.load_scene(CONFIGS / "ocean.toml", overrides={"sun.elevation": 45.0})
+    with pytest.raises(ConfigError, match="must be a dotted name"):
+        wc.load_scene(CONFIGS / "ocean.toml", overrides={1: 2})
+
+
+def test_a_table_override_merges_into_the_table():
+    """``--set 'water={wind_speed_m_s=3.0}'`` changes that key alone, as ``water.wind_speed_m_s=3.0``
+    does (it had put every other [water] key back to its default), and the caller's dict is left as
+    it was."""
+    dotted = wc.load_scene(CONFIGS / "ocean.toml", {"water.wind_speed_m_s": 3.0}).config
+    given = {"water": {"wind_speed_m_s": 3.0}}
+    table = wc.load_scene(CONFIGS / "ocean.toml", {**given, "water.seed": 7}).config
+    assert table == dotted
+    assert table.water.resolution == 256 and table.water.extent_m == 16.0  # the file's, not the defaults
+    assert given == {"water": {"wind_speed_m_s": 3.0}}
 
 
 def test_render_writes_complete_outputs(tmp_path, capsys):
@@ -225,10 +239,42 @@ def test_heightfield_unreadable_files(capsys, tmp_path, writer, needle):
     _fails_cleanly(capsys, tmp_path, [cfg], "water.file", needle)
 
 
-@pytest.mark.parametrize("time_arg", ["nan", "inf"])
-def test_non_finite_time_is_refused(capsys, tmp_path, time_arg):
-    """--time must be a finite number of seconds."""
-    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), "--time", time_arg], "--time")
+@pytest.mark.parametrize("time_args", [["--time", "nan"], ["--time", "inf"], ["--time", "1e39"],
+                                       ["--frames", "2", "--fps", "1e-308"]])
+def test_non_finite_time_is_refused(capsys, tmp_path, time_args):
+    """--time (and the animation's last frame) must be a finite number of seconds within ±1e9: past
+    float32's range the surface's sweep overflowed inside the render, after the folder was made."""
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), *SMALL, *time_args], "--time")
+
+
+@pytest.mark.parametrize(("integration", "frames"), [("10", "3"), ("0.05", "3")])
+def test_an_integration_the_animation_cannot_hold_is_refused_before_rendering(capsys, tmp_path, integration,
+                                                                               frames):
+    """stats.integration_s over a 3-frame animation at 30 fps: 10 s raised inside run.json's writer after
+    every frame was written, 0.05 s left the integrated statistics out in silence; both are one line
+    naming the frames needed (⌈T·fps⌉ + 3), before any output."""
+    needed = "303" if integration == "10" else "5"
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), *SMALL, "--frames", frames,
+                                      "--set", f"stats.integration_s={integration}"],
+                   "stats.integration_s", f"--frames ≥ {needed}")
+
+
+def test_the_walked_spreads_photons_are_counted_and_named_in_the_memory_check():
+    """The walked beam spread's photons are in the host memory the check asks for (a render with
+    2²⁶ of them had failed for lack of memory blaming the map's keys, 'needs 0.00 GiB'), and the fix
+    names optics.beam_spread_photons."""
+    from warpcaustics.optics.beam_spread import SPREAD_CACHE
+    from warpcaustics.pipeline import HOST_BYTES_PER_SPREAD_PHOTON, host_bytes, memory_fix
+
+    walked = {"optics.scattering": "small_angle", "optics.beam_spread": "walk", "optics.wavelengths": "rgb"}
+    few = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread_photons": 1024})
+    many = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread_photons": 1 << 26})
+    per_photon = HOST_BYTES_PER_SPREAD_PHOTON + 4 * 3 + SPREAD_CACHE * (32 + 4 * 3)
+    assert host_bytes(many) - host_bytes(few) == ((1 << 26) - 1024) * per_photon
+    assert "optics.beam_spread_photons" in memory_fix(many.config)
+    wells = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread": "wells"})
+    assert "beam_spread_photons" not in memory_fix(wells.config)
+    assert host_bytes(wells) == host_bytes(few) - 1024 * per_photon
 
 
 def test_wavelengths_outside_the_data_fail_at_load():

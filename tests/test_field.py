@@ -226,6 +226,9 @@ def test_bad_input_is_one_line(tmp_path, capsys):
     with pytest.raises(ConfigError, match="--set sun.elevation_deg"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sun.elevation_deg": 30.0},
                              quick=True)
+    with pytest.raises(ConfigError, match="--set sun.elevation_deg"):  # a table reaches the key too
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sun": {"elevation_deg": 30.0}},
+                             quick=True)
     with pytest.raises(ConfigError, match="sky.model"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", overrides={"sky.model": "none"}, quick=True)
     with pytest.raises(ConfigError, match="--set sky.model: the comparison sets it"):  # the overcast sky
@@ -235,10 +238,41 @@ def test_bad_input_is_one_line(tmp_path, capsys):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=4.0, quick=True)
     with pytest.raises(ConfigError, match="--long-waves = -1"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=-1.0, quick=True)
+    with pytest.raises(ConfigError, match="--frame-interval"):  # the last frame past float32's range
+        field.run_gernez2009(_scene(tmp_path), tmp_path / "o", frame_interval_s=1e308, quick=True)
     assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "o"),
                  "--zeniths", "20,x"]) == 2
     assert "--zeniths '20,x' must be comma-separated numbers" in capsys.readouterr().err
+    (tmp_path / "afile").write_text("")
+    assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "afile" / "o"),
+                 "--zeniths", "20", "--series", "zenith", "--quick"]) == 2
+    assert "cannot be created" in capsys.readouterr().err
+    assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "o"),
+                 "--zeniths", "20", "--series", "zenith", "--quick", "--device", "bogus"]) == 2
+    assert "device = 'bogus' is not allowed" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_task_that_fails_as_it_renders_is_named_in_the_one_line(tmp_path, capsys):
+    """A depth the waves reach fails in the render, not at load: the command's line carries the first
+    task's own error (it had said only "3 task(s) failed (see …/manifest.jsonl)")."""
+    code = main(["field", "darecki2011", str(DARECKI), "--out", str(tmp_path / "o"), "--quick",
+                 "--depths", "0.1", "--frames", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and err[-1].startswith("warpcaustics: error: 1 task(s) failed, the first:")
+    assert "floor.depth_m = 0.1 is too shallow" in err[-1]
+
+
+def test_the_long_waves_patch_sets_the_scenes_window_aside(tmp_path):
+    """The longer waves' patch renders its whole patch: a window's centre as well as its extent is set
+    aside (a centre kept alone had refused the run, asking for the extent the user had set)."""
+    from warpcaustics.scene import load_scene
+
+    path = _scene(tmp_path, water="model = 'fft'\nresolution = 16\nextent_m = 4.0\n")
+    window = {"caustics.map_center_m": [0.3, 0.0]}
+    config = load_scene(path, window).config
+    long = field.common.long_waves_overrides(config, window, 16.0, True, path)
+    assert long["caustics.map_extent_m"] == 0.0 and long["caustics.map_center_m"] == [0.0, 0.0]
 
 
 def test_points_are_chosen_from_the_record():

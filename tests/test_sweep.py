@@ -116,6 +116,34 @@ def test_a_failing_task_is_reported_and_the_rest_finish(tmp_path):
     assert len(_csv_rows(tmp_path / "out")) == 4
 
 
+def test_a_bad_device_or_out_folder_is_one_error_before_any_output(tmp_path):
+    """An explicit device that cannot be had fails once, before the folder is made (every task had
+    failed with it, one line each); an --out that cannot be made is one line, not mkdir's traceback."""
+    from warpcaustics.errors import DeviceError, WarpcausticsError
+
+    sweep = load_sweep(_sweep(tmp_path))
+    with pytest.raises(DeviceError, match="device = 'bogus' is not allowed"):
+        run_sweep(sweep, tmp_path / "out", workers=1, device="bogus", quiet=True)
+    assert not (tmp_path / "out").exists()
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(WarpcausticsError, match="cannot be created"):
+        run_sweep(sweep, tmp_path / "afile" / "out", workers=1, device="cpu", quiet=True)
+
+
+def test_sweep_frame_times_past_the_renderers_range_are_refused(tmp_path):
+    """A sweep's [frames] whose times overflow (or a start that is no number) are refused as the sweep
+    loads, not by every task."""
+    from warpcaustics.errors import WarpcausticsError
+
+    base = (CONFIGS / "ocean.toml").as_posix()
+    for frames, needle in (("start_s = 1e300", "start_s"), ("start_s = 'noon'", "start_s"),
+                           ("count = 3\nfps = 1e-300", "last time")):
+        path = tmp_path / "s.toml"
+        path.write_text(f'base = "{base}"\n[frames]\n{frames}\n')
+        with pytest.raises(WarpcausticsError, match=needle):
+            load_sweep(path)
+
+
 def test_sigkill_midway_then_rerun_finishes_each_task_once(tmp_path):
     """SIGKILL the sweep's driver after its first task: its workers die with it (nothing is left
     writing), a rerun completes the rest, every task is recorded done exactly once, and no

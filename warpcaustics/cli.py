@@ -221,12 +221,7 @@ def _render(args: argparse.Namespace) -> int:
 
     overrides = _overrides(args)
     scene = load_scene(args.config, overrides)  # validate everything before touching the output
-    if args.frames < 1:
-        raise WarpcausticsError(f"--frames = {args.frames} must be at least 1")
-    if not args.fps > 0 or args.fps == float("inf"):
-        raise WarpcausticsError(f"--fps = {args.fps} must be a positive number")
-    if args.time != args.time or abs(args.time) == float("inf"):
-        raise WarpcausticsError(f"--time = {args.time} must be a finite number of seconds")
+    _check_animation(args, scene.config.stats.integration_s)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
@@ -301,11 +296,31 @@ def _preview(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_animation(args: argparse.Namespace, integration_s: float) -> None:
+    """The render command's --frames, --fps and --time, and whether an animation that long holds the
+    radiometer's integration (``stats.integration_s``) it is asked to report: before any output."""
+    from warpcaustics.io.run_json import integration_frames
+    from warpcaustics.pipeline import check_time
+
+    if args.frames < 1:
+        raise WarpcausticsError(f"--frames = {args.frames} must be at least 1")
+    if not args.fps > 0 or args.fps == float("inf"):
+        raise WarpcausticsError(f"--fps = {args.fps} must be a positive number")
+    check_time("--time", args.time)
+    check_time("--time + (--frames - 1) / --fps", args.time + (args.frames - 1) / args.fps)
+    needed = integration_frames(integration_s, 1 / args.fps)
+    if args.frames >= 3 and integration_s > 0 and args.frames < needed:  # three frames: time statistics
+        raise WarpcausticsError(
+            f"stats.integration_s = {integration_s:g} needs --frames ≥ {needed} at --fps {args.fps:g} for "
+            "its time statistics (three samples after the first whole window); give more frames or a "
+            "shorter integration_s")
+
+
 def _compare(args: argparse.Namespace) -> int:
     from warpcaustics.batch.compare import compare_methods, write_comparison
+    from warpcaustics.pipeline import check_time
 
-    if args.time != args.time or abs(args.time) == float("inf"):
-        raise WarpcausticsError(f"--time = {args.time} must be a finite number of seconds")
+    check_time("--time", args.time)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")

@@ -16,8 +16,8 @@ import warp as wp
 from warpcaustics import device as devices
 from warpcaustics.caustics.registry import METHODS
 from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch, sky_bytes
-from warpcaustics.config import Scattering, SkySampling
-from warpcaustics.errors import WarpcausticsError
+from warpcaustics.config import BeamSpread, Scattering, SkySampling
+from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.optics import spectra
 from warpcaustics.optics.refraction import (
     height_blocks,
@@ -66,13 +66,46 @@ HOST_BYTES_PER_BAND = 28
 passes in (24; photons at K = 8 peaked at 24 K) and the float32 result (4)."""
 
 
+HOST_BYTES_PER_SPREAD_PHOTON = 700
+"""Host memory per photon of the walked beam spread (``optics.beam_spread = "walk"``) at its peak
+[bytes]: tracemalloc's peak of ``walk_column`` with 3 bands was 651–669 bytes a photon at b·D ≈ 4
+(2¹⁶ and 2¹⁸ photons) and 470 at b·D ≈ 0.4; 4 more per band for the band weights. The walks it keeps
+(``column_spread``'s cache of 20) hold up to 32 + 4 per band more each (float64 offsets, float32
+weights and memory)."""
+
+
+def walks_spread(cfg) -> bool:
+    """Whether the small-angle transfer walks its beam spread (``optics.beam_spread_photons`` each)."""
+    return cfg.optics.scattering is Scattering.SMALL_ANGLE and cfg.optics.beam_spread is BeamSpread.WALK
+
+
 def host_bytes(scene: Scene) -> int:
-    """Host memory one frame's read-back and post-processing need at their peak [bytes]."""
+    """Host memory one frame's read-back and post-processing need at their peak [bytes], with the
+    walked beam spread's photons where the transfer walks it."""
     cfg = scene.config
     k = len(spectra.bins_for(cfg.optics).centres_nm)
     camera = cfg.camera.width * cfg.camera.height if cfg.camera.enabled else 0
     pixels = cfg.caustics.map_resolution**2 + camera
-    return pixels * (HOST_BYTES_PER_PIXEL + HOST_BYTES_PER_BAND * k)
+    walk = 0
+    if walks_spread(cfg):
+        from warpcaustics.optics.beam_spread import SPREAD_CACHE
+
+        per_photon = HOST_BYTES_PER_SPREAD_PHOTON + 4 * k + SPREAD_CACHE * (32 + 4 * k)
+        walk = cfg.optics.beam_spread_photons * per_photon
+    return pixels * (HOST_BYTES_PER_PIXEL + HOST_BYTES_PER_BAND * k) + walk
+
+
+MAX_TIME_S = 1e9
+"""The largest render time either way [s], about 32 years: past ~3e38 float32 overflows (and a
+random-phase sea looks the same at any time, so nothing is lost by the bound)."""
+
+
+def check_time(name: str, time_s: float) -> None:
+    """Refuse a render time that is not finite or beyond :data:`MAX_TIME_S`, in one line naming
+    ``name`` (a flag or an argument)."""
+    if not (math.isfinite(time_s) and abs(time_s) <= MAX_TIME_S):
+        raise ConfigError(f"{name} = {time_s} must be a finite number of seconds within "
+                          f"±{MAX_TIME_S:g}")
 
 
 class Renderer:
@@ -125,9 +158,8 @@ class Renderer:
         return self.light.ior
 
     def render(self, time_s: float = 0.0) -> RenderResult:
-        """Render the floor caustics at ``time_s`` [s]."""
-        if not math.isfinite(time_s):
-            raise WarpcausticsError(f"time_s = {time_s} is not a finite number of seconds")
+        """Render the floor caustics at ``time_s`` [s] (finite, at most :data:`MAX_TIME_S` either way)."""
+        check_time("time_s", time_s)
         with self.memory_errors():
             return self._render(float(time_s))
 
@@ -215,9 +247,11 @@ _MEMORY_FIX = "lower water.resolution, caustics.map_resolution or optics.wavelen
 
 
 def memory_fix(cfg) -> str:
-    """What to lower when a scene does not fit: a grid method's 3-D grid comes first."""
+    """What to lower when a scene does not fit: a grid method's 3-D grid comes first, the walked
+    beam spread's photons (where the transfer walks it) next."""
     grid_key = METHODS[cfg.caustics.method].memory_key
-    return f"lower {grid_key}, water.resolution or caustics.map_resolution" if grid_key else _MEMORY_FIX
+    fix = f"lower {grid_key}, water.resolution or caustics.map_resolution" if grid_key else _MEMORY_FIX
+    return fix.replace("lower ", "lower optics.beam_spread_photons, ", 1) if walks_spread(cfg) else fix
 
 
 @contextmanager

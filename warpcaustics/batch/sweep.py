@@ -144,7 +144,13 @@ def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
         raise ConfigError(f"sweep frames.count = {count!r} must be a positive integer")
     if not isinstance(fps, (int, float)) or not fps > 0:
         raise ConfigError(f"sweep frames.fps = {fps!r} must be a positive number")
+    if not isinstance(start, (int, float)) or isinstance(start, bool):
+        raise ConfigError(f"sweep frames.start_s = {start!r} must be a number of seconds")
     times = tuple(float(start) + i / float(fps) for i in range(count))
+    from warpcaustics.pipeline import check_time
+
+    for name, t in (("sweep frames.start_s", times[0]), ("sweep frames' last time", times[-1])):
+        check_time(name, t)
     return expand_sweep(base, fixed, grid, zipped, times, path)
 
 
@@ -325,10 +331,17 @@ def run_sweep(
         raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
     if workers < 1:
         raise WarpcausticsError(f"--workers = {workers} must be at least 1")
+    if device is not None and executor == "local":  # checked once here, before anything is written
+        from warpcaustics.device import resolve_device
+
+        device = resolve_device(device)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
     _claim(out, sweep, force)
     for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
         shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)

@@ -115,6 +115,11 @@ def _build(cls: type, table: dict, prefix: str) -> Any:
 
 
 def _set_dotted(table: dict, key: str, value: Any) -> None:
+    """Set ``key`` (dotted) in ``table`` to a copy of ``value``; a table given for a table merges into
+    it key by key (``--set 'sun={elevation_deg=30}'`` changes the elevation alone, as
+    ``--set sun.elevation_deg=30`` does), anything else replaces what was there."""
+    if not isinstance(key, str) or not key:
+        raise ConfigError(f"override key {key!r} must be a dotted name, e.g. 'sun.elevation_deg'")
     parts = key.split(".")
     node = table
     for i, part in enumerate(parts[:-1]):
@@ -122,7 +127,11 @@ def _set_dotted(table: dict, key: str, value: Any) -> None:
         if not isinstance(child, dict):
             raise ConfigError(f"override '{key}': '{'.'.join(parts[: i + 1])}' is a value, not a table")
         node = child
-    node[parts[-1]] = value
+    if isinstance(value, dict) and isinstance(node.get(parts[-1]), dict):
+        for name, item in value.items():
+            _set_dotted(node[parts[-1]], name, item)
+    else:
+        node[parts[-1]] = _deepcopy(value) if isinstance(value, dict) else value
 
 
 def parse_override(text: str) -> tuple[str, Any]:

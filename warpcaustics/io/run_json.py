@@ -4,6 +4,7 @@ fluxes, statistics); written last, so its presence marks a complete run."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,13 @@ def frame_statistics_entry(r) -> dict:
     return {**frame_statistics(r, cfg), "probe_irradiance_w_m2": probe_values(r, cfg).tolist()}
 
 
+def integration_frames(integration_s: float, dt_s: float) -> int:
+    """The frames an animation ``dt_s`` apart needs for a radiometer's integration over
+    ``integration_s`` to give three samples (``time_statistics.integrated``): the first whole window
+    ends ⌈T/dt⌉ frames in."""
+    return int(math.ceil(integration_s / dt_s - 1e-9)) + 3
+
+
 def time_statistics(frames: list[dict], first) -> dict | None:
     """Statistics of the probes' E(t) over an animation (three frames or more, equally spaced);
     ``first`` is the first frame's RenderResult (for the config and the map)."""
@@ -62,7 +70,7 @@ def time_statistics(frames: list[dict], first) -> dict | None:
     dt = float(np.mean(np.diff(times)))
     out = {"probes_m": [list(p) for p in probe_points(stats_cfg, first.map_center_m)], "dt_s": dt,
            **series_statistics(series, dt, stats_cfg.flash_threshold)}
-    if stats_cfg.integration_s > 0.0:
+    if stats_cfg.integration_s > 0.0 and integration_frames(stats_cfg.integration_s, dt) <= len(frames):
         integrated = integrate_series(series, dt, stats_cfg.integration_s)
         if len(integrated) >= 3:  # a radiometer's samples, each its mean over the integration time
             out["integrated"] = {"integration_s": stats_cfg.integration_s, "samples": len(integrated),

@@ -177,7 +177,11 @@ def _band_weights(a: np.ndarray, b: np.ndarray, b_star: float, events: np.ndarra
     return np.exp(log_ratio[:, None] * events[None, :] - (a + b - b_star)[:, None] * path[None, :])
 
 
-@functools.lru_cache(maxsize=20)
+SPREAD_CACHE = 20
+"""Walks :func:`column_spread` keeps (the last directions' and depths')."""
+
+
+@functools.lru_cache(maxsize=SPREAD_CACHE)
 def column_spread(kind, hg_g, station, absorption: tuple, scattering: tuple, cos_w: float, depth_m: float,
                   ior: float, photons: int, seed: int) -> SpreadSample:
     """:func:`walk_column` for a phase function named as the config names it, cached (the last 20

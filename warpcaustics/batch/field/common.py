@@ -21,12 +21,27 @@ def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
     if not (math.isfinite(frame_interval_s) and frame_interval_s > 0):
         raise ConfigError(f"--frame-interval = {frame_interval_s} must be a positive number of seconds, "
                           "e.g. 2 (frames further apart than the waves' periods are independent)")
+    from warpcaustics.pipeline import check_time
+
+    check_time("--frame-interval × (--frames − 1)", (frames - 1) * frame_interval_s)
     return tuple(i * frame_interval_s for i in range(frames))
+
+
+def dotted_keys(overrides: dict, prefix: str = "") -> list[str]:
+    """Every dotted key a ``--set`` reaches, a table's keys inside it included (``sun={elevation_deg=…}``
+    sets ``sun.elevation_deg``)."""
+    keys = []
+    for key, value in overrides.items():
+        name = f"{prefix}{key}"
+        keys.append(name)
+        if isinstance(value, dict):
+            keys += dotted_keys(value, f"{name}.")
+    return keys
 
 
 def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose: str) -> None:
     """A ``--set`` of a key the comparison sets at each point would be overwritten: say so."""
-    varied = sorted(set(overrides or {}) & set(point_keys))
+    varied = sorted(set(dotted_keys(overrides or {})) & set(point_keys))
     if varied:
         raise ConfigError(f"--set {varied[0]}: the comparison sets it at each point; choose the points "
                           f"with {choose} instead")
@@ -47,10 +62,10 @@ def render_points(scene_path: Path, fixed: dict, variants: list[dict], times: tu
     report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet, force=force)
     if not quiet:
         print(format_report(report))
-    if report.failed:
+    if report.failed:  # the first task's own error names the cause (the rest are in the manifest)
         raise WarpcausticsError(
-            f"{len(report.failed)} task(s) failed (see {Path(out) / 'manifest.jsonl'}); "
-            "fix the cause and rerun the same command to finish them"
+            f"{len(report.failed)} task(s) failed, the first: {report.failed[0][1]} (all in "
+            f"{Path(out) / 'manifest.jsonl'}); fix the cause and rerun the same command to finish them"
         )
     return sweep
 
@@ -143,9 +158,10 @@ LONG_WAVES_FOLDER = "long_waves"
 
 def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scene_path: Path) -> dict | None:
     """The overrides of the long waves' patch at every point: ``extent_m`` wide, without the waves of
-    the scene's patch's side or shorter (which the scene holds), its floor map the whole patch;
-    None for ``extent_m`` = 0. A patch no larger than the scene's own is an error naming
-    --long-waves."""
+    the scene's patch's side or shorter (which the scene holds), its floor map the whole patch (the
+    window's extent and centre set aside); None for ``extent_m`` = 0. A patch no larger than the
+    scene's own, or a scene the patch cannot be built from (e.g. a height field), is an error naming
+    --long-waves and its way out, --long-waves 0."""
     from warpcaustics.scene import load_scene
 
     if not (math.isfinite(extent_m) and extent_m >= 0.0):
@@ -159,11 +175,12 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     grid = {"water.resolution": 64, "caustics.map_resolution": 64} if quick else {
         **LONG_WAVES_OVERRIDES, "sky.directions": min(config.sky.directions, LONG_WAVES_SKY_DIRECTIONS)}
     long = {**fixed, **grid, "water.extent_m": extent_m, "water.shortest_wave_m": config.water.extent_m,
-            "caustics.map_extent_m": 0.0}
+            "caustics.map_extent_m": 0.0, "caustics.map_center_m": [0.0, 0.0]}  # the whole patch
     try:
         load_scene(scene_path, long)
     except ConfigError as exc:
-        raise ConfigError(f"--long-waves = {extent_m:g} m: {exc}") from None
+        raise ConfigError(f"--long-waves = {extent_m:g} m cannot take this scene ({exc}); "
+                          "give --long-waves 0 to compare the scene's own waves alone") from None
     return long
 
 
