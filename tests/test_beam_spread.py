@@ -124,6 +124,22 @@ def test_the_spread_has_the_exact_geometry_of_single_scattering():
     assert np.all(np.abs(wells[1:3] - exact[1:3]) > bound[1:3]), (wells, exact, bound)
 
 
+def test_water_that_scatters_nothing_walks_no_photon(recwarn):
+    """b = 0 in every band (optics.water_type = "none"): no photon scatters, so the spread holds none,
+    without numpy's divide-by-zero warnings (its free paths 1/b and log b/b* had raised two), and the
+    small-angle map is the single-scattering one to the bit."""
+    theta, weight = phase_quadrature(PhaseFunctionKind.PETZOLD, None, "HAOCE 11")
+    sample = walk_column(theta, weight, np.zeros(3), np.zeros(3), 0.9, 3.0, 1.34, 4096, 1)
+    assert sample.along.size == 0 and sample.weight.shape == (3, 0) and sample.memory.shape == (4, 0)
+    scene = {"water.resolution": 32, "caustics.map_resolution": 32, "optics.wavelengths": "rgb",
+             "optics.water_type": "none"}
+    single = wc.render(wc.load_scene(CONFIGS / "ocean.toml", scene), device="cpu")
+    walked = wc.render(wc.load_scene(CONFIGS / "ocean.toml", {**scene, "optics.scattering": "small_angle",
+                                                              "optics.beam_spread": "walk"}), device="cpu")
+    np.testing.assert_array_equal(walked.floor_irradiance, single.floor_irradiance)
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 def test_the_tally_gives_the_spectrum_of_a_known_spread():
     """A spread of Gaussian offsets (σ = 2.5 map texels, along a beam at 30° azimuth) tallied on the
     map's grid: its multiplier is e^{−k²σ²/2} times the gain e^{c s} within the photons' noise

@@ -126,6 +126,44 @@ def test_python_overrides_and_errors():
         wc.load_scene(CONFIGS / "ocean.toml", overrides={1: 2})
 
 
+def test_numpy_values_in_python_overrides_are_their_python_numbers():
+    """np.int64(64), np.float32(0.2) and np.array([450., 550.]) from a numpy script load as 64, 0.2 and
+    [450, 550] (they had been refused as 'the wrong type; expected an integer')."""
+    scene = wc.load_scene(None, {"sky.model": "uniform", "sky.sampling": "cones",
+                                 "sky.surface_resolution": np.int64(64),
+                                 "sky.diffuse_fraction": np.float32(0.25),
+                                 "optics.wavelengths": np.array([450.0, 550.0])})
+    assert scene.config.sky.surface_resolution == 64 and type(scene.config.sky.surface_resolution) is int
+    assert scene.config.sky.diffuse_fraction == 0.25
+    assert scene.config.optics.wavelengths.list_nm == (450.0, 550.0)
+
+
+def test_a_run_that_fails_before_its_first_frame_leaves_no_folder(capsys, tmp_path):
+    """A floor the waves reach is found as the first frame renders, after the folder was made: the
+    folder goes with the error (an empty one had been left behind)."""
+    _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), *SMALL, "--set", "floor.depth_m=1e-6"],
+                   "floor.depth_m = 1e-06 is too shallow")
+
+
+def test_a_render_and_a_sweep_do_not_share_a_folder_unasked(capsys, tmp_path):
+    """A render into a sweep's folder, or a sweep into a render's, is one line naming --force (each had
+    checked for its own kind of outputs only and written beside the other's)."""
+    from warpcaustics.batch.sweep import load_sweep, run_sweep
+
+    sweep_dir, render_dir = tmp_path / "sweep", tmp_path / "render"
+    sweep_dir.mkdir()
+    (sweep_dir / "sweep.json").write_text("{}")
+    render = ["render", str(CONFIGS / "ocean.toml"), *SMALL, "--device", "cpu"]
+    assert main([*render, "--out", str(sweep_dir)]) == 2
+    assert "holds a sweep's results" in capsys.readouterr().err
+    assert sorted(p.name for p in sweep_dir.iterdir()) == ["sweep.json"]
+    assert main([*render, "--out", str(render_dir), "--quiet"]) == 0
+    path = tmp_path / "s.toml"
+    path.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[set]\n"water.resolution" = 32\n')
+    with pytest.raises(wc.WarpcausticsError, match="holds a render's outputs"):
+        run_sweep(load_sweep(path), render_dir, workers=1, device="cpu", quiet=True)
+
+
 def test_a_table_override_merges_into_the_table():
     """``--set 'water={wind_speed_m_s=3.0}'`` changes that key alone, as ``water.wind_speed_m_s=3.0``
     does (it had put every other [water] key back to its default), and the caller's dict is left as

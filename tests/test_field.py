@@ -238,6 +238,11 @@ def test_bad_input_is_one_line(tmp_path, capsys):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=4.0, quick=True)
     with pytest.raises(ConfigError, match="--long-waves = -1"):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=-1.0, quick=True)
+    for wrong, needle in ((dict(frames=2.5), "--frames = 2.5"), (dict(zeniths=20), "--zeniths = 20"),
+                          (dict(long_waves_m=None), "--long-waves = None"),
+                          (dict(sqrt_winds=("2",)), "--sqrt-winds")):
+        with pytest.raises(ConfigError, match=needle):  # from Python: wrong types had raised TypeError
+            field.run_gernez2009(_scene(tmp_path), tmp_path / "o", quick=True, **wrong)
     with pytest.raises(ConfigError, match="--frame-interval"):  # the last frame past float32's range
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", frame_interval_s=1e308, quick=True)
     assert main(["field", "gernez2009", str(_scene(tmp_path)), "--out", str(tmp_path / "o"),
@@ -273,6 +278,13 @@ def test_the_long_waves_patch_sets_the_scenes_window_aside(tmp_path):
     config = load_scene(path, window).config
     long = field.common.long_waves_overrides(config, window, 16.0, True, path)
     assert long["caustics.map_extent_m"] == 0.0 and long["caustics.map_center_m"] == [0.0, 0.0]
+
+
+def test_a_point_asked_for_twice_is_rendered_and_reported_once():
+    """--zeniths 20,20 chooses the 20° point once (it had written its row twice)."""
+    points = field.gernez2009.gernez2009_points(("zenith",))
+    chosen = field.gernez2009.select_points(points, (20.0, 20.0), None)
+    assert [p.sun_zenith_deg for p in chosen] == [20.0]
 
 
 def test_points_are_chosen_from_the_record():

@@ -4,6 +4,7 @@ info``. User errors print one line and exit with 2."""
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -231,6 +232,7 @@ def _render(args: argparse.Namespace) -> int:
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
+    created = not out.exists()
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -256,6 +258,10 @@ def _render(args: argparse.Namespace) -> int:
             results.append(result)
             progress.step(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
                           f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
+    except BaseException:
+        if created and not results:  # failed before its first frame: the folder this run made goes
+            shutil.rmtree(out, ignore_errors=True)
+        raise
     finally:
         progress.close()
     write_run_json(out, results)

@@ -53,6 +53,7 @@ from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.io.files import atomic_path, write_csv, write_json
+from warpcaustics.io.manifest import MANIFEST as RUN_MANIFEST
 
 MANIFEST = "manifest.jsonl"
 SUMMARY = "summary.csv"
@@ -237,6 +238,9 @@ def _claim(out: Path, sweep: Sweep, force: bool) -> None:
             theirs = None
     else:
         theirs = "unrecorded" if (out / MANIFEST).exists() else None
+    if not force and ((out / RUN_MANIFEST).exists() or (out / "run.json").exists()):
+        raise WarpcausticsError(f"--out {str(out)!r} holds a render's outputs ({RUN_MANIFEST} or run.json); "
+                                "give another --out, or --force to add the sweep beside them")
     if theirs not in (None, mine) and not force:
         raise WarpcausticsError(f"--out {str(out)!r} holds the results of another sweep (other keys, values, "
                                 "frames or version); give another --out, or --force to add this one to it")

@@ -180,7 +180,7 @@ def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Co
         check_depth(value, key)
     table = _deepcopy(table)
     for key, value in (overrides or {}).items():
-        _set_dotted(table, key, value)
+        _set_dotted(table, key, _plain(value))
     optics = table.get("optics")
     if isinstance(optics, dict):
         wavelengths = optics.get("wavelengths")
@@ -293,6 +293,18 @@ def config_to_dict(cfg: Any) -> dict:
         else:
             out[f.name] = value
     return out
+
+
+def _plain(value: Any) -> Any:
+    """A Python override as TOML would give it: numpy's scalars and arrays as the Python numbers and
+    lists they hold (np.int64(64) → 64, np.array([450., 550.]) → [450.0, 550.0]), inside tables too."""
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
 
 
 def _deepcopy(table: dict) -> dict:

@@ -14,6 +14,9 @@ from warpcaustics.errors import WarpcausticsError
 from warpcaustics.io.files import atomic_path
 
 MANIFEST = "outputs.json"
+SWEEP_FILES = ("manifest.jsonl", "sweep.json")
+"""What a sweep (``batch/sweep.py``, the field commands) keeps in its folder: a render refuses to
+write among them without --force."""
 
 OUTPUT_GLOBS = ("frame_[0-9]*", "camera_[0-9]*", "surface_[0-9]*", "floor_[0-9]*", "receivers_[0-9]*",
                 "run.json")
@@ -43,6 +46,9 @@ def claim(out: Path, force: bool) -> RunManifest:
     """Take ``out`` for a new run: remove what the earlier run's manifest lists, or, where outputs
     stand without a manifest, refuse (a one-line error naming ``--force``) unless ``force``."""
     manifest = out / MANIFEST
+    if not force and any((out / name).exists() for name in SWEEP_FILES):
+        raise WarpcausticsError(f"--out {str(out)!r} holds a sweep's results (manifest.jsonl, sweep.json); "
+                                "give another --out, or --force to write beside them")
     if manifest.exists():
         try:
             listed = json.loads(manifest.read_text(encoding="utf-8"))["files"]

@@ -93,6 +93,10 @@ def walk_column(theta: np.ndarray, weight: np.ndarray, absorption: np.ndarray, s
     a = np.asarray(absorption, np.float64)
     b = np.asarray(scattering, np.float64)
     b_star = float(b.max())
+    if b_star <= 0.0:  # water that scatters nothing: no photon scatters on its way to the floor
+        none = np.zeros(0)
+        return SpreadSample(none, none, np.zeros((len(b), 0), np.float32), photons,
+                            np.zeros((4, 0), np.float32))
     cdf = (np.cumsum(weight) - 0.5 * weight) / weight.sum()  # as the walk's inverse_cdf_table
     rng = np.random.default_rng(seed)
     sin_w = np.sqrt(max(0.0, 1.0 - cos_w * cos_w))

@@ -233,7 +233,18 @@ class ShallowWaterPool(WalledPool):
         self._check_forward(time_s)
         # Viscous limit of the explicit Laplacian: ν dt / Δ² ≤ 1/8.
         dt_viscous = self.cell_m**2 / (8.0 * self.viscosity) if self.viscosity > 0 else math.inf
-        speed = math.nan
+        body_speed = 0.0
+        if self.body is not None:
+            body_speed = 2.0 * math.pi * self.body.path_radius_m / self.body.period_s
+        speed = self.max_wave_speed()
+        if math.isfinite(speed):  # the substeps at today's speed, a lower bound: refuse now, not in minutes
+            first = min(self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
+            needed = (time_s - self.time_s) / first
+            if needed > MAX_SUBSTEPS_PER_CALL:
+                raise WarpcausticsError(
+                    f"the pool needs at least {needed:.3g} substeps of {first:.3g} s to reach "
+                    f"t = {time_s:g} s (more than {MAX_SUBSTEPS_PER_CALL:.0e}); render an earlier time, "
+                    "lower water.resolution or raise --fps")
         for i in range(MAX_SUBSTEPS_PER_CALL):
             remaining = time_s - self.time_s
             if remaining <= 1e-12:
@@ -243,9 +254,6 @@ class ShallowWaterPool(WalledPool):
             if not math.isfinite(speed):
                 raise WarpcausticsError(f"the pool became unstable at t = {self.time_s:g} s; lower "
                                         f"water.cfl (now {self.cfl}) or the drops' height")
-            body_speed = 0.0
-            if self.body is not None:
-                body_speed = 2.0 * math.pi * self.body.path_radius_m / self.body.period_s
             dt = min(remaining, self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
             next_drop = next((d.time_s for d in self._drops if d.time_s > self.time_s), math.inf)
             dt = min(dt, max(next_drop - self.time_s, 1e-9))

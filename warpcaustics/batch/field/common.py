@@ -14,8 +14,25 @@ from warpcaustics.batch.stats import continuous_sky_cv
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 
+def numbers_of(flag: str, values) -> tuple[float, ...] | None:
+    """``values`` (a flag's numbers from Python: a list or tuple; None for all) as floats, or a
+    one-line error naming ``flag`` (a bare number or a string had raised TypeError deep inside)."""
+    if values is None:
+        return None
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
+    values = tuple(values)
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
+    return tuple(float(v) for v in values)
+
+
 def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
     """The frame times ``i · frame_interval_s``, i < ``frames``, once both flags are sane."""
+    if not isinstance(frames, int) or isinstance(frames, bool):
+        raise ConfigError(f"--frames = {frames!r} must be a whole number of frames, e.g. 3")
+    if not isinstance(frame_interval_s, (int, float)) or isinstance(frame_interval_s, bool):
+        raise ConfigError(f"--frame-interval = {frame_interval_s!r} must be a number of seconds, e.g. 2")
     if frames < 1:
         raise ConfigError(f"--frames = {frames} must be at least 1")
     if not (math.isfinite(frame_interval_s) and frame_interval_s > 0):
@@ -164,7 +181,7 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     --long-waves and its way out, --long-waves 0."""
     from warpcaustics.scene import load_scene
 
-    if not (math.isfinite(extent_m) and extent_m >= 0.0):
+    if not (isinstance(extent_m, (int, float)) and math.isfinite(extent_m) and extent_m >= 0.0):
         raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
                           "scene's waves alone")
     if extent_m == 0.0:
@@ -233,6 +250,7 @@ def select_measured(have_values: np.ndarray, wanted: tuple[float, ...] | None, f
     error naming ``flag``, unless ``unmeasured``: then ``wanted`` as asked, in increasing order
     (positive; a duplicate once)."""
     have = [float(d) for d in have_values]
+    wanted = numbers_of(flag, wanted)
     if wanted is None:
         return have
     if unmeasured:

@@ -42,6 +42,7 @@ from warpcaustics.batch.field.common import (
     continuous_sky,
     frame_statistics_of,
     long_waves_overrides,
+    numbers_of,
     pooled_statistics,
     render_points,
     sea_cv,
@@ -189,8 +190,9 @@ def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
                   sqrt_winds: tuple[float, ...] | None) -> list[Point]:
     """The points of the zenith and overcast series at ``zeniths`` [deg] and of the wind series at
     ``sqrt_winds`` [√(m/s)] (None: all of that series); a value the record does not hold is an error
-    naming them. The water series is kept whole."""
+    naming them; a value given twice is chosen once. The water series is kept whole."""
     chosen = [p for p in points if p.series == "water"]
+    zeniths, sqrt_winds = numbers_of("--zeniths", zeniths), numbers_of("--sqrt-winds", sqrt_winds)
     flags = ((("zenith", "overcast"), zeniths, lambda p: p.sun_zenith_deg, "--zeniths"),
              (("wind",), sqrt_winds, lambda p: math.sqrt(p.wind_m_s), "--sqrt-winds"))
     for series, wanted, key, flag in flags:
@@ -203,7 +205,7 @@ def select_points(points: list[Point], zeniths: tuple[float, ...] | None,
             if not match:
                 held = ", ".join(sorted({f"{key(p):g}" for p in have}, key=float)) or "none (not in --series)"
                 raise ConfigError(f"{flag}: {value:g} is not a measured point; the record holds {held}")
-            chosen += match
+            chosen += [p for p in match if p not in chosen]
     return chosen
 
 
