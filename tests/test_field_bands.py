@@ -140,7 +140,8 @@ def test_bands_bad_input_is_one_line(tmp_path, capsys):
     with those it holds; another data set's point flag is refused; nothing is written."""
     scene = _scene(tmp_path)
     for key, value in (("optics.wavelengths", [443.0]), ("sky.diffuse_fraction", 0.3),
-                       ("stats.per_band", False), ("sun.elevation_deg", 30.0)):
+                       ("stats.per_band", False), ("sun.elevation_deg", 30.0),
+                       ("optics.wavelengths.bins", 4)):  # a key inside one had read "is a value, not a table"
         with pytest.raises(ConfigError, match=f"--set {key}: the comparison sets it"):
             field.run_gernez2009_bands(scene, tmp_path / "o", overrides={key: value}, quick=True)
     with pytest.raises(ConfigError, match=r"--zeniths: 21 is not a measured sun zenith \[deg\]; the record "

@@ -57,8 +57,11 @@ def dotted_keys(overrides: dict, prefix: str = "") -> list[str]:
 
 
 def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose: str) -> None:
-    """A ``--set`` of a key the comparison sets at each point would be overwritten: say so."""
-    varied = sorted(set(dotted_keys(overrides or {})) & set(point_keys))
+    """A ``--set`` of a key the comparison sets at each point, or of a key inside one (``--set
+    optics.wavelengths.bins=4`` where the comparison sets ``optics.wavelengths``), would be
+    overwritten or clash with it: say so."""
+    given = dotted_keys(overrides or {})
+    varied = sorted(k for k in given if any(k == p or k.startswith(p + ".") for p in point_keys))
     if varied:
         raise ConfigError(f"--set {varied[0]}: the comparison sets it at each point; choose the points "
                           f"with {choose} instead")
