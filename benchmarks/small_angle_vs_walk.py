@@ -81,8 +81,16 @@ def main(argv: list[str] | None = None) -> int:
     if args.seeds < 4 or args.seeds % 2:
         parser.error("--seeds: give an even number of at least 4")
     from warpcaustics.config import parse_override
+    from warpcaustics.errors import ConfigError
 
-    extra = dict(parse_override(text) for text in args.set)
+    try:
+        extra = dict(parse_override(text) for text in args.set)
+    except ConfigError as exc:
+        parser.error(str(exc))
+    fixed = sorted(set(extra) & {"floor.depth_m", "optics.phase_function", "caustics.map_resolution",
+                                 "optics.scattering", "optics.beam_spread"})
+    if fixed:  # optics.mc_seed is free: the walks set their own, so it seeds the walked spread alone
+        parser.error(f"--set {fixed[0]}: the benchmark sets it itself (per geometry, map or method)")
     sys.path.insert(0, str(ROOT / "tests"))
     from helpers import CONFIGS  # noqa: I001 (the tests' folder, put on the path above)
     from test_small_angle import BANDS, SCENE, band_power, fluctuations
@@ -114,6 +122,8 @@ def main(argv: list[str] | None = None) -> int:
     edges = " ".join(f"{lo:.4g}–{hi:.4g}" for lo, hi in zip(BANDS, BANDS[1:]))
     print("radial bands [cycles per texel]:", edges)
     print("rows: the 450, 550 and 650 nm bands of the map (optics.wavelengths = rgb)")
+    if extra:
+        print("--set:", ", ".join(f"{k}={v}" for k, v in extra.items()))
     for depth, phase in GEOMETRIES:
         start = time.perf_counter()
         base = {**SCENE, "floor.depth_m": depth, "optics.phase_function": phase, **extra}

@@ -174,6 +174,40 @@ def test_a_table_override_merges_into_the_table():
     assert table == dotted
     assert table.water.resolution == 256 and table.water.extent_m == 16.0  # the file's, not the defaults
     assert given == {"water": {"wind_speed_m_s": 3.0}}
+    place = {"datetime": "2009-07-14T11:30:00+02:00", "latitude_deg": 43.7, "longitude_deg": 7.3}
+    by_table = wc.load_scene(CONFIGS / "ocean.toml", {"sun": place}).config.sun  # replaces the file's angles
+    by_keys = wc.load_scene(CONFIGS / "ocean.toml", {f"sun.{k}": v for k, v in place.items()}).config.sun
+    assert by_table == by_keys
+
+
+def test_a_wavelengths_table_replaces_the_bins_of_a_resolved_config():
+    """optics.wavelengths is one value: a table given for it replaces a resolved config's (whose
+    list_nm would otherwise win over the new bins, in silence)."""
+    from warpcaustics.config import config_to_dict
+    from warpcaustics.config.loading import config_from_dict
+
+    resolved = config_to_dict(wc.load_scene(ROOT / "configs/field/darecki2011.toml").config)
+    assert resolved["optics"]["wavelengths"]["list_nm"] == [443.0, 532.0, 670.0]
+    cfg = config_from_dict(resolved, {"optics.wavelengths": {"min_nm": 400.0, "max_nm": 700.0, "bins": 8}})
+    assert cfg.optics.wavelengths.list_nm == () and cfg.optics.wavelengths.bins == 8
+
+
+def test_run_json_refuses_an_integration_its_frames_cannot_hold():
+    """A sweep's or the API's animation too short for stats.integration_s (⌈T/dt⌉ + 3 frames) is one
+    WarpcausticsError from the writer (the render command refuses it before rendering), not the
+    integrated statistics left out in silence."""
+    from types import SimpleNamespace
+
+    from warpcaustics.io.run_json import time_statistics
+
+    stats = wc.load_scene(None, {"stats.integration_s": 0.1}).config.stats
+    scene = SimpleNamespace(config=SimpleNamespace(stats=stats))
+    first = SimpleNamespace(scene=scene, map_center_m=(0.0, 0.0))
+    frames = [{"time_s": i / 30.0, "statistics": {"probe_irradiance_w_m2": [1.0 + 0.1 * (i % 2)]}}
+              for i in range(8)]
+    with pytest.raises(wc.WarpcausticsError, match="needs 6 frames"):
+        time_statistics(frames[:5], first)
+    assert time_statistics(frames[:6], first)["integrated"]["samples"] == 3
 
 
 def test_render_writes_complete_outputs(tmp_path, capsys):
@@ -297,22 +331,41 @@ def test_an_integration_the_animation_cannot_hold_is_refused_before_rendering(ca
                    "stats.integration_s", f"--frames ≥ {needed}")
 
 
-def test_the_walked_spreads_photons_are_counted_and_named_in_the_memory_check():
-    """The walked beam spread's photons are in the host memory the check asks for (a render with
-    2²⁶ of them had failed for lack of memory blaming the map's keys, 'needs 0.00 GiB'), and the fix
-    names optics.beam_spread_photons."""
-    from warpcaustics.optics.beam_spread import SPREAD_CACHE
-    from warpcaustics.pipeline import HOST_BYTES_PER_SPREAD_PHOTON, host_bytes, memory_fix
+def test_the_walked_spreads_photons_are_counted_and_named_in_the_memory_check(monkeypatch):
+    """The walked beam spread's photons are in the host memory the check asks for (a render with 2²⁶
+    of them had failed for lack of memory blaming the map's keys, "needs 0.00 GiB"): the estimate a
+    photon is at least the walk's own peak, measured here by tracemalloc (b·D ≈ 4, 3 bands), and not
+    above twice it; a render that does not fit is refused before anything runs, naming
+    optics.beam_spread_photons."""
+    import tracemalloc
 
-    walked = {"optics.scattering": "small_angle", "optics.beam_spread": "walk", "optics.wavelengths": "rgb"}
+    from warpcaustics import device as devices
+    from warpcaustics.config import PhaseFunctionKind
+    from warpcaustics.optics.beam_spread import walk_column
+    from warpcaustics.optics.phase import phase_quadrature
+    from warpcaustics.pipeline import HOST_BYTES_PER_SPREAD_PHOTON, Renderer, host_bytes, memory_fix
+
+    theta, weight = phase_quadrature(PhaseFunctionKind.PETZOLD, None, "HAOCE 11")
+    photons = 1 << 15
+    tracemalloc.start()
+    walk_column(theta, weight, np.array([0.02, 0.05, 0.4]), np.array([0.6, 0.57, 0.54]), 0.9, 6.73, 1.34,
+                photons, 1)
+    peak = tracemalloc.get_traced_memory()[1] / photons
+    tracemalloc.stop()
+    assert peak <= HOST_BYTES_PER_SPREAD_PHOTON <= 2 * peak, peak
+
+    walked = {"optics.scattering": "small_angle", "optics.beam_spread": "walk", "optics.wavelengths": "rgb",
+              "water.resolution": 32, "caustics.map_resolution": 32}
     few = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread_photons": 1024})
     many = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread_photons": 1 << 26})
-    per_photon = HOST_BYTES_PER_SPREAD_PHOTON + 4 * 3 + SPREAD_CACHE * (32 + 4 * 3)
-    assert host_bytes(many) - host_bytes(few) == ((1 << 26) - 1024) * per_photon
+    assert host_bytes(many) - host_bytes(few) > ((1 << 26) - 1024) * HOST_BYTES_PER_SPREAD_PHOTON
     assert "optics.beam_spread_photons" in memory_fix(many.config)
     wells = wc.load_scene(CONFIGS / "ocean.toml", {**walked, "optics.beam_spread": "wells"})
-    assert "beam_spread_photons" not in memory_fix(wells.config)
-    assert host_bytes(wells) == host_bytes(few) - 1024 * per_photon
+    assert "beam_spread_photons" not in memory_fix(wells.config) and host_bytes(wells) < host_bytes(few)
+    monkeypatch.setattr(devices, "free_bytes", lambda device: host_bytes(few) + (1 << 30))
+    Renderer(few, "cpu")  # fits
+    with pytest.raises(wc.DeviceError, match="lower optics.beam_spread_photons"):
+        Renderer(many, "cpu")
 
 
 def test_wavelengths_outside_the_data_fail_at_load():

@@ -258,6 +258,19 @@ def test_bad_input_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+def test_numpy_numbers_are_numbers_to_the_field_functions():
+    """np.int64 frames, an np.float32 interval and an np.arange of zeniths are taken as the numbers
+    they hold (the type checks must not refuse what a numpy script passes)."""
+    import numpy as np
+
+    from warpcaustics.batch.field.common import check_frames, numbers_of
+
+    assert check_frames(np.int64(2), np.float32(2.0)) == (0.0, 2.0)
+    assert numbers_of("--zeniths", np.arange(20.0, 30.0, 5.0)) == (20.0, 25.0)
+    with pytest.raises(ConfigError, match="--zeniths"):
+        numbers_of("--zeniths", [True])
+
+
 def test_a_task_that_fails_as_it_renders_is_named_in_the_one_line(tmp_path, capsys):
     """A depth the waves reach fails in the render, not at load: the command's line carries the first
     task's own error (it had said only "3 task(s) failed (see …/manifest.jsonl)")."""

@@ -71,10 +71,10 @@ def test_a_blown_up_pool_is_reported_not_carried_on(device):
 
 
 def test_a_time_beyond_a_million_substeps_is_refused_before_stepping():
-    """Reaching t = 1e7 s takes ~1e9 substeps: refused at once with the estimate (the guard after a
+    """Reaching t = 1e7 s takes ~1e8 substeps: refused at once with the estimate (the guard after a
     million substeps had taken minutes to fire), and the pool is left where it was."""
     pool = ShallowWaterPool(16, 4.0, DEPTH_M, "cpu")
-    with pytest.raises(wc.WarpcausticsError, match=r"needs at least .* substeps .* render an earlier time"):
+    with pytest.raises(wc.WarpcausticsError, match=r"needs about .* substeps .* render an earlier time"):
         pool.advance(1.0e7)
     assert pool.time_s == 0.0 and pool.substeps == 0
 

@@ -297,6 +297,9 @@ def _preview(args: argparse.Namespace) -> int:
     scene = load_scene(args.config, _overrides(args))
     if not out.parent.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
+    from warpcaustics.pipeline import check_time
+
+    check_time("--time", args.time)
     preview_png(render(scene, args.time, args.device), out)
     print(f"wrote {out}")
     return 0

@@ -16,7 +16,7 @@ import warp as wp
 from warpcaustics import device as devices
 from warpcaustics.caustics.registry import METHODS
 from warpcaustics.caustics.stage import Frame, Lighting, StageOutput, Stopwatch, sky_bytes
-from warpcaustics.config import BeamSpread, Scattering, SkySampling
+from warpcaustics.config import BeamSpread, Scattering, SkyModel, SkySampling
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.optics import spectra
 from warpcaustics.optics.refraction import (
@@ -90,8 +90,10 @@ def host_bytes(scene: Scene) -> int:
     if walks_spread(cfg):
         from warpcaustics.optics.beam_spread import SPREAD_CACHE
 
-        per_photon = HOST_BYTES_PER_SPREAD_PHOTON + 4 * k + SPREAD_CACHE * (32 + 4 * k)
-        walk = cfg.optics.beam_spread_photons * per_photon
+        sky = cfg.sky.directions if cfg.sky.model is not SkyModel.NONE else 0
+        # each direction walks three times (its depth and the two of the path's derivative)
+        kept = min(SPREAD_CACHE, 3 * (len(scene.sun_disk_directions()) + sky))
+        walk = cfg.optics.beam_spread_photons * (HOST_BYTES_PER_SPREAD_PHOTON + 4 * k + kept * (32 + 4 * k))
     return pixels * (HOST_BYTES_PER_PIXEL + HOST_BYTES_PER_BAND * k) + walk
 
 

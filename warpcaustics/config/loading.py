@@ -114,10 +114,28 @@ def _build(cls: type, table: dict, prefix: str) -> Any:
     return cls(**kwargs)
 
 
-def _set_dotted(table: dict, key: str, value: Any) -> None:
+WHOLE_VALUES = ("optics.wavelengths",)
+"""Keys whose table is one value (the bins' min_nm, max_nm and bins, or a resolved config's list_nm
+beside them): a table given for one replaces it rather than merging into it."""
+
+
+def dotted_keys(overrides: dict, prefix: str = "") -> list[str]:
+    """Every dotted key overrides reach, a table's keys inside it included (``sun={elevation_deg=…}``
+    sets ``sun.elevation_deg``)."""
+    keys = []
+    for key, value in overrides.items():
+        name = f"{prefix}{key}"
+        keys.append(name)
+        if isinstance(value, dict):
+            keys += dotted_keys(value, f"{name}.")
+    return keys
+
+
+def _set_dotted(table: dict, key: str, value: Any, prefix: str = "") -> None:
     """Set ``key`` (dotted) in ``table`` to a copy of ``value``; a table given for a table merges into
     it key by key (``--set 'sun={elevation_deg=30}'`` changes the elevation alone, as
-    ``--set sun.elevation_deg=30`` does), anything else replaces what was there."""
+    ``--set sun.elevation_deg=30`` does) but for :data:`WHOLE_VALUES`; anything else replaces what
+    was there."""
     if not isinstance(key, str) or not key:
         raise ConfigError(f"override key {key!r} must be a dotted name, e.g. 'sun.elevation_deg'")
     parts = key.split(".")
@@ -127,9 +145,10 @@ def _set_dotted(table: dict, key: str, value: Any) -> None:
         if not isinstance(child, dict):
             raise ConfigError(f"override '{key}': '{'.'.join(parts[: i + 1])}' is a value, not a table")
         node = child
-    if isinstance(value, dict) and isinstance(node.get(parts[-1]), dict):
+    whole = f"{prefix}{key}" in WHOLE_VALUES
+    if isinstance(value, dict) and isinstance(node.get(parts[-1]), dict) and not whole:
         for name, item in value.items():
-            _set_dotted(node[parts[-1]], name, item)
+            _set_dotted(node[parts[-1]], name, item, f"{prefix}{key}.")
     else:
         node[parts[-1]] = _deepcopy(value) if isinstance(value, dict) else value
 
@@ -194,7 +213,7 @@ def config_from_dict(table: dict, overrides: dict[str, Any] | None = None) -> Co
         elif isinstance(wavelengths, str):
             raise ConfigError(f"optics.wavelengths = {wavelengths!r} is not allowed; allowed: a table "
                               f"{{min_nm, max_nm, bins}}, a list of centres [nm] or \"rgb\"")
-    _resolve_sun_position(table, set(overrides or {}))
+    _resolve_sun_position(table, set(dotted_keys(overrides or {})))
     cfg = _build(Config, table, "")
     _check_consistency(cfg)
     return cfg

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from warpcaustics.config import config_to_dict
+from warpcaustics.errors import WarpcausticsError
 from warpcaustics.io.comparison import comparison_entry
 from warpcaustics.io.files import jsonable, versions, write_json
 
@@ -70,7 +71,12 @@ def time_statistics(frames: list[dict], first) -> dict | None:
     dt = float(np.mean(np.diff(times)))
     out = {"probes_m": [list(p) for p in probe_points(stats_cfg, first.map_center_m)], "dt_s": dt,
            **series_statistics(series, dt, stats_cfg.flash_threshold)}
-    if stats_cfg.integration_s > 0.0 and integration_frames(stats_cfg.integration_s, dt) <= len(frames):
+    if stats_cfg.integration_s > 0.0:
+        needed = integration_frames(stats_cfg.integration_s, dt)
+        if len(frames) < needed:  # the render command refuses it before rendering; a sweep's task fails
+            raise WarpcausticsError(f"stats.integration_s = {stats_cfg.integration_s:g} needs {needed} "
+                                    f"frames {dt:.4g} s apart for its time statistics; the animation has "
+                                    f"{len(frames)}")
         integrated = integrate_series(series, dt, stats_cfg.integration_s)
         if len(integrated) >= 3:  # a radiometer's samples, each its mean over the integration time
             out["integrated"] = {"integration_s": stats_cfg.integration_s, "samples": len(integrated),

@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 from pathlib import Path
 
 import numpy as np
 
 from warpcaustics.batch.stats import continuous_sky_cv
+from warpcaustics.config.loading import dotted_keys
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 
@@ -22,17 +24,18 @@ def numbers_of(flag: str, values) -> tuple[float, ...] | None:
     if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
     values = tuple(values)
-    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+    if not all(isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) for v in values):
         raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
     return tuple(float(v) for v in values)
 
 
 def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
     """The frame times ``i · frame_interval_s``, i < ``frames``, once both flags are sane."""
-    if not isinstance(frames, int) or isinstance(frames, bool):
+    if not isinstance(frames, numbers.Integral) or isinstance(frames, (bool, np.bool_)):
         raise ConfigError(f"--frames = {frames!r} must be a whole number of frames, e.g. 3")
-    if not isinstance(frame_interval_s, (int, float)) or isinstance(frame_interval_s, bool):
+    if not isinstance(frame_interval_s, numbers.Real) or isinstance(frame_interval_s, (bool, np.bool_)):
         raise ConfigError(f"--frame-interval = {frame_interval_s!r} must be a number of seconds, e.g. 2")
+    frames, frame_interval_s = int(frames), float(frame_interval_s)
     if frames < 1:
         raise ConfigError(f"--frames = {frames} must be at least 1")
     if not (math.isfinite(frame_interval_s) and frame_interval_s > 0):
@@ -42,18 +45,6 @@ def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
 
     check_time("--frame-interval × (--frames − 1)", (frames - 1) * frame_interval_s)
     return tuple(i * frame_interval_s for i in range(frames))
-
-
-def dotted_keys(overrides: dict, prefix: str = "") -> list[str]:
-    """Every dotted key a ``--set`` reaches, a table's keys inside it included (``sun={elevation_deg=…}``
-    sets ``sun.elevation_deg``)."""
-    keys = []
-    for key, value in overrides.items():
-        name = f"{prefix}{key}"
-        keys.append(name)
-        if isinstance(value, dict):
-            keys += dotted_keys(value, f"{name}.")
-    return keys
 
 
 def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose: str) -> None:
@@ -184,7 +175,7 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     --long-waves and its way out, --long-waves 0."""
     from warpcaustics.scene import load_scene
 
-    if not (isinstance(extent_m, (int, float)) and math.isfinite(extent_m) and extent_m >= 0.0):
+    if not (isinstance(extent_m, numbers.Real) and math.isfinite(extent_m) and extent_m >= 0.0):
         raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
                           "scene's waves alone")
     if extent_m == 0.0:
