@@ -102,6 +102,33 @@ def test_scene_too_big_for_memory(capsys, tmp_path):
                    "the scene needs", "GiB", "caustics.map_resolution")
 
 
+def test_host_memory_is_what_the_kernel_and_the_container_leave(tmp_path, monkeypatch):
+    """The memory check's host figure: /proc/meminfo's MemAvailable (free pages and reclaimable
+    cache; free pages alone had refused runs on machines whose memory was mostly page cache), within
+    a cgroup's limit less its working set (usage but the inactive file cache), v2 or v1."""
+    from warpcaustics import device as devices
+
+    meminfo = tmp_path / "meminfo"
+    meminfo.write_text("MemTotal:       32000000 kB\nMemFree:         1000000 kB\n"
+                       "MemAvailable:   20000000 kB\n")
+    monkeypatch.setattr(devices, "MEMINFO", str(meminfo))
+    monkeypatch.setattr(devices, "CGROUPS", ())
+    assert devices.host_available_bytes() == 20_000_000 * 1024
+    v2 = tmp_path / "v2"
+    v2.mkdir()
+    (v2 / "memory.max").write_text("8000000000\n")
+    (v2 / "memory.current").write_text("3000000000\n")
+    (v2 / "memory.stat").write_text("anon 1000000000\ninactive_file 1000000000\nactive_file 5\n")
+    cgroup = (str(v2 / "memory.max"), str(v2 / "memory.current"), str(v2 / "memory.stat"), "inactive_file")
+    missing = ("/nonexistent/a", "/nonexistent/b", "/nonexistent/c", "x")  # v2 absent, v1 read
+    monkeypatch.setattr(devices, "CGROUPS", (missing, cgroup))
+    assert devices.host_available_bytes() == 8_000_000_000 - (3_000_000_000 - 1_000_000_000)
+    (v2 / "memory.max").write_text("max\n")  # no limit: the kernel's figure
+    assert devices.host_available_bytes() == 20_000_000 * 1024
+    monkeypatch.setattr(devices, "MEMINFO", str(tmp_path / "none"))  # no meminfo: free pages
+    assert devices.host_available_bytes() > 0
+
+
 def test_cuda_requested_without_cuda(capsys, tmp_path):
     """Asking for CUDA where there is none is a one-line error, not a Warp traceback."""
     import warp as wp

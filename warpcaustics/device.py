@@ -88,15 +88,56 @@ def _cuda_index(choice: str) -> int:
         raise DeviceError(f"device = {choice!r} is not allowed; use cuda:N with N an integer") from None
 
 
+MEMINFO = "/proc/meminfo"
+
+CGROUPS = (
+    ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current", "/sys/fs/cgroup/memory.stat",
+     "inactive_file"),
+    ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes",
+     "/sys/fs/cgroup/memory/memory.stat", "total_inactive_file"),
+)
+"""A container's memory limit, its usage and the usage's reclaimable page cache: cgroup v2, then v1."""
+
+
 def free_bytes(device: str) -> int | None:
     """Free memory on the device in bytes, or None where it cannot be told."""
     wp = _warp()
     if device.startswith("cuda"):
         return int(wp.get_device(device).free_memory)
+    return host_available_bytes()
+
+
+def host_available_bytes() -> int | None:
+    """Host memory a run can still allocate [bytes]: the kernel's MemAvailable (free pages and the
+    page cache it can reclaim; free pages alone, ``SC_AVPHYS_PAGES``, where there is no
+    /proc/meminfo), and within a container's cgroup limit less its usage but the reclaimable cache
+    (the working set). None where none of these can be read."""
+    available = None
     try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
-        return None
+        with open(MEMINFO, encoding="ascii") as fh:
+            available = next((int(line.split()[1]) * 1024 for line in fh if line.startswith("MemAvailable:")),
+                             None)
+    except (OSError, ValueError, IndexError):
+        pass
+    if available is None:
+        try:
+            available = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+            return None
+    for limit_path, usage_path, stat_path, cache_key in CGROUPS:
+        try:
+            with open(limit_path, encoding="ascii") as fh:
+                limit = fh.read().strip()
+            if limit == "max":
+                break
+            with open(usage_path, encoding="ascii") as fh:
+                usage = int(fh.read())
+            with open(stat_path, encoding="ascii") as fh:
+                cache = next((int(line.split()[1]) for line in fh if line.split()[:1] == [cache_key]), 0)
+        except (OSError, ValueError, IndexError):
+            continue
+        return min(available, max(int(limit) - (usage - cache), 0))
+    return available
 
 
 def check_fits(device: str, needed_bytes: int, what: str) -> None:
