@@ -170,6 +170,10 @@ def test_a_run_that_fails_before_its_first_frame_leaves_no_folder(capsys, tmp_pa
     folder goes with the error (an empty one had been left behind)."""
     _fails_cleanly(capsys, tmp_path, [str(CONFIGS / "ocean.toml"), *SMALL, "--set", "floor.depth_m=1e-6"],
                    "floor.depth_m = 1e-06 is too shallow")
+    nested = tmp_path / "made" / "by" / "the run"  # the folders above it that the run made go too
+    assert main(["render", str(CONFIGS / "ocean.toml"), *SMALL, "--set", "floor.depth_m=1e-6",
+                 "--out", str(nested), "--device", "cpu"]) == 2
+    assert not (tmp_path / "made").exists()
 
 
 def test_a_render_and_a_sweep_do_not_share_a_folder_unasked(capsys, tmp_path):

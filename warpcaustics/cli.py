@@ -232,7 +232,7 @@ def _render(args: argparse.Namespace) -> int:
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
-    created = not out.exists()
+    made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)  # the first folder made
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -259,8 +259,8 @@ def _render(args: argparse.Namespace) -> int:
             progress.step(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
                           f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
     except BaseException:
-        if created and not results:  # failed before its first frame: the folder this run made goes
-            shutil.rmtree(out, ignore_errors=True)
+        if made is not None and not results:  # failed before its first frame: what this run made goes
+            shutil.rmtree(made, ignore_errors=True)
         raise
     finally:
         progress.close()
