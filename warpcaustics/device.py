@@ -112,32 +112,37 @@ def host_available_bytes() -> int | None:
     page cache it can reclaim; free pages alone, ``SC_AVPHYS_PAGES``, where there is no
     /proc/meminfo), and within a container's cgroup limit less its usage but the reclaimable cache
     (the working set). None where none of these can be read."""
-    available = None
-    try:
-        with open(MEMINFO, encoding="ascii") as fh:
-            available = next((int(line.split()[1]) * 1024 for line in fh if line.startswith("MemAvailable:")),
-                             None)
-    except (OSError, ValueError, IndexError):
-        pass
-    if available is None:
+    available = _field(MEMINFO, "MemAvailable:")
+    if available is not None:
+        available *= 1024  # kB
+    else:
         try:
             available = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
         except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
             return None
     for limit_path, usage_path, stat_path, cache_key in CGROUPS:
-        try:
-            with open(limit_path, encoding="ascii") as fh:
-                limit = fh.read().strip()
-            if limit == "max":
-                break
-            with open(usage_path, encoding="ascii") as fh:
-                usage = int(fh.read())
-            with open(stat_path, encoding="ascii") as fh:
-                cache = next((int(line.split()[1]) for line in fh if line.split()[:1] == [cache_key]), 0)
-        except (OSError, ValueError, IndexError):
+        limit, usage = _field(limit_path), _field(usage_path)
+        if limit is None or usage is None:  # absent, or "max": no limit
             continue
-        return min(available, max(int(limit) - (usage - cache), 0))
+        working_set = usage - (_field(stat_path, cache_key) or 0)
+        return min(available, max(limit - working_set, 0))
     return available
+
+
+def _field(path: str, key: str | None = None) -> int | None:
+    """The integer a file holds (``key`` None), or the one after ``key`` on its line of ``key value``
+    pairs; None where the file, the key or the number is missing."""
+    try:
+        with open(path, encoding="ascii") as fh:
+            for line in fh:
+                words = line.split()
+                if key is None:
+                    return int(words[0])
+                if words[:1] == [key]:
+                    return int(words[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
 
 
 def check_fits(device: str, needed_bytes: int, what: str) -> None:

@@ -75,8 +75,9 @@ weights and memory)."""
 
 
 def walks_spread(cfg) -> bool:
-    """Whether the small-angle transfer walks its beam spread (``optics.beam_spread_photons`` each)."""
-    return cfg.optics.scattering is Scattering.SMALL_ANGLE and cfg.optics.beam_spread is BeamSpread.WALK
+    """Whether the small-angle transfer walks its beam spread (``optics.beam_spread_photons`` each):
+    the config takes ``walk`` only with ``optics.scattering = "small_angle"`` (config/checks.py)."""
+    return cfg.optics.beam_spread is BeamSpread.WALK
 
 
 def host_bytes(scene: Scene) -> int:

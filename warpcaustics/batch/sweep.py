@@ -54,8 +54,9 @@ from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.io.files import atomic_path, write_csv, write_json
 from warpcaustics.io.manifest import MANIFEST as RUN_MANIFEST
+from warpcaustics.io.manifest import SWEEP_MANIFEST as MANIFEST
+from warpcaustics.io.manifest import SWEEP_RECORD
 
-MANIFEST = "manifest.jsonl"
 SUMMARY = "summary.csv"
 
 
@@ -206,10 +207,6 @@ def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
 
 # ---------------------------------------------------------------------------------------------
 # Driver
-
-
-SWEEP_RECORD = "sweep.json"
-"""Which sweep a folder holds: the hash of its task ids (the resolved configs, times and version)."""
 
 
 def _varied(sweep: Sweep, task: Task) -> str:

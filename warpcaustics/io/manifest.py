@@ -14,7 +14,11 @@ from warpcaustics.errors import WarpcausticsError
 from warpcaustics.io.files import atomic_path
 
 MANIFEST = "outputs.json"
-SWEEP_FILES = ("manifest.jsonl", "sweep.json")
+SWEEP_MANIFEST = "manifest.jsonl"
+"""A sweep's record of its tasks, one JSON line each (``batch/sweep.py``)."""
+SWEEP_RECORD = "sweep.json"
+"""Which sweep a folder holds: the hash of its task ids (the resolved configs, times and version)."""
+SWEEP_FILES = (SWEEP_MANIFEST, SWEEP_RECORD)
 """What a sweep (``batch/sweep.py``, the field commands) keeps in its folder: a render refuses to
 write among them without --force."""
 

@@ -236,10 +236,14 @@ class ShallowWaterPool(WalledPool):
         body_speed = 0.0
         if self.body is not None:
             body_speed = 2.0 * math.pi * self.body.path_radius_m / self.body.period_s
+
+        def cfl_dt(speed: float) -> float:  # the longest stable substep at this wave speed
+            return min(self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
+
         speed = self.max_wave_speed()
         if math.isfinite(speed):  # the substeps at the present speed: refuse now what is far past the
             # guard below, not after minutes (the speed may fall as the waves spread, hence the margin)
-            first = min(self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
+            first = cfl_dt(speed)
             needed = (time_s - self.time_s) / first
             if needed > 10 * MAX_SUBSTEPS_PER_CALL:
                 raise WarpcausticsError(
@@ -250,12 +254,12 @@ class ShallowWaterPool(WalledPool):
             remaining = time_s - self.time_s
             if remaining <= 1e-12:
                 break
-            if i % SPEED_REFRESH_SUBSTEPS == 0 or not math.isfinite(speed):
-                speed = self.max_wave_speed()  # a read-back: not every substep
+            if (i and i % SPEED_REFRESH_SUBSTEPS == 0) or not math.isfinite(speed):
+                speed = self.max_wave_speed()  # a read-back: not every substep (the first was read above)
             if not math.isfinite(speed):
                 raise WarpcausticsError(f"the pool became unstable at t = {self.time_s:g} s; lower "
                                         f"water.cfl (now {self.cfl}) or the drops' height")
-            dt = min(remaining, self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
+            dt = min(remaining, cfl_dt(speed))
             next_drop = next((d.time_s for d in self._drops if d.time_s > self.time_s), math.inf)
             dt = min(dt, max(next_drop - self.time_s, 1e-9))
             self.step(dt)
