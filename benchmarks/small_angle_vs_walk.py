@@ -23,8 +23,11 @@ the cross-spectra of ``--seeds`` independent walks (all pairs averaged). Printed
 ``--set`` changes the scene for every map alike: the walked spread's photons
 (``optics.beam_spread_photons``: its own Monte Carlo noise is a fixed realisation per seed, which the
 walks' jackknife does not hold) or the waves' amplitude (``water.phillips_amplitude``: does a residual
-grow with the slopes?). The figures are in docs/physics.md and docs/validation.md (issue 32 item 2).
-About two minutes per geometry on one core with 8 seeds.
+grow with the slopes?). ``--oversample R`` renders the small-angle maps on R times finer texels and
+averages them down to the walk's: the map's texels fold the floor's detail finer than themselves
+into its finest band, which the transfer would spread by that band's multiplier instead of the
+detail's own (R = 2 takes the fold out here). The figures are in docs/physics.md and
+docs/validation.md (issue 32 item 2). About two minutes per geometry on one core with 8 seeds.
 """
 
 from __future__ import annotations
@@ -74,12 +77,17 @@ def jackknife_sd(samples: np.ndarray) -> np.ndarray:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=8, help="independent walks (even, ≥ 4; default 8)")
+    parser.add_argument("--oversample", type=int, default=1, metavar="R",
+                        help="render the small-angle maps on R times finer texels and average them "
+                             "down (R x R texels each) to the walk's map (default 1: as the test)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="a config override on top of the test's scene, for every map alike "
                              "(repeatable), e.g. optics.beam_spread_photons=2097152")
     args = parser.parse_args(argv)
     if args.seeds < 4 or args.seeds % 2:
         parser.error("--seeds: give an even number of at least 4")
+    if args.oversample < 1:
+        parser.error("--oversample: give a whole number of at least 1")
     from warpcaustics.config import parse_override
     from warpcaustics.errors import ConfigError
 
@@ -115,8 +123,11 @@ def main(argv: list[str] | None = None) -> int:
 
     seeds = range(1, args.seeds + 1)
 
-    def floor(overrides: dict) -> np.ndarray:
-        return wc.render(wc.load_scene(CONFIGS / "ocean.toml", overrides), device="cpu").floor_irradiance
+    def floor(overrides: dict, oversample: int = 1) -> np.ndarray:
+        """The floor map, rendered on ``oversample`` times finer texels and averaged down to M²."""
+        fine = {**overrides, "caustics.map_resolution": m * oversample}
+        a = wc.render(wc.load_scene(CONFIGS / "ocean.toml", fine), device="cpu").floor_irradiance
+        return np.asarray(a, np.float64).reshape(-1, m, oversample, m, oversample).mean(axis=(2, 4))
 
     np.set_printoptions(precision=3, suppress=True, linewidth=120)
     edges = " ".join(f"{lo:.4g}–{hi:.4g}" for lo, hi in zip(BANDS, BANDS[1:]))
@@ -124,6 +135,9 @@ def main(argv: list[str] | None = None) -> int:
     print("rows: the 450, 550 and 650 nm bands of the map (optics.wavelengths = rgb)")
     if extra:
         print("--set:", ", ".join(f"{k}={v}" for k, v in extra.items()))
+    if args.oversample > 1:
+        print(f"--oversample {args.oversample}: the small-angle maps on {m * args.oversample}² texels, "
+              "averaged down")
     for depth, phase in GEOMETRIES:
         start = time.perf_counter()
         base = {**SCENE, "floor.depth_m": depth, "optics.phase_function": phase, **extra}
@@ -141,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         print("surface factor (single / walk, no water):\n", surface)
         for spread in SPREADS:
             mode = {**base, "optics.scattering": "small_angle", "optics.beam_spread": spread}
-            power = np.abs(fluctuations(floor(mode))) ** 2
+            power = np.abs(fluctuations(floor(mode, args.oversample))) ** 2
             ratio = band_power(power, m) / walk
             left = over_surface(power, single0, walk0, walk)
             samples = [over_surface(power, single0, a, b) for a, b in zip(walk0_k, walk_k)]
