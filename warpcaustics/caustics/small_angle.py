@@ -195,7 +195,8 @@ class SmallAngleScattering:
         patch's single-scattering light on coarse texels beside a window, the window's scattered light
         is the whole patch's at the large scales, read bilinearly from the coarse texels, plus the
         window's own detail beyond them taken as periodic: B*C + B_w*(S_w − C_w), C_w the coarse map
-        at the window's texels (B the transfer)."""
+        at the window's texels (B the transfer), the detail's mean over the window left out (the
+        transfer reaches metres past the window: :meth:`MapWindow.convolve`)."""
         out, at_zero = 0.0, 0.0
         if coarse is None:
             on_map = np.asarray(single, np.float64).mean(axis=(1, 2))
@@ -213,7 +214,7 @@ class SmallAngleScattering:
                                                    self.terms(coarse, light, down, path, *centres)):
             far_m, zero = self.multiplier(self.extent_m / mc, mc, down, path, derivative)
             near_m, _ = self.multiplier(self.texel_m, term.shape[-1], down, path, derivative)
-            on_window, on_coarse = self.window.convolve(term, term_c, far_m, near_m)
+            on_window, on_coarse = self.window.convolve(term, term_c, far_m, near_m, detail_mean=False)
             out, out_c = out + on_window, out_c + on_coarse
             at_zero = at_zero + np.divide(term_c.mean(axis=(1, 2)), whole, out=np.zeros_like(whole),
                                           where=whole > 0) * zero

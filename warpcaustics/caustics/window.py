@@ -65,11 +65,23 @@ class MapWindow:
         _, (rows, wy), (cols, wx), _ = self.on_coarse(a.shape[-1])
         return wy @ a[:, rows][:, :, cols] @ wx.T
 
-    def convolve(self, window: np.ndarray, coarse: np.ndarray, far, near) -> tuple[np.ndarray, np.ndarray]:
+    def convolve(self, window: np.ndarray, coarse: np.ndarray, far, near, *, detail_mean: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray]:
         """(B*S on the window's texels (K, M, M), B*C on the coarse texels (K, Mc, Mc)) for the
         window's map ``window`` (K, M, M) whose whole patch's light is ``coarse`` (K, Mc, Mc): the
         coarse map convolved over the periodic patch (``far``: B's multiplier by band on the coarse
         texels' FFT grid) and read at the texels, plus the window's detail beyond the coarse texels
-        convolved as periodic over the window (``near``: on the window's grid)."""
+        convolved as periodic over the window (``near``: on the window's grid).
+
+        ``detail_mean=False`` leaves the detail's mean over the window out of its convolution: for a
+        B that reaches far past the window (the scattered light's transfer, over metres), the window
+        taken as periodic would spread that mean as if every window around held it, by B's whole
+        weight (its k = 0 value: about 440 at 9.58 m in Darecki et al.'s water), where the detail's
+        light averages out over B's reach; the coarse map's bilinear reading misses a window's own
+        light by 5–19 % when its texels are half the window (``tests/test_small_angle.py``). A
+        narrow B (a sky cone's blur) keeps it."""
         whole = transferred(coarse, far)
-        return self.on_map(whole) + transferred(window - self.on_map(coarse), near), whole
+        detail = window - self.on_map(coarse)
+        if not detail_mean:
+            detail = detail - detail.mean(axis=(1, 2), keepdims=True)
+        return self.on_map(whole) + transferred(detail, near), whole
