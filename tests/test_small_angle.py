@@ -151,7 +151,34 @@ def test_a_window_agrees_with_the_whole_map():
     np.testing.assert_allclose(cv, part.std(axis=(1, 2)) / part.mean(axis=(1, 2)), rtol=0.01)
 
 
-def test_a_deep_window_takes_its_large_scales_from_the_whole_patch():
+DEEP = {"floor.depth_m": 9.58, "water.resolution": 256, "stats.collector_mm": 0.0, "sky.model": "none",
+        "sky.diffuse_fraction": 0.0, "sun.angular_diameter_deg": 0.0, "optics.wavelengths": [532.0]}
+"""Darecki et al. (2011)'s water at 9.58 m under a point sun, its 32 m sea on 256² cells (t = 10 s)."""
+
+
+@pytest.fixture(scope="module")
+def deep_sea():
+    """(the whole patch's map, its single-scattering map) of :data:`DEEP` on 128² texels of 25 cm."""
+    whole = wc.render(wc.load_scene(CONFIGS / "field" / "darecki2011.toml",
+                                    {**DEEP, "caustics.map_extent_m": 0.0, "caustics.map_resolution": 128}),
+                      time_s=10.0, device="cpu")
+    return (whole.floor_irradiance[0].astype(np.float64),
+            whole.comparison.floor_irradiance[0].astype(np.float64))
+
+
+def deep_window(side_m: float, cx: float, cy: float) -> tuple[np.ndarray, tuple[slice, slice]]:
+    """(the map of a window of :data:`DEEP` on texels of the whole map's 25 cm, (rows, columns) of the
+    same ground on the whole map)."""
+    where = {"caustics.map_extent_m": side_m, "caustics.map_resolution": round(side_m * 4),
+             "caustics.map_center_m": [float(cx), float(cy)]}
+    window = wc.render(wc.load_scene(CONFIGS / "field" / "darecki2011.toml", {**DEEP, **where}), time_s=10.0,
+                       device="cpu").floor_irradiance[0].astype(np.float64)
+    ground = tuple(slice(round((c - side_m / 2 + 16) * 4), round((c + side_m / 2 + 16) * 4))
+                   for c in (cy, cx))  # 25 cm texels from −16 m
+    return window, ground
+
+
+def test_a_deep_window_takes_its_large_scales_from_the_whole_patch(deep_sea):
     """Darecki et al. (2011)'s water at 9.58 m (b z ≈ 5.7: almost all the light scattered, spread over
     metres): 2 m windows of the 32 m sea (256² cells) at four places against the same texels of the
     whole patch's map (25 cm texels). The window's light must come from the sea around it: the
@@ -159,49 +186,28 @@ def test_a_deep_window_takes_its_large_scales_from_the_whole_patch():
     0.89–1.08×, and the window taken as periodic (before 2026-12-05) kept the window's own swing,
     0.77–1.15× the whole map's with 12–23 % L1. Now each window is within 2.5 % of the whole map
     in the mean (measured 0.4–1.6 %) and 3 % in L1 (0.4–1.6 %)."""
-    base = {"floor.depth_m": 9.58, "water.resolution": 256, "stats.collector_mm": 0.0, "sky.model": "none",
-            "sky.diffuse_fraction": 0.0, "sun.angular_diameter_deg": 0.0, "optics.wavelengths": [532.0]}
-    scene = CONFIGS / "field" / "darecki2011.toml"
-    whole = wc.render(wc.load_scene(scene, {**base, "caustics.map_extent_m": 0.0,
-                                            "caustics.map_resolution": 128}), time_s=10.0, device="cpu")
-    full = whole.floor_irradiance[0].astype(np.float64)
-    single = whole.comparison.floor_irradiance[0].astype(np.float64)
+    full, single = deep_sea
     swings = []
     for cx, cy in ((0, 0), (7, -5), (-9, 11), (13, 3)):
-        where = {"caustics.map_extent_m": 2.0, "caustics.map_resolution": 8,
-                 "caustics.map_center_m": [float(cx), float(cy)]}
-        window = wc.render(wc.load_scene(scene, {**base, **where}), time_s=10.0,
-                           device="cpu").floor_irradiance[0].astype(np.float64)
-        rows = slice(int((cy + 15) * 4), int((cy + 17) * 4))  # 25 cm texels from −16 m
-        cols = slice(int((cx + 15) * 4), int((cx + 17) * 4))
-        part = full[rows, cols]
+        window, ground = deep_window(2.0, cx, cy)
+        part = full[ground]
         assert abs(window.mean() / part.mean() - 1.0) < 0.025, (cx, cy)
         assert np.abs(window - part).sum() / part.sum() < 0.03, (cx, cy)
-        swings.append(single[rows, cols].mean() / single.mean())
+        swings.append(single[ground].mean() / single.mean())
     assert max(abs(s - 1.0) for s in swings) > 0.2  # the windows' own light swings: the test can tell
 
 
-def test_a_window_two_coarse_texels_wide_keeps_the_whole_maps_mean():
+def test_a_window_two_coarse_texels_wide_keeps_the_whole_maps_mean(deep_sea):
     """The same water and sea with 0.5 m windows (two 25 cm texels), whose coarse texels (two
     cells, 25 cm) are half the window: the coarse map read bilinearly misses the window's own light
     by 5–19 %, and the window's detail taken as periodic would spread that miss by the transfer's
     whole weight (its k = 0 value, about 440 here): 0.91–1.00× the whole map's mean over the same
     ground (up to 9 % L1) when it did. With the detail's mean left out of its transfer each window
     is within 1 % of the whole map (measured 0.998–1.004, L1 ≤ 0.5 %)."""
-    base = {"floor.depth_m": 9.58, "water.resolution": 256, "stats.collector_mm": 0.0, "sky.model": "none",
-            "sky.diffuse_fraction": 0.0, "sun.angular_diameter_deg": 0.0, "optics.wavelengths": [532.0]}
-    scene = CONFIGS / "field" / "darecki2011.toml"
-    whole = {**base, "caustics.map_extent_m": 0.0, "caustics.map_resolution": 128}
-    full = wc.render(wc.load_scene(scene, whole), time_s=10.0, device="cpu").floor_irradiance[0]
-    full = full.astype(np.float64)
+    full, _ = deep_sea
     for cx, cy in ((7.25, -4.75), (-8.75, 11.25), (-3.75, -9.75), (5.25, 5.25)):
-        where = {"caustics.map_extent_m": 0.5, "caustics.map_resolution": 2,
-                 "caustics.map_center_m": [cx, cy]}
-        window = wc.render(wc.load_scene(scene, {**base, **where}), time_s=10.0,
-                           device="cpu").floor_irradiance[0].astype(np.float64)
-        rows = slice(round((cy + 15.75) * 4), round((cy + 16.25) * 4))  # 25 cm texels from −16 m
-        cols = slice(round((cx + 15.75) * 4), round((cx + 16.25) * 4))
-        part = full[rows, cols]
+        window, ground = deep_window(0.5, cx, cy)
+        part = full[ground]
         assert abs(window.mean() / part.mean() - 1.0) < 0.01, (cx, cy, window.mean() / part.mean())
         assert np.abs(window - part).sum() / part.sum() < 0.01, (cx, cy)
 

@@ -16,6 +16,11 @@ from warpcaustics.config.loading import dotted_keys
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
 
+def _is_number(value, kind: type = numbers.Real) -> bool:
+    """Whether ``value`` is a number of ``kind`` (numpy's included), not a bool."""
+    return isinstance(value, kind) and not isinstance(value, (bool, np.bool_))
+
+
 def numbers_of(flag: str, values) -> tuple[float, ...] | None:
     """``values`` (a flag's numbers from Python: a list or tuple; None for all) as floats, or a
     one-line error naming ``flag`` (a bare number or a string had raised TypeError deep inside)."""
@@ -24,16 +29,16 @@ def numbers_of(flag: str, values) -> tuple[float, ...] | None:
     if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
     values = tuple(values)
-    if not all(isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) for v in values):
+    if not all(_is_number(v) for v in values):
         raise ConfigError(f"{flag} = {values!r} must be a list of numbers, e.g. (20.0, 40.0)")
     return tuple(float(v) for v in values)
 
 
 def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
     """The frame times ``i · frame_interval_s``, i < ``frames``, once both flags are sane."""
-    if not isinstance(frames, numbers.Integral) or isinstance(frames, (bool, np.bool_)):
+    if not _is_number(frames, numbers.Integral):
         raise ConfigError(f"--frames = {frames!r} must be a whole number of frames, e.g. 3")
-    if not isinstance(frame_interval_s, numbers.Real) or isinstance(frame_interval_s, (bool, np.bool_)):
+    if not _is_number(frame_interval_s):
         raise ConfigError(f"--frame-interval = {frame_interval_s!r} must be a number of seconds, e.g. 2")
     frames, frame_interval_s = int(frames), float(frame_interval_s)
     if frames < 1:
