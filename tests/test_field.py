@@ -338,6 +338,22 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 DARECKI = ROOT / "configs/field/darecki2011.toml"
 
 
+def test_gernez_config_takes_the_petzold_station_nearest_its_waters_scattering():
+    """configs/field/gernez2009.toml's phase function is from the Petzold station (jerlov package)
+    whose measured b(530) is nearest the config's own water's b at its 510 nm band (AUTEC 7, 0.117
+    against Jerlov IB's 0.127 1/m; the default HAOCE 11 is coastal, 0.219)."""
+    import warpcaustics as wc
+    from warpcaustics.config import PetzoldStation
+    from warpcaustics.optics import spectra
+
+    optics = wc.load_scene(ROOT / "configs/field/gernez2009.toml").config.optics
+    b = float(spectra.water_optics(optics, spectra.bins_for(optics)).scattering_per_m[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        measured = {s: jerlov.petzold_scattering(s.value).b for s in PetzoldStation}
+    assert optics.petzold_station is min(measured, key=lambda s: abs(measured[s] - b)), (b, measured)
+
+
 def test_darecki_config_holds_the_records_conditions():
     """configs/field/darecki2011.toml: the record's bands, collector, mid sun and wind, and a water
     whose c(555) is the record's 0.68 1/m to 0.5 % (its chlorophyll, solved by chlorophyll_for,
