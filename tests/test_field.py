@@ -240,6 +240,7 @@ def test_bad_input_is_one_line(tmp_path, capsys):
         field.run_gernez2009(_scene(tmp_path), tmp_path / "o", long_waves_m=-1.0, quick=True)
     for wrong, needle in ((dict(frames=2.5), "--frames = 2.5"), (dict(zeniths=20), "--zeniths = 20"),
                           (dict(long_waves_m=None), "--long-waves = None"),
+                          (dict(long_waves_m=True), "--long-waves = True"),  # not a side of 1 m
                           (dict(sqrt_winds=("2",)), "--sqrt-winds")):
         with pytest.raises(ConfigError, match=needle):  # from Python: wrong types had raised TypeError
             field.run_gernez2009(_scene(tmp_path), tmp_path / "o", quick=True, **wrong)

@@ -180,7 +180,7 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     --long-waves and its way out, --long-waves 0."""
     from warpcaustics.scene import load_scene
 
-    if not (isinstance(extent_m, numbers.Real) and math.isfinite(extent_m) and extent_m >= 0.0):
+    if not (_is_number(extent_m) and math.isfinite(extent_m) and extent_m >= 0.0):
         raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
                           "scene's waves alone")
     if extent_m == 0.0:
