@@ -227,6 +227,27 @@ def _cpu_name() -> str:
     return platform.processor() or "unknown"
 
 
+CHILD_MODULES = (
+    "photons",        # photon splatting against its numpy twin
+    "beams",          # the beam rasteriser against its numpy twins
+    "sunmap",         # sun-map caustics against the flux-ratio map of the same frame
+    "above_water",    # the camera above the water against the camera under it
+    "photon_splats",  # photon footprint splats against texel deposits
+    "bounces",        # photons and beams through a glass receiver against the same receiver opaque
+    "eikonal",        # the eikonal texture at Mercier's sizes
+    "sun_disk",       # the sun's disk against a point sun
+    "shading",        # the crest-shading march over height blocks against the step-by-step one
+    "deposit",        # the flux-ratio deposit by the footprints' edges against clipping every texel
+    "multiple",       # the multiple-scattering random walk's photon rate
+    "small_angle",    # the small-angle scattering mode against single scattering
+    "long_waves",     # the field comparison's long waves against its scene's frame
+    "field_bands",    # the Gernez comparison's six bands against its one
+    "spectra",        # the Elfouhaily spectrum against JONSWAP: the ocean's build and step
+)
+"""The benchmark modules (``benchmarks/<name>.py``) whose ``run(quick, device)`` main runs in a child
+process each, in this order; their records go into the run's record under their names."""
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m benchmarks.run", description=__doc__.splitlines()[0])
     p.add_argument("--quick", action="store_true", help="small sizes, one repeat (CI keeps it alive)")
@@ -256,56 +277,14 @@ def main(argv: list[str] | None = None) -> int:
 
     steps = {module: _step_rows(module, args.quick, args.device, repeats) for module, _, _, _ in STEPS}
 
-    # Photon splatting vs its numpy twin, both in one child process (benchmarks/photons.py).
-    photons = _in_child("run", args.quick, args.device, module="photons")
-
-    # The beam rasteriser vs its numpy twins, in one child process (benchmarks/beams.py).
-    beams = _in_child("run", args.quick, args.device, module="beams")
-
-    # Sun-map caustics vs the flux-ratio map of the same frame (benchmarks/sunmap.py).
-    sunmap = _in_child("run", args.quick, args.device, module="sunmap")
-
-    # The camera above the water against the camera under it (benchmarks/above_water.py).
-    above_water = _in_child("run", args.quick, args.device, module="above_water")
-
-    # Photon footprint splats against texel deposits (benchmarks/photon_splats.py).
-    photon_splats = _in_child("run", args.quick, args.device, module="photon_splats")
-
-    # Photons and beams through a glass receiver against the same receiver opaque (benchmarks/bounces.py).
-    bounces = _in_child("run", args.quick, args.device, module="bounces")
-
-    # The eikonal texture at Mercier's sizes (benchmarks/eikonal.py).
-    eikonal = _in_child("run", args.quick, args.device, module="eikonal")
-
-    # The sun's disk against a point sun (benchmarks/sun_disk.py).
-    sun_disk = _in_child("run", args.quick, args.device, module="sun_disk")
-
-    # The crest-shading march over height blocks against the step-by-step one (benchmarks/shading.py).
-    shading = _in_child("run", args.quick, args.device, module="shading")
-
-    # The flux-ratio deposit by the footprints' edges against clipping every texel (benchmarks/deposit.py).
-    deposit = _in_child("run", args.quick, args.device, module="deposit")
-
-    # The multiple-scattering random walk's photon rate (benchmarks/multiple.py).
-    multiple = _in_child("run", args.quick, args.device, module="multiple")
-
-    # The small-angle scattering mode against single scattering (benchmarks/small_angle.py).
-    small_angle = _in_child("run", args.quick, args.device, module="small_angle")
-
-    # The field comparison's long waves against its scene's frame (benchmarks/long_waves.py).
-    long_waves = _in_child("run", args.quick, args.device, module="long_waves")
-
-    # The Gernez comparison's six bands against its one (benchmarks/field_bands.py).
-    field_bands = _in_child("run", args.quick, args.device, module="field_bands")
+    # Each capability's benchmark against its baseline, each in a child process of its own.
+    children = {module: _in_child("run", args.quick, args.device, module=module) for module in CHILD_MODULES}
 
     # The sky's cones on the sea's waves cut to a coarser grid (benchmarks/sky_surface.py), in this
     # process: it runs each case in a child of its own (a pool's worker may not start one).
     from benchmarks import sky_surface as sky_surface_bench
 
     sky_surface = sky_surface_bench.run(args.quick, args.device)
-
-    # The Elfouhaily spectrum against JONSWAP: the ocean's build and step (benchmarks/spectra.py).
-    spectra = _in_child("run", args.quick, args.device, module="spectra")
 
     # Sweep throughput (benchmarks/sweep.py) in this process: it starts its own worker pool.
     from benchmarks import sweep as sweep_bench
@@ -331,21 +310,7 @@ def main(argv: list[str] | None = None) -> int:
         "results": rows,
         "steps": steps,
         "bins": bins_rows,
-        "photons": photons,
-        "beams": beams,
-        "sunmap": sunmap,
-        "above_water": above_water,
-        "bounces": bounces,
-        "photon_splats": photon_splats,
-        "eikonal": eikonal,
-        "sun_disk": sun_disk,
-        "shading": shading,
-        "deposit": deposit,
-        "multiple": multiple,
-        "small_angle": small_angle,
-        "spectra": spectra,
-        "long_waves": long_waves,
-        "field_bands": field_bands,
+        **children,
         "sky_surface": sky_surface,
         "sweep": sweeps,
         "memory": memory,

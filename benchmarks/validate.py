@@ -18,12 +18,28 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 
 def main() -> int:
+    _floor_physics()
+    _lens()
+    _crests()
+    _fft_ocean()
+    _colour_and_fft()
+    _photons()
+    _beams()
+    _approximate_methods()
+    _sunmap_variants()
+    _wave_depths()
+    _multiple_scattering()
+    return 0
+
+
+
+def _floor_physics() -> None:
+    """The flux-ratio floor on flat water, its energy on a rough sea and the float64 reference."""
     import warpcaustics as wc
-    from warpcaustics import reference, water
+    from warpcaustics import reference
 
     from helpers import flat_floor_irradiance
     from test_floor_physics import _flat_scene, _rough_ocean, _transmitted_flux_float64
-    from test_lens import APEX_M, FOCAL_M, N
 
     print("## Flat water vs E_sun cosθ T(θ) exp(-c D / cosθ_t)  (pure water, 8 bins, max over bins, texels)")
     for el in (15.0, 40.0, 65.0, 90.0):
@@ -43,6 +59,13 @@ def main() -> int:
     f64, _ = reference.floor_caustics(r.surface_positions, r.surface_normals, r.scene.sun_direction,
                                       1.333, 6.0, r.sun_irradiance, r.attenuation_per_m, 8.0, 96)
     print(f"relative L1 {np.abs(r.floor_irradiance - f64).sum() / np.abs(f64).sum():.2e}")
+
+
+def _lens() -> None:
+    """The paraboloid lens's focus, under an overhead and an oblique sun."""
+    import warpcaustics as wc
+
+    from test_lens import APEX_M, FOCAL_M, N
 
     print(f"\n## Paraboloid lens: f = nR/(n-1) = {FOCAL_M:.4f} m, apex {APEX_M:.4f} m")
     with tempfile.TemporaryDirectory() as tmp:
@@ -80,6 +103,12 @@ def main() -> int:
     print(f"spot centroid ({cx:.4f}, {cy:.4f}) m, chief ray ({ex:.4f}, {ey:.4f}) m, "
           f"distance {np.hypot(cx - ex, cy - ey) * 1000:.1f} mm (texel {EXTENT_M / N * 1000:.1f} mm)")
 
+
+def _crests() -> None:
+    """The crests' shading of a low sun against the float64 sweep."""
+    import warpcaustics as wc
+    from warpcaustics import reference
+
     print("\n## Shading by crests: steep sea, sun 10° high (64², water_type none)")
     scene = point_sun_scene(None, {"water.model": "fft", "water.resolution": 64, "water.extent_m": 8.0,
                                  "water.wind_speed_m_s": 5.0, "water.phillips_amplitude": 0.05,
@@ -100,7 +129,12 @@ def main() -> int:
           f"{np.maximum(a_perp, 0).sum() / (64.0 * s_dir[2]):.3f}; floor flux / beam flux "
           f"{r.floor_flux_w_nm[0] / beam:.3f}")
 
+
+def _fft_ocean() -> None:
+    """The FFT ocean's height variance, dynamics and choppiness, and JONSWAP's variance."""
     from test_water import _phillips_h0
+
+    from warpcaustics import water
 
     print("\n## Ocean height variance vs the spectrum (24 seeds, 512² over 200 m, A = 3e-3)")
     for wind in (4.0, 8.0):
@@ -158,6 +192,11 @@ def main() -> int:
     print(f"JONSWAP (6 m/s, 20 km fetch): Σ P Δk² {drawn:.5f} m², ∫ S dω {np.trapezoid(so, om):.5f} m² "
           f"({drawn / np.trapezoid(so, om) - 1:+.2%})")
 
+
+def _colour_and_fft() -> None:
+    """D65 through the colour pipeline and Warp's FFT against numpy's."""
+    from warpcaustics import water
+
     print("\n## Colour: D65 → linear sRGB / Y")
     from warpcaustics.optics import colour as colour_out
     from warpcaustics.optics.spectra import SpectralBins
@@ -178,14 +217,6 @@ def main() -> int:
         water.ifft2(a)
         ref = np.fft.ifft2(x) * n * n
         print(f"{n}²: {np.linalg.norm(water.from_vec2(a) - ref) / np.linalg.norm(ref):.2e}")
-
-    _photons()
-    _beams()
-    _approximate_methods()
-    _sunmap_variants()
-    _wave_depths()
-    _multiple_scattering()
-    return 0
 
 
 def _wave_depths() -> None:
