@@ -32,7 +32,6 @@ def main() -> int:
     return 0
 
 
-
 def _floor_physics() -> None:
     """The flux-ratio floor on flat water, its energy on a rough sea and the float64 reference."""
     import warpcaustics as wc
