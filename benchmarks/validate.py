@@ -410,18 +410,16 @@ def _camera_floor() -> None:
 
 def _beams() -> None:
     """Beam caustics: the figures of docs/validation.md's beam section."""
-    from test_beams import (
-        BEAMS,
+    from test_beam_chords import (
         NEAR_AXIS_BEAMS,
         PRISM_BASE,
         PRISM_DIRECTION,
         PRISM_ENDS,
-        _flat,
         _prism_chord,
-        _sphere_bins,
         _straight_prism_chords,
         near_axis_chord_errors,
     )
+    from test_beams import BEAMS, _flat, _sphere_bins
     from test_photons import shaft_block
 
     import warpcaustics as wc
