@@ -306,7 +306,8 @@ def _sunmap_variants() -> None:
 
 def _photons() -> None:
     """Photon caustics: the figures of docs/validation.md's photon section."""
-    from test_photons import PHOTONS, SLOPE, SPHERE, _flat, newton_errors
+    from test_newton import SLOPE, SPHERE, newton_errors
+    from test_photons import PHOTONS, _flat
 
     import warpcaustics as wc
 
@@ -351,7 +352,7 @@ def _photons() -> None:
                   f"{e['within_texel']:.1%}")
 
     print("\n## Newton vs exact hits: where a walled pool's light lands (0.6 s, no absorption)")
-    from test_photons import pool_flux_by_intersection
+    from test_newton import pool_flux_by_intersection
 
     for config, el in (("pool", 20.0), ("pool", 40.0), ("pool", 70.0), ("wavepool", 30.0)):
         f = pool_flux_by_intersection(el, ROOT / "configs" / f"{config}.toml")
