@@ -70,13 +70,29 @@ def test_a_blown_up_pool_is_reported_not_carried_on(device):
         pool.advance(0.1)
 
 
-def test_a_time_beyond_a_million_substeps_is_refused_before_stepping():
-    """Reaching t = 1e7 s takes ~1e8 substeps: refused at once with the estimate (the guard after a
-    million substeps had taken minutes to fire), and the pool is left where it was."""
+@pytest.mark.parametrize("time_s", [1.0e7, 5.0e4])
+def test_a_time_beyond_a_million_substeps_is_refused_before_stepping(time_s):
+    """Reaching t = 1e7 s takes ~1e8 substeps, t = 5e4 s about 1.9e6 (twice the guard): each is
+    refused at once with the estimate (the guard after a million substeps had taken minutes to fire;
+    until 2026-12-07 only times past ten times it were refused up front), and the pool is left where
+    it was."""
     pool = ShallowWaterPool(16, 4.0, DEPTH_M, "cpu")
-    with pytest.raises(wc.WarpcausticsError, match=r"needs about .* substeps .* render an earlier time"):
-        pool.advance(1.0e7)
+    substep = 0.4 * (4.0 / 16) / np.sqrt(9.81 * DEPTH_M)  # CFL at √(g H): no slower wave in still water
+    with pytest.raises(wc.WarpcausticsError, match=r"needs at least .* substeps .* render an earlier time"
+                       ) as refused:
+        pool.advance(time_s)
+    assert float(str(refused.value).split("at least ")[1].split()[0]) == pytest.approx(time_s / substep,
+                                                                                     rel=5e-3)  # 3 digits
     assert pool.time_s == 0.0 and pool.substeps == 0
+
+
+def test_a_time_within_the_guard_is_not_refused_up_front():
+    """The up-front refusal takes the slowest speed the pool can reach, √(g h̄): a still pool's frame
+    that needs fewer substeps than the guard steps to it."""
+    pool = ShallowWaterPool(8, 4.0, DEPTH_M, "cpu", viscosity_m2_s=0.0)
+    substep = 0.4 * (4.0 / 8) / np.sqrt(9.81 * DEPTH_M)
+    pool.advance(2000 * substep)
+    assert pool.substeps == pytest.approx(2000, abs=2)
 
 
 def test_a_pool_needs_two_cells_a_side():

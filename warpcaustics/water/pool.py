@@ -241,15 +241,19 @@ class ShallowWaterPool(WalledPool):
             return min(self.cfl * self.cell_m / max(speed + body_speed, 1e-6), dt_viscous)
 
         speed = self.max_wave_speed()
-        if math.isfinite(speed):  # the substeps at the present speed: refuse now what is far past the
-            # guard below, not after minutes (the speed may fall as the waves spread, hence the margin)
-            first = cfl_dt(speed)
-            needed = (time_s - self.time_s) / first
-            if needed > 10 * MAX_SUBSTEPS_PER_CALL:
+        if math.isfinite(speed) and (time_s - self.time_s) / cfl_dt(speed) > MAX_SUBSTEPS_PER_CALL:
+            # Past the guard below at the present speed: refuse now, not after minutes, if it is past
+            # it at the slowest speed the pool can reach. The speed may fall as the waves spread, but
+            # not below √(g h̄): the walls keep the water and drops only add to it, so the deepest
+            # cell is at least the mean depth.
+            mean_depth = max(self.volume_m3(), 0.0) / self.extent_m**2
+            slowest = cfl_dt(math.sqrt(pool_kernels.GRAVITY * mean_depth))
+            needed = (time_s - self.time_s) / slowest
+            if needed > MAX_SUBSTEPS_PER_CALL:
                 raise WarpcausticsError(
-                    f"the pool needs about {needed:.3g} substeps of {first:.3g} s to reach t = {time_s:g} s "
-                    f"(at most {MAX_SUBSTEPS_PER_CALL:.0e} a frame); render an earlier time, lower "
-                    "water.resolution or raise the frame rate")
+                    f"the pool needs at least {needed:.3g} substeps of {slowest:.3g} s to reach t = "
+                    f"{time_s:g} s (at most {MAX_SUBSTEPS_PER_CALL:.0e} a frame); render an earlier time, "
+                    "lower water.resolution or raise the frame rate")
         for i in range(MAX_SUBSTEPS_PER_CALL):
             remaining = time_s - self.time_s
             if remaining <= 1e-12:
