@@ -147,7 +147,7 @@ def _bounds_plot(renderer, path: Path) -> None:
     import matplotlib.pyplot as plt
     from scipy.spatial import ConvexHull
 
-    from benchmarks.beams import prism_ends
+    from benchmarks.beam_fill import prism_ends
 
     stage, camera = renderer.method.caustics[0], renderer.method.camera
     cam = camera.cam

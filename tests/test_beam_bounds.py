@@ -14,7 +14,7 @@ from warpcaustics.kernels.caustics.beams import bounds
 from helpers import CONFIGS
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from benchmarks.beams import prism_ends  # noqa: E402  (float64, written apart from the kernel)
+from benchmarks.beam_fill import prism_ends  # noqa: E402  (float64, written apart from the kernel)
 
 KINDS = {"hull": bounds.HULL, "prism": bounds.PRISM, "ernst": bounds.ERNST}
 
