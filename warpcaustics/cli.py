@@ -4,6 +4,7 @@ info``. User errors print one line and exit with 2."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shutil
 import sys
 import time
@@ -205,6 +206,33 @@ def _field(args: argparse.Namespace) -> int:
     return 0
 
 
+def _out_folder(text: str) -> Path:
+    """--out as a folder: refused at once if it is empty or a file."""
+    if not text.strip():
+        raise ConfigError("--out is empty; give a folder, e.g. --out out/run")
+    out = Path(text)
+    if out.exists() and not out.is_dir():
+        raise WarpcausticsError(f"--out {text!r} is a file; give a folder")
+    return out
+
+
+@contextlib.contextmanager
+def _made_out(out: Path):
+    """Make ``out`` now, before anything renders (one line if it cannot be made), and remove what
+    this made if the command fails before it is done: no folder left behind as if it were a result."""
+    made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)  # the first folder made
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
+    try:
+        yield out
+    except BaseException:
+        if made is not None:
+            shutil.rmtree(made, ignore_errors=True)
+        raise
+
+
 def _config(args: argparse.Namespace) -> int:
     """The resolved configuration as TOML (every key with its value): load_scene's whole validation,
     the files it names included, and nothing rendered."""
@@ -223,9 +251,7 @@ def _render(args: argparse.Namespace) -> int:
     overrides = _overrides(args)
     scene = load_scene(args.config, overrides)  # validate everything before touching the output
     _check_animation(args, scene.config.stats.integration_s)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+    out = _out_folder(args.out)
 
     from warpcaustics.io.frame import save_frame
     from warpcaustics.io.run_json import write_run_json
@@ -275,11 +301,10 @@ def _study(args: argparse.Namespace) -> int:
     from warpcaustics.batch.study import load_study, run_study
 
     study = load_study(args.study, _overrides(args))
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+    out = _out_folder(args.out)
     t0 = time.perf_counter()
-    paths = run_study(study, Path(args.out), device=args.device)
+    with _made_out(out):
+        paths = run_study(study, out, device=args.device)
     count = len(study.water_types) * len(study.depths_m) * len(study.sun_elevations_deg)
     print(f"{count} renders in {time.perf_counter() - t0:.1f} s; wrote "
           + ", ".join(str(p) for p in paths.values()))
@@ -330,13 +355,15 @@ def _compare(args: argparse.Namespace) -> int:
     from warpcaustics.pipeline import check_time
 
     check_time("--time", args.time)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
+    out = _out_folder(args.out)
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
+    if not methods:
+        raise ConfigError(f"--methods {args.methods!r} names no method; give some of "
+                          f"{', '.join(FLOOR_METHODS)}, e.g. --methods photons,beams")
     overrides = _overrides(args)
-    comparison = compare_methods(args.config, overrides, args.time, args.device, methods)
-    paths = write_comparison(out, comparison, args.time)
+    with _made_out(out):
+        comparison = compare_methods(args.config, overrides, args.time, args.device, methods)
+        paths = write_comparison(out, comparison, args.time)
     print(f"{'method':10s} {'correlation':>11s} {'rel. L1':>8s} {'contrast':>8s} {'seconds':>8s}"
           "   (normalised maps vs fluxratio)")
     for r in comparison["rows"]:
@@ -399,6 +426,8 @@ def one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
+        if args.command not in ("preview", "report") and isinstance(getattr(args, "out", None), str):
+            _out_folder(args.out)  # an empty --out would write into the working folder
         if args.command == "render":
             return _render(args)
         if args.command == "study":

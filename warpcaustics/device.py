@@ -54,6 +54,8 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
     ``auto`` means CUDA when available, else the CPU with a one-line notice on stderr; an explicit
     ``cuda`` (or ``cuda:N``) where there is none is an error.
     """
+    if requested is not None and not isinstance(requested, str):
+        raise DeviceError(f"device = {requested!r} must be a name: auto, cpu, cuda or cuda:N")
     choice = requested or os.environ.get(DEVICE_ENV) or config_value or "auto"
     choice = choice.strip().lower()
     wp = _warp()
@@ -83,9 +85,12 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
 
 def _cuda_index(choice: str) -> int:
     try:
-        return int(choice.split(":", 1)[1])
+        index = int(choice.split(":", 1)[1])
     except ValueError:
         raise DeviceError(f"device = {choice!r} is not allowed; use cuda:N with N an integer") from None
+    if index < 0:
+        raise DeviceError(f"device = {choice!r} is not allowed; use cuda:N with N = 0 for the first device")
+    return index
 
 
 MEMINFO = "/proc/meminfo"

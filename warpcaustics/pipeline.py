@@ -8,6 +8,7 @@ holds no per-method logic (``warpcaustics/caustics/stage.py`` has the interface)
 from __future__ import annotations
 
 import math
+import numbers
 from contextlib import contextmanager
 
 import numpy as np
@@ -103,9 +104,16 @@ MAX_TIME_S = 1e9
 random-phase sea looks the same at any time, so nothing is lost by the bound)."""
 
 
+def _short_repr(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def check_time(name: str, time_s: float) -> None:
     """Refuse a render time that is not finite or beyond :data:`MAX_TIME_S`, in one line naming
     ``name`` (a flag or an argument)."""
+    if not isinstance(time_s, numbers.Real) or isinstance(time_s, bool):
+        raise ConfigError(f"{name} = {time_s!r} must be a number of seconds, e.g. 0.0")
     if not (math.isfinite(time_s) and abs(time_s) <= MAX_TIME_S):
         raise ConfigError(f"{name} = {time_s} must be a finite number of seconds within "
                           f"±{MAX_TIME_S:g}")
@@ -120,6 +128,9 @@ class Renderer:
     """
 
     def __init__(self, scene: Scene, device: str | None = None):
+        if not isinstance(scene, Scene):
+            raise ConfigError(f"a render takes a Scene from warpcaustics.load_scene(path); got "
+                              f"{type(scene).__name__} {_short_repr(scene)}")
         cfg = scene.config
         self.scene = scene
         self.device = devices.resolve_device(device, config_value=cfg.device.value)

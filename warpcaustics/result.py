@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from warpcaustics.errors import ConfigError, WarpcausticsError
 from warpcaustics.optics import spectra
 
 if TYPE_CHECKING:
@@ -121,7 +122,8 @@ class RenderResult:
     def receiver_irradiance(self, receiver: int) -> np.ndarray:
         """(F_r, K) irradiance on the faces of receiver id ``receiver`` [W m^-2 nm^-1]."""
         if self.face_flux_w_nm is None:
-            raise ValueError("receiver irradiance needs caustics.method = 'photons' or 'beams'")
+            raise ConfigError(f"receiver irradiance needs caustics.method = 'photons' or 'beams' (this "
+                              f"render's is {self.method!r})")
         sel = self.face_receiver == receiver
         return self.face_flux_w_nm[sel] / self.face_area_m2[sel, None]
 
@@ -174,6 +176,10 @@ class RenderResult:
         from warpcaustics.io.frame import save_frame
         from warpcaustics.io.run_json import write_run_json
 
-        paths = save_frame(self, Path(out_dir), frame=frame)
-        paths["json"] = write_run_json(Path(out_dir), [self])
+        try:
+            paths = save_frame(self, Path(out_dir), frame=frame)
+            paths["json"] = write_run_json(Path(out_dir), [self])
+        except OSError as exc:
+            raise WarpcausticsError(f"cannot save into {str(out_dir)!r}: {exc.strerror or exc}; give a "
+                                    "folder that can be made and written") from None
         return paths

@@ -56,9 +56,11 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
         try:
             scenes[name] = load_scene(config, {**overrides, "caustics.method": name})
         except WarpcausticsError as exc:
+            fix = ("every comparison renders the flux-ratio reference, which needs a flat floor and no "
+                   "camera: --set floor.shape=flat --set camera.enabled=false" if name == "fluxratio" else
+                   f"drop {name!r} from --methods")
             raise WarpcausticsError(f"compare renders this scene with caustics.method = {name!r}, which it "
-                                    f"cannot take: {exc} (drop {name!r} from --methods; the flux-ratio "
-                                    "reference needs a flat floor and no camera)") from None
+                                    f"cannot take: {exc} ({fix})") from None
     results = {}
     seconds = {}
     for name, scene in scenes.items():

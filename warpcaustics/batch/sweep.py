@@ -38,6 +38,7 @@ import difflib
 import hashlib
 import itertools
 import json
+import math
 import os
 import shutil
 import sys
@@ -100,8 +101,24 @@ def _values(table: Any, key: str) -> dict[str, list]:
             raise ConfigError(f'sweep [{key}] {name!r} is a table; quote dotted keys: "{name}.…" = [...]')
         if not isinstance(values, list) or not values:
             raise ConfigError(f"sweep [{key}] {name!r} must be a non-empty list of values")
+        if key == "grid":  # a value twice would be the same task twice, racing on one folder
+            twice = next((v for i, v in enumerate(values) if v in values[:i]), None)
+            if twice is not None:
+                raise ConfigError(f"sweep [grid] {name!r} lists {twice!r} twice; give each value once")
         out[name] = values
     return out
+
+
+MAX_SWEEP_FRAMES = 100_000
+"""The most frames one sweep (or field comparison) renders: past it the tasks alone would take
+minutes to list and days to render, so it is refused before anything is built."""
+
+
+def check_sweep_size(variants: int, frames: int, what: str) -> None:
+    """Refuse a sweep of more than :data:`MAX_SWEEP_FRAMES` frames, naming ``what`` sets the count."""
+    if variants * frames > MAX_SWEEP_FRAMES:
+        raise ConfigError(f"{what}: {variants} variant(s) × {frames} frame(s) is more than "
+                          f"{MAX_SWEEP_FRAMES} frames; split the sweep or render fewer frames")
 
 
 FRAME_KEYS = ("count", "fps", "start_s")
@@ -128,6 +145,14 @@ def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
     lengths = {len(v) for v in zipped.values()}
     if len(lengths) > 1:
         raise ConfigError(f"sweep [zip] lists must have equal lengths; got {sorted(lengths)}")
+    both = next((k for k in grid if k in zipped), None)
+    if both is not None:
+        raise ConfigError(f"sweep {both!r} is in both [grid] and [zip]; put it in one of them")
+    rows = list(zip(*zipped.values()))
+    twice = next((i for i, row in enumerate(rows) if row in rows[:i]), None)
+    if twice is not None:
+        raise ConfigError(f"sweep [zip] entry {twice + 1} repeats entry {rows.index(rows[twice]) + 1} "
+                          f"({dict(zip(zipped, rows[twice]))}); give each combination once")
     for where, keys in (("sweep [set]", fixed), ("sweep [grid]", grid), ("sweep [zip]", zipped)):
         for key in keys:  # a misspelt key fails the sweep at once, not each of its tasks
             check_key(key, where)
@@ -148,6 +173,8 @@ def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
         raise ConfigError(f"sweep frames.fps = {fps!r} must be a positive number")
     if not isinstance(start, (int, float)) or isinstance(start, bool):
         raise ConfigError(f"sweep frames.start_s = {start!r} must be a number of seconds")
+    variants = math.prod(len(v) for v in grid.values()) * (len(rows) if rows else 1)
+    check_sweep_size(variants, count, "sweep [grid], [zip] and frames.count")
     times = tuple(float(start) + i / float(fps) for i in range(count))
     from warpcaustics.pipeline import check_time
 
@@ -187,6 +214,10 @@ def expand_sweep(
             continue
         resolved = config_to_dict(scene.config)
         stateful = scene.config.water.stateful  # the pools: frame k steps on from frame k-1
+        short = _too_short_to_integrate(scene.config.stats.integration_s, times) if stateful else None
+        if short is not None:  # refused before it renders, as the render command does
+            tasks.append(Task(task_id(resolved, times), overrides, times, 0, short, stateful, resolved))
+            continue
         groups = [times] if stateful else [(t,) for t in times]
         for i, group in enumerate(groups):
             tasks.append(
@@ -195,6 +226,21 @@ def expand_sweep(
                 )
             )
     return Sweep(base, tasks, source, list(grid) + list(zipped))
+
+
+def _too_short_to_integrate(integration_s: float, times: tuple[float, ...]) -> str | None:
+    """Why an animation at ``times`` cannot give the time statistics of a radiometer integrating
+    over ``integration_s`` (None: it can, or it has no time statistics)."""
+    from warpcaustics.io.run_json import integration_frames
+
+    if integration_s <= 0.0 or len(times) < 3:
+        return None
+    needed = integration_frames(integration_s, times[1] - times[0])
+    if len(times) >= needed:
+        return None
+    return (f"stats.integration_s = {integration_s:g} needs frames.count ≥ {needed} at frames.fps "
+            f"{1 / (times[1] - times[0]):g} for its time statistics; give more frames or a shorter "
+            "integration_s")
 
 
 def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
@@ -489,15 +535,44 @@ STAT_AXES = (("floor_w_m2", "floor irradiance\n[W m$^{-2}$]"), ("contrast", "con
 """The statistics ``warpcaustics report`` plots, one panel each, over the sweep's variants."""
 
 
+def _summary_rows(path: Path) -> list[dict]:
+    """The rows of a sweep's ``summary.csv``, or one line saying why it is not one."""
+    fix = "rerun the sweep with the same --out to write it again"
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise WarpcausticsError(f"{str(path)!r} cannot be read as a sweep summary "
+                                f"({getattr(exc, 'strerror', None) or exc}); {fix}") from None
+    needed = ("id", "frame")
+    for k, row in enumerate(rows):
+        missing = [c for c in needed if not row.get(c)]
+        numbers = [c for c, _ in STAT_AXES if row.get(c) not in (None, "") and not _is_float(row[c])]
+        if missing or numbers or None in row:
+            what = (f"no {missing[0]!r}" if missing else f"{numbers[0]} = {row[numbers[0]]!r} is not a "
+                    "number" if numbers else "more cells than columns")
+            raise WarpcausticsError(f"{str(path)!r} is not a sweep summary (row {k + 1}: {what}); {fix}")
+    return rows
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def report_main(out: str) -> int:
     """Print ``DIR/summary.csv`` as a table and plot the floor irradiance per task."""
+    if Path(out).exists() and not Path(out).is_dir():
+        raise WarpcausticsError(f"{out!r} is a file; give the folder a sweep wrote (its --out)")
     path = Path(out) / SUMMARY
     if not path.exists():
         raise WarpcausticsError(
             f"{str(path)!r} does not exist; run `warpcaustics sweep ... --out {out}` first"
         )
-    with open(path, encoding="utf-8") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = _summary_rows(path)
     if not rows:
         print("no finished tasks")
         return 0

@@ -22,6 +22,7 @@ import numpy as np
 from warpcaustics.caustics.cache import BoundedCache
 from warpcaustics.caustics.window import MapWindow
 from warpcaustics.config import BeamSpread, Config
+from warpcaustics.errors import ConfigError
 from warpcaustics.optics.beam_spread import column_spread, spread_multiplier
 from warpcaustics.optics.small_angle import transferred, wells_multiplier
 from warpcaustics.optics.snell import refract
@@ -40,6 +41,26 @@ _MULTIPLIERS = BoundedCache(MULTIPLIER_CACHE_BYTES, size=lambda entry: entry[2])
 (by band, k = 0 values, bytes)."""
 
 
+MAX_ATTENUATION_LENGTHS = 80.0
+"""The most attenuation lengths, c s, along the most slanted path in the water (s = D n/√(n² − 1), past
+the critical angle none is steeper) that the transfer takes: it scales the unscattered map, e^{−c s}
+in float32, by up to e^{c s}, and past about 87 the map underflows. (A bound on the numbers, not on
+the physics: the transfer is checked against the random walk up to b s ≈ 6, docs/physics.md.)"""
+
+
+def check_column(cfg: Config, ior: float, extinction_per_m: np.ndarray) -> None:
+    """Refuse, before anything renders, a water column too deep for the transfer's numbers."""
+    slant = cfg.floor.depth_m * ior / np.sqrt(ior * ior - 1.0) if ior > 1.0 else math.inf
+    lengths = np.asarray(extinction_per_m, np.float64) * slant
+    k = int(np.argmax(lengths))
+    if lengths[k] > MAX_ATTENUATION_LENGTHS:
+        raise ConfigError(
+            f"floor.depth_m = {cfg.floor.depth_m:g} is {lengths[k]:.3g} attenuation lengths of this water "
+            f"along the most slanted path in it (c = {extinction_per_m[k]:.3g} 1/m in band {k}), past the "
+            f"{MAX_ATTENUATION_LENGTHS:g} that optics.scattering = 'small_angle' can carry; use a shallower "
+            "floor, clearer water or optics.scattering = 'multiple'")
+
+
 class SmallAngleScattering:
     """Collects the passes of one frame (:meth:`add`) and returns the scattered light (:meth:`finish`)."""
 
@@ -52,6 +73,7 @@ class SmallAngleScattering:
         self.ior = float(ior)
         self.a = np.asarray(absorption_per_m, np.float64)
         self.b = np.asarray(scattering_per_m, np.float64)
+        check_column(cfg, self.ior, self.a + self.b)
         self.window = MapWindow(cfg)
         self.texel_m = self.window.texel_m
         self.extent_m = self.window.extent_m

@@ -278,7 +278,10 @@ def read_toml(path: str | Path) -> dict:
     """Read a TOML file, turning a missing or malformed file into a one-line ConfigError."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        if path.exists() and not path.is_dir() and not path.is_file():  # reading would never end
+            raise ConfigError(f"config file {_describe(str(path))} is not a regular file (a device or a "
+                              "pipe); give the path of a .toml file")
+        text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # an editor's byte-order mark
     except FileNotFoundError:
         raise ConfigError(f"config file {_describe(str(path))} does not exist; check the path") from None
     except (OSError, UnicodeDecodeError) as exc:

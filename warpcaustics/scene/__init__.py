@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,6 +22,7 @@ from warpcaustics.config import (
     config_from_dict,
     read_toml,
 )
+from warpcaustics.errors import ConfigError
 from warpcaustics.optics.sky import cie_relative_radiance, cie_sky_type, stratified_hemisphere
 from warpcaustics.optics.sky_cells import cell_key, cell_shares
 from warpcaustics.optics.spectra import bins_for, refractive_index
@@ -191,6 +194,12 @@ def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None 
     ``load_scene(None, {...})`` builds a scene from the defaults and the overrides alone.
     Raises :class:`warpcaustics.errors.ConfigError` with a one-line message on any bad input.
     """
+    if path is not None and not isinstance(path, (str, os.PathLike)):
+        raise ConfigError(f"load_scene() takes the path of a .toml file (a str or a Path) or None; got "
+                          f"{type(path).__name__} {path!r:.60}")
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise ConfigError(f"load_scene() overrides must be a dict of dotted keys, e.g. "
+                          f"{{'water.resolution': 64}}; got {type(overrides).__name__} {overrides!r:.60}")
     table = read_toml(path) if path is not None else {}
     cfg = config_from_dict(table, overrides)
     base = Path(path).resolve().parent if path is not None else Path.cwd()

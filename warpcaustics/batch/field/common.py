@@ -43,6 +43,11 @@ def check_frames(frames: int, frame_interval_s: float) -> tuple[float, ...]:
     frames, frame_interval_s = int(frames), float(frame_interval_s)
     if frames < 1:
         raise ConfigError(f"--frames = {frames} must be at least 1")
+    from warpcaustics.batch.sweep import MAX_SWEEP_FRAMES
+
+    if frames > MAX_SWEEP_FRAMES:
+        raise ConfigError(f"--frames = {frames} is more than {MAX_SWEEP_FRAMES} frames a point; render fewer "
+                          "(frames further apart than the waves' periods are independent)")
     if not (math.isfinite(frame_interval_s) and frame_interval_s > 0):
         raise ConfigError(f"--frame-interval = {frame_interval_s} must be a positive number of seconds, "
                           "e.g. 2 (frames further apart than the waves' periods are independent)")

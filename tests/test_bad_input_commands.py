@@ -1,0 +1,181 @@
+"""Bad input a second fuzz (2026-12-07) found still crashing, hanging or leaving folders behind: the
+commands' output folders, a damaged sweep summary, sweeps that list a task twice or far too many, a
+config that is not a regular file, the Python API given the wrong types, and a water column too deep
+for the small-angle transfer. Each is now one line (exit 2 from the CLI, a WarpcausticsError from
+Python) before anything renders. The CLI runs in-process here (``cli.main``)."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import warpcaustics as wc
+from warpcaustics import cli
+from warpcaustics.batch.sweep import MAX_SWEEP_FRAMES, load_sweep
+
+from helpers import CONFIGS
+
+TINY = ["--device", "cpu", "--set", "water.resolution=16", "--set", "caustics.map_resolution=16"]
+
+
+def one_line_error(capsys, argv: list[str], *needles: str) -> str:
+    """``cli.main(argv)`` exits 2 with one stderr line naming each of ``needles``."""
+    assert cli.main(argv) == 2
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("warpcaustics:")]
+    assert len(lines) == 1 and lines[0].startswith("warpcaustics: error: "), lines
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+@pytest.mark.parametrize("command", [["study", str(CONFIGS / "study.toml")],
+                                     ["compare", str(CONFIGS / "ocean.toml"), *TINY]])
+def test_an_output_folder_that_cannot_be_made_is_refused_before_rendering(tmp_path, capsys, command):
+    """study and compare made their folder only after every render: a file in the way crashed them
+    then. Now it is one line, before anything renders."""
+    (tmp_path / "a_file").write_text("")
+    out = tmp_path / "a_file" / "x"
+    one_line_error(capsys, [*command, "--out", str(out)], "cannot be created", "Not a directory")
+
+
+def test_a_failed_compare_leaves_no_folder(tmp_path, capsys):
+    """A compare that fails after its folder was made removes it (nothing is left as if a result)."""
+    out = tmp_path / "new" / "x"
+    one_line_error(capsys, ["compare", str(CONFIGS / "ocean_floor.toml"), "--out", str(out), *TINY,
+                            "--methods", "photons"], "floor.shape=flat", "camera.enabled=false")
+    assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.parametrize("command", [["render", str(CONFIGS / "ocean.toml")],
+                                     ["study", str(CONFIGS / "study.toml")],
+                                     ["compare", str(CONFIGS / "ocean.toml")],
+                                     ["field", "gernez2009", str(CONFIGS / "field" / "gernez2009.toml")]])
+def test_an_empty_out_is_refused(tmp_path, capsys, command, monkeypatch):
+    """``--out ""`` had written into the working folder."""
+    monkeypatch.chdir(tmp_path)
+    one_line_error(capsys, [*command, "--out", ""], "--out is empty")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_compare_with_no_methods_is_refused(tmp_path, capsys):
+    one_line_error(capsys, ["compare", str(CONFIGS / "ocean.toml"), "--out", str(tmp_path / "c"),
+                            "--methods", ",,"], "--methods", "names no method")
+
+
+@pytest.mark.parametrize("content,needle", [
+    (b"garbage\xff\n", "cannot be read as a sweep summary"),
+    (b"id,frame,time_s,floor.depth_m,floor_w_m2\nx,0,0,1.0,abc\n", "floor_w_m2 = 'abc' is not a number"),
+    (b"time_s\n0\n", "no 'id'"),
+    (None, "Is a directory"),
+])
+def test_report_on_a_damaged_summary_is_one_line(tmp_path, capsys, content, needle):
+    if content is None:
+        (tmp_path / "summary.csv").mkdir()
+    else:
+        (tmp_path / "summary.csv").write_bytes(content)
+    one_line_error(capsys, ["report", str(tmp_path)], needle, "rerun the sweep")
+
+
+def sweep_file(tmp_path, body: str):
+    path = tmp_path / "sweep.toml"
+    path.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n{body}')
+    return path
+
+
+@pytest.mark.parametrize("body,needle", [
+    ('[grid]\n"floor.depth_m" = [1.0, 2.0, 1.0]\n', "lists 1.0 twice"),
+    ('[grid]\n"floor.depth_m" = [1.0, 2.0]\n[zip]\n"floor.depth_m" = [3.0, 4.0]\n',
+     "in both [grid] and [zip]"),
+    ('[zip]\n"floor.depth_m" = [1.0, 2.0, 1.0]\n"sun.elevation_deg" = [40.0, 50.0, 40.0]\n',
+     "entry 3 repeats entry 1"),
+    (f'[grid]\n"floor.depth_m" = [1.0, 2.0]\n[frames]\ncount = {MAX_SWEEP_FRAMES}\n', "more than"),
+])
+def test_a_sweep_listing_a_task_twice_or_too_many_is_refused(tmp_path, body, needle):
+    """The same task twice raced on one folder (raw FileNotFoundErrors); a hundred million frames
+    hung while the tasks were listed."""
+    with pytest.raises(wc.ConfigError, match=needle.replace("[", r"\[").replace("]", r"\]")):
+        load_sweep(sweep_file(tmp_path, body))
+
+
+def test_field_frames_past_the_bound_are_refused_at_once(tmp_path, capsys):
+    one_line_error(capsys, ["field", "gernez2009", str(CONFIGS / "field" / "gernez2009.toml"), "--out",
+                            str(tmp_path / "f"), "--frames", "100000000", "--quick"], "--frames = 100000000")
+
+
+def test_a_pool_sweep_too_short_for_its_integration_fails_before_rendering(tmp_path):
+    """The render command refuses it up front; a sweep's pool task now fails the same way, without
+    rendering its frames and leaving a checkpoint to repeat them."""
+    path = tmp_path / "sweep.toml"
+    path.write_text(f'base = "{(CONFIGS / "pool.toml").as_posix()}"\n[set]\n"stats.integration_s" = 10.0\n'
+                    '[frames]\ncount = 3\n')
+    (task,) = load_sweep(path).tasks
+    assert task.error is not None and "stats.integration_s = 10 needs frames.count" in task.error
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path, capsys):
+    """``config /dev/zero`` read forever; a pipe blocked."""
+    pipe = tmp_path / "pipe.toml"
+    os.mkfifo(pipe)
+    one_line_error(capsys, ["config", str(pipe)], "not a regular file")
+
+
+def test_a_config_with_a_byte_order_mark_loads(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf[water]\nresolution = 32\n")
+    assert wc.load_scene(path).config.water.resolution == 32
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return wc.load_scene(CONFIGS / "ocean.toml", {"water.resolution": 16, "caustics.map_resolution": 16})
+
+
+@pytest.mark.parametrize("call,needle", [
+    (lambda s: wc.load_scene(3), "load_scene() takes the path"),
+    (lambda s: wc.load_scene(CONFIGS / "ocean.toml", "water.resolution=16"), "overrides must be a dict"),
+    (lambda s: wc.render(str(CONFIGS / "ocean.toml")), "takes a Scene"),
+    (lambda s: wc.Renderer("x"), "takes a Scene"),
+    (lambda s: wc.render(s, time_s="0", device="cpu"), "time_s = '0' must be a number"),
+    (lambda s: wc.render(s, time_s=None, device="cpu"), "time_s = None must be a number"),
+    (lambda s: wc.render(s, device=1), "device = 1 must be a name"),
+])
+def test_the_python_api_names_a_wrong_type(scene, call, needle):
+    """Wrong types had raised TypeError or AttributeError from inside the package."""
+    with pytest.raises(wc.WarpcausticsError, match=needle.replace("(", r"\(").replace(")", r"\)")):
+        call(scene)
+
+
+def test_a_numpy_time_still_renders(scene):
+    assert np.isfinite(wc.render(scene, time_s=np.float32(0.5), device="cpu").floor_irradiance).all()
+
+
+def test_saving_and_receivers_of_a_result_fail_in_one_line(scene, tmp_path):
+    result = wc.render(scene, device="cpu")
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(wc.WarpcausticsError, match="cannot save into"):
+        result.save(tmp_path / "a_file")
+    with pytest.raises(wc.WarpcausticsError, match="needs caustics.method = 'photons' or 'beams'"):
+        result.receiver_irradiance(0)
+
+
+def test_cuda_minus_one_is_refused():
+    from warpcaustics.device import _cuda_index
+    from warpcaustics.errors import DeviceError
+
+    assert _cuda_index("cuda:1") == 1
+    with pytest.raises(DeviceError, match="cuda:-1"):
+        _cuda_index("cuda:-1")
+
+
+def test_a_column_too_deep_for_the_small_angle_transfer_is_refused_before_rendering(tmp_path, capsys):
+    """Turbid water 100 m deep: the unscattered map underflows float32 and the transfer had printed
+    overflow warnings, then walked its spread for minutes or ended in 'not finite'."""
+    one_line_error(capsys, ["render", str(CONFIGS / "ocean.toml"), "--out", str(tmp_path / "r"), *TINY,
+                            "--set", "optics.scattering=small_angle",
+                            "--set", "optics.water_type=turbid_harbor",
+                            "--set", "floor.depth_m=100"], "floor.depth_m = 100", "attenuation lengths",
+                   "optics.scattering = 'multiple'")
+    assert not (tmp_path / "r").exists()
