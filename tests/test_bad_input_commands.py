@@ -179,3 +179,40 @@ def test_a_column_too_deep_for_the_small_angle_transfer_is_refused_before_render
                             "--set", "floor.depth_m=100"], "floor.depth_m = 100", "attenuation lengths",
                    "optics.scattering = 'multiple'")
     assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("overrides,needle", [
+    ({"caustics.method": "wave3d", "caustics.wave3d_resolution": 16}, "to at least 48"),
+    ({"sun.datetime": "2009-07-14", "sun.latitude_deg": 43.0, "sun.longitude_deg": 7.0}, "no time of day"),
+    ({"sun.datetime": "2009-07-14Z", "sun.latitude_deg": 43.0, "sun.longitude_deg": 7.0}, "no time of day"),
+])
+def test_a_hint_gives_a_value_that_is_accepted(overrides, needle):
+    """The wave3d hint had asked for a value below the key's own minimum, and the datetime hint for
+    '2009-07-14+00:00', which it then refused too."""
+    with pytest.raises(wc.ConfigError, match=needle):
+        wc.load_scene(CONFIGS / "ocean.toml", overrides)
+
+
+def test_heights_in_a_file_are_bounded_as_other_lengths(tmp_path):
+    path = tmp_path / "h.npy"
+    np.save(path, np.full((16, 16), 1e30, np.float32))
+    with pytest.raises(wc.ConfigError, match="within ±100000 m"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"water.model": "heightfield", "water.file": str(path),
+                                               "water.resolution": 16})
+
+
+@pytest.mark.parametrize("body,needle", [
+    ("depths_m = [1.0, 1.0]", "two different depths"),
+    ("depths_m = [1.0, 2.0, 1.0]", "lists 1.0 twice"),
+    ('depths_m = [1.0, 2.0]\n[overrides]\n"floor.depth_m" = 3.0', "sets floor.depth_m, which the study sets"),
+])
+def test_a_study_that_could_only_write_nonsense_is_refused(tmp_path, body, needle):
+    """Two equal depths had fitted an attenuation over nothing (a RankWarning, then a number), and an
+    override of a key the study sets was silently replaced."""
+    from warpcaustics.batch.study import load_study
+
+    path = tmp_path / "study.toml"
+    path.write_text(f'scene = "{(CONFIGS / "ocean.toml").as_posix()}"\nwater_types = ["jerlov_IB"]\n'
+                    f"sun_elevations_deg = [40.0]\n{body}\n")
+    with pytest.raises(wc.ConfigError, match=needle):
+        load_study(path)

@@ -20,6 +20,9 @@ from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
 STUDY_KEYS = {"scene", "water_types", "depths_m", "sun_elevations_deg", "overrides"}
+STUDY_SETS = {"optics.water_type": "water_types", "floor.depth_m": "depths_m",
+              "sun.elevation_deg": "sun_elevations_deg"}
+"""The scene keys a study sets at each render, and the study keys that list their values."""
 
 
 @dataclass(frozen=True)
@@ -62,7 +65,7 @@ def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
     for key in ("scene", "water_types", "depths_m", "sun_elevations_deg"):
         if key not in table:
             raise ConfigError(f"study key {key!r} is missing in {str(path)!r}")
-    if not isinstance(table["scene"], str):
+    if not isinstance(table["scene"], str) or not table["scene"].strip():
         raise ConfigError(f"study key scene = {table['scene']!r} must be the path of a scene TOML")
     water_types = table["water_types"]
     if not (isinstance(water_types, list) and water_types and all(isinstance(t, str) for t in water_types)):
@@ -73,10 +76,15 @@ def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
             raise ConfigError(f"water_types: {t!r} is not a water type; allowed: "
                               f"{', '.join(sorted(allowed))}")
     depths = _numbers("depths_m", table["depths_m"], positive=True)
-    if len(depths) < 2:
-        raise ConfigError("study key depths_m needs at least two depths (the attenuation is fitted "
-                          "over them)")
+    if len(set(depths)) < 2:
+        raise ConfigError(f"study key depths_m = {list(depths)} needs at least two different depths (the "
+                          "attenuation is fitted over them)")
     elevations = _numbers("sun_elevations_deg", table["sun_elevations_deg"], positive=True)
+    for key, values in (("water_types", water_types), ("depths_m", depths),
+                        ("sun_elevations_deg", elevations)):
+        twice = next((v for i, v in enumerate(values) if v in values[:i]), None)
+        if twice is not None:
+            raise ConfigError(f"study key {key} lists {twice!r} twice; give each once")
     extra = overrides
     overrides = table.get("overrides", {})
     if not isinstance(overrides, dict):
@@ -84,6 +92,9 @@ def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
     scene_overrides = {**_flatten(overrides), **(extra or {})}
     for key in scene_overrides:
         check_key(key, "study [overrides]")
+        if key in STUDY_SETS:
+            raise ConfigError(f"study [overrides] sets {key}, which the study sets from its own "
+                              f"{STUDY_SETS[key]}; remove it and list the values in {STUDY_SETS[key]}")
     return StudyConfig(path.parent / table["scene"], tuple(water_types), depths, elevations, scene_overrides)
 
 
@@ -114,7 +125,8 @@ def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> d
         spectra_by[(water_type, elevation, depth)] = (mean, result)
         rows.append({"water_type": water_type, "sun_elevation_deg": elevation, "depth_m": depth,
                      "broadband_w_m2": float(np.sum(mean * result.bin_widths_nm)),
-                     "caustic_contrast": float(broadband.std() / broadband.mean()),
+                     "caustic_contrast": (float(broadband.std() / broadband.mean()) if broadband.mean() > 0
+                                          else float("nan")),  # no light reaches this floor
                      "floor_colour_srgb": floor_colour_hex(mean, bins),
                      **{f"E_{w:.1f}nm": float(e) for w, e in zip(result.wavelengths_nm, mean)}})
     out_dir.mkdir(parents=True, exist_ok=True)

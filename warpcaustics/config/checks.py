@@ -228,8 +228,11 @@ def _check_sunmap(cfg: Config) -> None:
     if c.method is CausticsMethod.WAVE3D and c.wave3d_cells_per_wavelength > c.wave3d_resolution / 6:
         raise ConfigError(f"caustics.wave3d_cells_per_wavelength = {c.wave3d_cells_per_wavelength:g} makes "
                           f"the wave longer than a sixth of the patch at caustics.wave3d_resolution = "
-                          f"{c.wave3d_resolution} (its direction could not be kept); use at most "
-                          f"{c.wave3d_resolution / 6:g} or raise caustics.wave3d_resolution")
+                          f"{c.wave3d_resolution} (its direction could not be kept); "
+                          + (f"use at most {c.wave3d_resolution / 6:g} or raise caustics.wave3d_resolution"
+                             if c.wave3d_resolution / 6 >= 4.0 else "raise caustics.wave3d_resolution to at "
+                             f"least {math.ceil(6 * c.wave3d_cells_per_wavelength)} (24 for the fewest "
+                             "cells per wavelength, 4)"))
     disk = cfg.sun.angular_diameter_deg
     if c.sunmap_halo_deg <= disk:
         raise ConfigError(f"caustics.sunmap_halo_deg = {c.sunmap_halo_deg:g} must exceed "

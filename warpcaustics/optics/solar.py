@@ -24,6 +24,9 @@ def parse_datetime(text: str) -> datetime:
     except (TypeError, ValueError):
         raise ConfigError(f"sun.datetime = {text!r} is not an ISO 8601 date and time; write e.g. "
                           "\"2009-07-14T11:30:00+02:00\"") from None
+    if not any(sep in text for sep in "Tt "):  # a date alone: midnight, and any offset was dropped
+        raise ConfigError(f"sun.datetime = {text!r} has no time of day; write e.g. "
+                          f"\"{when.date().isoformat()}T12:00:00+00:00\"")
     if when.tzinfo is None:
         raise ConfigError(f"sun.datetime = {text!r} has no UTC offset; add one, e.g. {text}+00:00 or "
                           f"{text}Z")

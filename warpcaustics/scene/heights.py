@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.config.fields import MAX_LENGTH_M
 from warpcaustics.errors import ConfigError
 from warpcaustics.io.files import input_file
 
@@ -32,6 +33,9 @@ def load_heights(name: str, base_dir: Path, resolution: int | None) -> np.ndarra
                           f"2-D array of heights, at least 4×4")
     if not np.all(np.isfinite(heights)):
         raise ConfigError(f"water.file = {str(path)!r} must hold finite numbers (found NaN or inf)")
+    if np.abs(heights).max(initial=0.0) > MAX_LENGTH_M:  # as every other length: float32 keeps them finite
+        raise ConfigError(f"water.file = {str(path)!r} holds a height of {np.abs(heights).max():.3g} m; "
+                          f"heights must lie within ±{MAX_LENGTH_M:g} m")
     if resolution is not None and resolution != heights.shape[0]:
         raise ConfigError(f"water.resolution = {resolution} disagrees with water.file, which is "
                           f"{heights.shape[0]}×{heights.shape[0]}; remove water.resolution or set it "
