@@ -216,3 +216,16 @@ def test_a_study_that_could_only_write_nonsense_is_refused(tmp_path, body, needl
                     f"sun_elevations_deg = [40.0]\n{body}\n")
     with pytest.raises(wc.ConfigError, match=needle):
         load_study(path)
+
+
+def test_preview_names_its_output_problem_not_pyvista(tmp_path, capsys):
+    """A folder named like the PNG, or one that cannot be written, had been reported as pyvista
+    failing to render off screen, after the render."""
+    (tmp_path / "dir.png").mkdir()
+    one_line_error(capsys, ["preview", str(CONFIGS / "ocean.toml"), "--out", str(tmp_path / "dir.png"),
+                            *TINY], "is a folder")
+
+
+def test_a_ray_address_without_the_ray_executor_is_refused(tmp_path, capsys):
+    one_line_error(capsys, ["sweep", str(CONFIGS / "sweeps" / "water_types.toml"), "--out",
+                            str(tmp_path / "s"), "--address", "auto"], "--executor ray")

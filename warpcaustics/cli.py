@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import shutil
 import sys
 import time
@@ -174,7 +175,7 @@ def _floats(text: str | None, flag: str) -> tuple[float, ...] | None:
     try:
         return tuple(float(x) for x in text.split(","))
     except ValueError:
-        raise ConfigError(f"{flag} {text!r} must be comma-separated numbers, e.g. 20,50,80") from None
+        raise ConfigError(f"{flag} {text!r} must be comma-separated numbers, e.g. {flag} 1,2.5") from None
 
 
 def _field(args: argparse.Namespace) -> int:
@@ -322,6 +323,14 @@ def _preview(args: argparse.Namespace) -> int:
     scene = load_scene(args.config, _overrides(args))
     if not out.parent.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
+    if out.is_dir():
+        raise WarpcausticsError(f"--out {str(out)!r} is a folder; name the .png file to write")
+    probe = out.with_name(f".{out.stem}.probe-{os.getpid()}")
+    try:  # a folder the PNG cannot be written into fails now, not as pyvista's error after the render
+        probe.open("xb").close()
+        probe.unlink()
+    except OSError as exc:
+        raise WarpcausticsError(f"--out {str(out)!r} cannot be written: {exc.strerror or exc}") from None
     from warpcaustics.pipeline import check_time
 
     check_time("--time", args.time)
@@ -434,6 +443,10 @@ def main(argv: list[str] | None = None) -> int:
             return _study(args)
         if args.command == "sweep":
             from warpcaustics.batch.sweep import sweep_main
+
+            if args.address is not None and args.executor != "ray":
+                raise ConfigError(f"--address {args.address!r} is the Ray cluster to run on; add "
+                                  "--executor ray (or leave --address out)")
 
             return sweep_main(args.sweep, args.out, args.workers, args.device, args.quiet, args.executor,
                               args.address, _overrides(args), args.force)

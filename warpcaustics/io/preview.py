@@ -70,16 +70,20 @@ def preview_png(result, path: Path, *, width: int = 960, height: int = 640) -> P
         (cx, cy, -0.6 * depth),
         (0, 0, 1),
     ]
-    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
+    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}.png")  # VTK knows its formats by lower case
     try:
         plotter.screenshot(str(tmp))
-        os.replace(tmp, path)
     except Exception as exc:  # VTK without an off-screen context reports in many ways
         raise WarpcausticsError(
             f"preview: pyvista could not render off screen ({type(exc).__name__}: "
             f"{str(exc).splitlines()[0] if str(exc) else ''}); the EXR and VTK outputs "
             "do not need it"
         ) from None
+    else:
+        try:
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise WarpcausticsError(f"preview: cannot write {str(path)!r}: {exc.strerror or exc}") from None
     finally:
         plotter.close()
         if tmp.exists():
