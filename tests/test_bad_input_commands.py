@@ -229,3 +229,20 @@ def test_preview_names_its_output_problem_not_pyvista(tmp_path, capsys):
 def test_a_ray_address_without_the_ray_executor_is_refused(tmp_path, capsys):
     one_line_error(capsys, ["sweep", str(CONFIGS / "sweeps" / "water_types.toml"), "--out",
                             str(tmp_path / "s"), "--address", "auto"], "--executor ray")
+
+
+def test_a_spectrum_file_without_a_header_keeps_its_first_row(tmp_path):
+    """The first line was skipped as a header even when it was data."""
+    from warpcaustics.optics.spectra import read_spectrum_csv
+
+    (tmp_path / "bare.csv").write_text("400,1.0\n500,1.2\n700,0.9\n")
+    (tmp_path / "headed.csv").write_text("wavelength_nm,irradiance\n400,1.0\n500,1.2\n700,0.9\n")
+    for name in ("bare.csv", "headed.csv"):
+        nm, values = read_spectrum_csv(name, tmp_path)
+        assert nm.tolist() == [400.0, 500.0, 700.0] and values.tolist() == [1.0, 1.2, 0.9]
+
+
+def test_a_spectrum_of_1e308_is_refused_before_it_overflows(tmp_path):
+    (tmp_path / "big.csv").write_text("nm,w\n400,1e308\n700,1e308\n")
+    with pytest.raises(wc.ConfigError, match="sun.file .* at most 1e\\+30"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"sun.spectrum": "file", "sun.file": str(tmp_path / "big.csv")})

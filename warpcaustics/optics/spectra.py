@@ -234,6 +234,19 @@ def sky_diffuse_shape(bins: SpectralBins) -> np.ndarray:
     return bins.average(wavelength, global_tilt - direct * math.cos(incidence), what="ASTM G173 diffuse sky")
 
 
+MAX_SPECTRUM_VALUE = 1e30
+"""The largest wavelength or value a spectrum file may hold: past it the bins' integrals overflow."""
+
+
+def _numbers_only(line: str) -> bool:
+    """Whether a CSV line is data (every cell a number) rather than a header."""
+    try:
+        [float(cell) for cell in line.split(",")]
+    except ValueError:
+        return False
+    return bool(line.strip())
+
+
 def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
                       quantity: str = "irradiance", upper: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
     """A two-column CSV (header line, then wavelength [nm], value): one-line errors naming ``key``."""
@@ -241,15 +254,20 @@ def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
     try:
+        with open(path, encoding="utf-8") as fh:
+            first = fh.readline()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # an empty file: numpy warns, then we say it in one line
-            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+            data = np.loadtxt(path, delimiter=",", skiprows=0 if _numbers_only(first) else 1, ndmin=2)
     except (OSError, ValueError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
         raise ConfigError(f"{key} = {str(path)!r} cannot be read as CSV (header line, then "
-                          f"wavelength_nm,{quantity}): {exc}") from None
+                          f"wavelength_nm,{quantity}): {reason}") from None
+    upper = min(upper, MAX_SPECTRUM_VALUE)
     if data.shape[1] < 2 or len(data) < 2 or not np.all(np.diff(data[:, 0]) > 0) \
-            or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0) or np.any(data[:, 1] > upper):
-        bound = "" if upper == np.inf else f" and at most {upper:g}"
+            or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0) or np.any(data[:, 1] > upper) \
+            or np.any(np.abs(data[:, 0]) > MAX_SPECTRUM_VALUE):
+        bound = f" and at most {upper:g}"
         raise ConfigError(f"{key} = {str(path)!r} needs two columns, wavelengths strictly "
                           f"increasing and finite, non-negative {quantity} values{bound}")
     return data[:, 0], data[:, 1]
