@@ -459,7 +459,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "field":
             return _field(args)
         if args.command == "report":
-            from warpcaustics.batch.sweep import report_main
+            from warpcaustics.batch.report import report_main
 
             return report_main(args.out)
         return _info()
