@@ -246,3 +246,60 @@ def test_a_spectrum_of_1e308_is_refused_before_it_overflows(tmp_path):
     (tmp_path / "big.csv").write_text("nm,w\n400,1e308\n700,1e308\n")
     with pytest.raises(wc.ConfigError, match="sun.file .* at most 1e\\+30"):
         wc.load_scene(CONFIGS / "ocean.toml", {"sun.spectrum": "file", "sun.file": str(tmp_path / "big.csv")})
+
+
+def receiver_scene(mesh):
+    return {"caustics.method": "photons", "receivers": [{"mesh": str(mesh), "translate_m": [0.0, 0.0, -1.0]}]}
+
+
+@pytest.mark.parametrize("name,content,needle", [
+    ("faces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + "f 1 2 1000\n" * 50,
+     "refer to vertex 1000, but it holds 3"),
+    ("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not finite"),
+    ("far.obj", "v 1e30 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "within ±100000 m"),
+    ("cut.stl", b"\0" * 80 + (50_000_000).to_bytes(4, "little") + b"\0" * 50, "declares 50000000 triangles"),
+])
+def test_a_broken_receiver_mesh_is_one_line(tmp_path, name, content, needle):
+    """Faces naming vertices the file lacks had crashed the process in VTK (a segfault) or raised an
+    IndexError; a binary STL cut short, NaN and far vertices had rendered."""
+    path = tmp_path / name
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    with pytest.raises(wc.ConfigError, match=r"receivers\[0\].mesh = .*" + needle):
+        wc.load_scene(CONFIGS / "ocean.toml", receiver_scene(path))
+
+
+@pytest.mark.parametrize("content,needle", [(b"", "EOFError"), (None, ".npz archive")])
+def test_a_floor_relief_file_numpy_cannot_read_is_one_line(tmp_path, content, needle):
+    path = tmp_path / "relief.npy"
+    if content is None:
+        path = tmp_path / "relief.npz"
+        np.savez(path, a=np.zeros((16, 16)))
+    else:
+        path.write_bytes(content)
+    with pytest.raises(wc.ConfigError, match=f"floor.file = .*{needle}"):
+        wc.load_scene(CONFIGS / "ocean_floor.toml", {"floor.shape": "file", "floor.file": str(path),
+                                                     "camera.enabled": False})
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero here")
+def test_a_spectrum_file_that_is_a_device_is_refused_not_read_forever(tmp_path):
+    with pytest.raises(wc.ConfigError, match="floor.albedo_file = '/dev/zero' is not a regular file"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"floor.albedo_file": "/dev/zero"})
+    with pytest.raises(wc.ConfigError, match="is a folder"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"floor.albedo_file": str(tmp_path)})
+
+
+def test_a_camera_up_float32_cannot_hold_is_refused():
+    with pytest.raises(wc.ConfigError, match="camera.up .* too short"):
+        wc.load_scene(CONFIGS / "ocean_floor.toml", {"camera.up": [0.0, 0.0, 1e-200]})
+
+
+def test_a_sweep_refuses_its_configured_device_before_making_its_folder(tmp_path, monkeypatch):
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "garbage")
+    path = tmp_path / "sweep.toml"
+    path.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n')
+    from warpcaustics.batch.sweep import run_sweep
+
+    with pytest.raises(wc.WarpcausticsError, match="device = 'garbage'"):
+        run_sweep(load_sweep(path), tmp_path / "out", quiet=True)
+    assert not (tmp_path / "out").exists()

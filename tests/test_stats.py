@@ -338,3 +338,14 @@ def test_every_band_has_its_sky_and_direct_parts():
         assert windows[0] + windows[1] == pytest.approx(windows[2], rel=1e-9), key
         assert windows[0] == pytest.approx(float(np.mean(r.coarse_sky_floor_irradiance[k], dtype=np.float64)),
                                            rel=1e-6), key
+
+
+@pytest.mark.parametrize("integration_s", [1e-300, 1e-12, 1e-6])
+def test_a_window_a_sliver_of_a_spacing_is_the_instantaneous_sample(integration_s):
+    """Over a window far shorter than the samples' spacing the running mean is the sample itself (to
+    the window's share of the slope). It had been a difference of two running integrals divided by
+    the window, which cancelled: -4e301 and an infinite CV for a window of 1e-300 s."""
+    e = 1.0 + np.random.default_rng(3).random((40, 2))
+    out = stats.integrate_series(e, 0.2, integration_s)
+    assert np.all(np.isfinite(out))
+    np.testing.assert_allclose(out, e[len(e) - len(out):], rtol=0, atol=10 * integration_s / 0.2 + 1e-15)

@@ -206,10 +206,10 @@ def test_a_record_after_a_cut_line_stands_on_its_own(tmp_path):
     the manifest reads the records before and after it, skipping the cut line."""
     from warpcaustics.batch.sweep import MANIFEST, _append
 
-    _append(tmp_path, {"id": "a", "state": "done"})
+    _append(tmp_path, {"id": "a", "state": "done", "rows": [{"frame": 0}]})
     with open(tmp_path / MANIFEST, "a", encoding="utf-8") as fh:
         fh.write('{"id": "b", "sta')  # the kill's cut
-    _append(tmp_path, {"id": "c", "state": "done"})
+    _append(tmp_path, {"id": "c", "state": "done", "rows": [{"frame": 0}]})
     _append(tmp_path, {"id": "d", "state": "failed"})
     lines = (tmp_path / MANIFEST).read_text(encoding="utf-8").splitlines()
     assert lines[1] == '{"id": "b", "sta'

@@ -265,6 +265,8 @@ def memory_fix(cfg) -> str:
     beam spread's photons (where the transfer walks it) next."""
     grid_key = METHODS[cfg.caustics.method].memory_key
     fix = f"lower {grid_key}, water.resolution or caustics.map_resolution" if grid_key else _MEMORY_FIX
+    if cfg.camera.enabled and cfg.camera.width * cfg.camera.height >= cfg.caustics.map_resolution**2:
+        fix = fix.replace("lower ", "lower camera.width × camera.height, ", 1)  # the image is the most
     return fix.replace("lower ", "lower optics.beam_spread_photons, ", 1) if walks_spread(cfg) else fix
 
 

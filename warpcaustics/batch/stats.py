@@ -386,15 +386,17 @@ def integrate_series(series: np.ndarray, dt_s: float, integration_s: float) -> n
                          f"{dt_s} s apart; the animation has {e.shape[0]}")
     # cumulative trapezoid integral of the piecewise-linear interpolant, in units of dt
     cumulative = np.concatenate([np.zeros((1,) + e.shape[1:]), np.cumsum(0.5 * (e[1:] + e[:-1]), axis=0)])
-    ends = np.arange(first, e.shape[0], dtype=np.float64)
-
-    def integral_to(u: np.ndarray) -> np.ndarray:  # ∫₀^u E, u in samples (fractional)
-        i = np.minimum(np.floor(u).astype(int), e.shape[0] - 2)
-        f = (u - i)[:, None]
-        left, right = e[i], e[i + 1]
-        return cumulative[i] + f * left + 0.5 * f * f * (right - left)
-
-    return (integral_to(ends) - integral_to(ends - steps)) / steps
+    ends = np.arange(first, e.shape[0])
+    # The window [n − steps, n]: its whole intervals [n − k, n], then the last `frac` of the interval
+    # before them, integrated on its own (not as a difference of running integrals, which cancels
+    # when the window is a sliver of a spacing).
+    k = int(math.floor(steps + 1e-9))
+    frac = max(steps - k, 0.0)
+    whole = cumulative[ends] - cumulative[ends - k]
+    if frac > 0.0:
+        right, left = e[ends - k], e[np.maximum(ends - k - 1, 0)]
+        whole = whole + frac * right - 0.5 * frac * frac * (right - left)
+    return whole / steps
 
 
 def series_statistics(series: np.ndarray, dt_s: float, flash_threshold: float) -> dict:

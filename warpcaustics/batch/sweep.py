@@ -21,7 +21,8 @@ order) for the stateful pools. Its id hashes the resolved config, the frame time
 version, so a rerun recognises finished tasks. Each task renders into ``DIR/.<id>.tmp/`` and
 that folder is renamed to ``DIR/<id>/`` only once complete. The driver alone appends to
 ``DIR/manifest.jsonl`` (one JSON object per line, flushed and fsynced): a task whose id is recorded
-as done and whose folder exists is skipped on a rerun; anything else runs again. Leftover
+as done and whose folder holds a whole ``run.json`` is skipped on a rerun; anything else (a damaged
+manifest line or run.json included) runs again. Leftover
 temporary folders of a killed run are removed at the start. Workers are separate processes (Warp's
 CPU launches run on one core each), and they die with the driver (parent-death signal plus a parent
 check), so a killed sweep leaves nothing writing. A sweep removes only the temporary folders of
@@ -272,37 +273,72 @@ def _claim(out: Path, sweep: Sweep, force: bool) -> None:
     """A folder resumes the sweep it holds and refuses another one (a one-line error naming
     ``--force``, which lets the two share the folder); the first run records its hash."""
     record = out / SWEEP_RECORD
+    for name in (MANIFEST, SWEEP_RECORD, SUMMARY):
+        if (out / name).is_dir():
+            raise WarpcausticsError(f"--out {str(out)!r} has a folder {name!r} where the sweep keeps its "
+                                    "file; remove it or give another --out")
     mine = sweep_hash(sweep)
     if record.exists():
         try:
             theirs = json.loads(record.read_text(encoding="utf-8")).get("hash")
         except (OSError, ValueError, AttributeError):
             theirs = None
+    elif (out / MANIFEST).exists():  # the record was lost: the tasks the manifest names say whose it is
+        theirs = mine if set(read_manifest(out)) <= {t.id for t in sweep.tasks} else "unrecorded"
     else:
-        theirs = "unrecorded" if (out / MANIFEST).exists() else None
+        theirs = None
     if not force and ((out / RUN_MANIFEST).exists() or (out / "run.json").exists()):
         raise WarpcausticsError(f"--out {str(out)!r} holds a render's outputs ({RUN_MANIFEST} or run.json); "
                                 "give another --out, or --force to add the sweep beside them")
     if theirs not in (None, mine) and not force:
         raise WarpcausticsError(f"--out {str(out)!r} holds the results of another sweep (other keys, values, "
                                 "frames or version); give another --out, or --force to add this one to it")
-    if theirs is None or force:
+    if theirs is None or force or not record.exists():
         write_json(record, {"hash": mine, "version": __version__, "source": str(sweep.source)})
 
 
 def read_manifest(out_dir: Path) -> dict[str, dict]:
-    """The last record of each task id (a line cut by a crash is ignored)."""
+    """The last record of each task id. A line that is not a task's record — cut by a crash, or
+    damaged — is ignored, so its task counts as not done and renders again."""
     records: dict[str, dict] = {}
     path = out_dir / MANIFEST
     if path.exists():
-        for line in path.read_text(encoding="utf-8").splitlines():
+        for line in path.read_bytes().splitlines():
             try:
-                rec = json.loads(line)
-            except json.JSONDecodeError:
+                rec = json.loads(line.decode("utf-8"))
+            except (UnicodeDecodeError, json.JSONDecodeError):
                 continue
-            if isinstance(rec, dict) and "id" in rec:
+            if _is_record(rec):
                 records[rec["id"]] = rec
     return records
+
+
+NUMBER_COLUMNS = ("frame", "time_s", "floor_w_m2", "contrast", "cv", "render_s")
+"""A summary row's columns that are numbers in every sweep (``warpcaustics report`` plots some)."""
+
+
+def _finished(folder: Path, task: Task) -> bool:
+    """Whether a task's folder holds its finished run: a ``run.json`` that reads as one, with a record
+    for each of its frames and that frame's statistics (a damaged one renders again)."""
+    try:
+        frames = json.loads((folder / "run.json").read_text(encoding="utf-8"))["frames"]
+        return len(frames) == len(task.times_s) and all(
+            isinstance(f["statistics"]["irradiance_w_m2"]["cv"], (int, float)) for f in frames)
+    except (OSError, ValueError, TypeError, KeyError):
+        return False
+
+
+def _is_record(rec) -> bool:
+    """A task's manifest record: an id, and if done, its rows of numbers and text."""
+    if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)):
+        return False
+    if rec.get("state") != "done":
+        return True
+    rows = rec.get("rows")
+    cells = (int, float, str, bool, type(None))
+    return isinstance(rows, list) and bool(rows) and all(
+        isinstance(row, dict) and all(isinstance(v, cells) for v in row.values())
+        and all(isinstance(row.get(c, 0.0), (int, float)) for c in NUMBER_COLUMNS) for row in rows)
 
 
 def _append(out_dir: Path, record: dict) -> None:
@@ -377,10 +413,14 @@ def run_sweep(
         raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
     if workers < 1:
         raise WarpcausticsError(f"--workers = {workers} must be at least 1")
-    if device is not None and executor == "local":  # checked once here, before anything is written
+    if executor == "local":  # checked once here, before anything is written
         from warpcaustics.device import resolve_device
 
-        device = resolve_device(device)
+        configured = {t.config.get("device", "auto") for t in sweep.tasks if t.config}
+        if device is not None:
+            device = resolve_device(device)
+        elif len(configured) == 1:  # the config's device (or $WARPCAUSTICS_DEVICE), said once
+            device = resolve_device(None, config_value=configured.pop())
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
@@ -409,7 +449,7 @@ def run_sweep(
             report.failed.append((task.id, task.error))
             continue
         rec = records.get(task.id)
-        if rec is not None and rec.get("state") == "done" and (out / task.id / "run.json").exists():
+        if rec is not None and rec.get("state") == "done" and _finished(out / task.id, task):
             report.skipped += 1
         else:
             todo.append(task)

@@ -28,6 +28,14 @@ def task_tmp_dir(out_dir: str | Path, task_id: str) -> Path:
     return Path(out_dir) / f".{task_id}.tmp"
 
 
+def remove(path: Path) -> None:
+    """Remove a task's folder, or a file in its place (which a folder's rename cannot replace)."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path, ignore_errors=True)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
 def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
     """Render one task into ``out_dir/<id>`` (via a temporary folder); return its summary row."""
     if task.stateful:
@@ -38,7 +46,7 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
     t0 = time.perf_counter()
     final = Path(out_dir) / task.id
     tmp = task_tmp_dir(out_dir, task.id)
-    shutil.rmtree(tmp, ignore_errors=True)
+    remove(tmp)
     try:
         renderer = Renderer(load_scene(base, task.overrides), device)
         results = []
@@ -48,11 +56,10 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
             results.append(result)
         entries = [frame_entry(task.frame_start + k, r) for k, r in enumerate(results)]  # as the files
         write_run_json(tmp, results, frames=entries)
-        if final.exists():
-            shutil.rmtree(final)
+        remove(final)
         os.replace(tmp, final)
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        remove(tmp)
     return {
         "rows": [summary_row(task, r, k, entries[k]["statistics"]) for k, r in enumerate(results)],
         "seconds": time.perf_counter() - t0,
@@ -62,6 +69,35 @@ def run_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
 
 CHECKPOINT = "checkpoint.npz"
 CHECKPOINT_META = "checkpoint.json"
+
+
+def _resume(partial: Path, renderer, task: Task) -> tuple[list[dict], list[dict]]:
+    """The frames' records and summary rows of an interrupted pool animation, its pool's state loaded
+    into ``renderer``; none (start again at frame 0) when there is no checkpoint or it cannot be
+    trusted — the pair not written together, a damaged file, a state that is not this animation's
+    at its last frame's time — rather than fail the task on every rerun."""
+    meta_path = partial / CHECKPOINT_META
+    if not (meta_path.exists() and (partial / CHECKPOINT).exists()):
+        return [], []
+    try:
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        with np.load(partial / CHECKPOINT, allow_pickle=False) as data:
+            state = {name: np.asarray(data[name]) for name in data.files}
+        done = int(state.pop("frames_done"))
+        entries, rows = meta["entries"], meta["rows"]
+        state["time_s"] = float(state["time_s"])
+        trusted = (done == meta["frames_done"] and 0 < done <= len(task.times_s) and len(entries) == done
+                   and len(rows) == done and abs(state["time_s"] - task.times_s[done - 1]) <= 1e-6
+                   and all(a.dtype.kind in "fiu" and np.all(np.isfinite(a)) for a in state.values()
+                           if isinstance(a, np.ndarray)))
+        if trusted:
+            renderer.water.load_state(state)
+            return entries, rows
+    except Exception:  # noqa: BLE001 - a damaged checkpoint, in whatever way: start again
+        pass
+    for name in (CHECKPOINT, CHECKPOINT_META):
+        remove(partial / name)
+    return [], []
 
 
 def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> dict:
@@ -76,19 +112,12 @@ def run_pool_task(base: str, task: Task, out_dir: str, device: str | None) -> di
     out = Path(out_dir)
     final = out / task.id
     partial = out / f".{task.id}.partial"
+    if not partial.is_dir():
+        remove(partial)
     partial.mkdir(parents=True, exist_ok=True)
     renderer = Renderer(load_scene(base, task.overrides), device)
-    entries: list[dict] = []
-    rows: list[dict] = []
+    entries, rows = _resume(partial, renderer, task)
     meta_path = partial / CHECKPOINT_META
-    if meta_path.exists() and (partial / CHECKPOINT).exists():
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        with np.load(partial / CHECKPOINT) as data:
-            state = {name: data[name] for name in data.files}
-        if int(state.pop("frames_done")) == meta["frames_done"]:  # the pair was written together
-            state["time_s"] = float(state["time_s"])
-            renderer.water.load_state(state)
-            entries, rows = meta["entries"], meta["rows"]
     result = None
     for k in range(len(entries), len(task.times_s)):
         result = renderer.render(task.times_s[k])

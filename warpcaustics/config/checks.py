@@ -339,6 +339,9 @@ def _check_photon_scene(cfg: Config) -> None:
     if math.hypot(*view) == 0.0:
         raise ConfigError("camera.look_at_m equals camera.position_m; look at another point")
     up = cam.up
+    if math.hypot(*up) < 1e-12:  # the camera's float32 vectors would lose it (1e-200 became zero)
+        raise ConfigError(f"camera.up = {list(up)} is too short to give a direction (length under 1e-12); "
+                          "give one of ordinary length, e.g. [0.0, 0.0, 1.0]")
     cross = (view[1] * up[2] - view[2] * up[1], view[2] * up[0] - view[0] * up[2],
              view[0] * up[1] - view[1] * up[0])
     if math.hypot(*cross) <= 1e-9 * math.hypot(*view) * max(math.hypot(*up), 1e-300):

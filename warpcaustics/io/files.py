@@ -32,9 +32,31 @@ def input_file(key: str, name: str, base_dir: Path | None, what: str) -> Path:
         raise ConfigError(f"{key} = {_describe(name)} cannot be a file name ({reason}); give the path "
                           f"of {what}") from None
     if not found:
-        raise ConfigError(f"{key} = {_describe(name)} does not exist; give the path of {what} (relative "
-                          "paths start at the config file's folder)")
+        kind = ("is a folder" if path.is_dir() else "is not a regular file (a device or a pipe)"
+                if path.exists() else "does not exist")
+        raise ConfigError(f"{key} = {_describe(name)} {kind}; give the path of {what} (relative paths "
+                          "start at the config file's folder)")
     return path
+
+
+def load_npy(key: str, path: Path, what: str):
+    """One array from a .npy file a config key names, or a one-line ConfigError naming ``key``: a file
+    numpy cannot read (empty, truncated, pickled, a header asking for more memory than there is) or a
+    .npz archive. ``what``: what the array holds ("heights")."""
+    import numpy as np
+
+    from warpcaustics.errors import ConfigError
+
+    try:
+        array = np.load(path, allow_pickle=False)
+    except Exception as exc:  # noqa: BLE001 - any unreadable file is the same user error
+        raise ConfigError(f"{key} = {str(path)!r} is not a readable .npy array "
+                          f"({type(exc).__name__}: {exc}); save the {what} with numpy.save") from None
+    if not isinstance(array, np.ndarray):
+        array.close()
+        raise ConfigError(f"{key} = {str(path)!r} is a .npz archive; save one array of {what} with "
+                          "numpy.save (.npy)")
+    return array
 
 
 @contextmanager

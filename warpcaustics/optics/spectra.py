@@ -250,9 +250,9 @@ def _numbers_only(line: str) -> bool:
 def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
                       quantity: str = "irradiance", upper: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
     """A two-column CSV (header line, then wavelength [nm], value): one-line errors naming ``key``."""
-    path = Path(name)
-    if not path.is_absolute() and base_dir is not None:
-        path = base_dir / path
+    from warpcaustics.io.files import input_file
+
+    path = input_file(key, name, base_dir, f"a CSV of wavelength_nm,{quantity}")
     try:
         with open(path, encoding="utf-8") as fh:
             first = fh.readline()

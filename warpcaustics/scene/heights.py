@@ -8,23 +8,18 @@ import numpy as np
 
 from warpcaustics.config.fields import MAX_LENGTH_M
 from warpcaustics.errors import ConfigError
-from warpcaustics.io.files import input_file
+from warpcaustics.io.files import input_file, load_npy
 
 DEFAULT_RESOLUTION = 256
 """Vertices per side when ``water.resolution`` is not given."""
+MAX_FILE_RESOLUTION = 4096
+"""The largest height field a file may give: ``water.resolution``'s own upper bound."""
 
 
 def load_heights(name: str, base_dir: Path, resolution: int | None) -> np.ndarray:
     """Read ``water.file``: a square 2-D array of finite heights [m], ``h[iy, ix]``."""
     path = input_file("water.file", name, base_dir, "a .npy file of heights")
-    try:
-        heights = np.load(path, allow_pickle=False)
-    except Exception as exc:  # noqa: BLE001 - any unreadable file is the same user error
-        raise ConfigError(f"water.file = {str(path)!r} is not a readable .npy array "
-                          f"({type(exc).__name__}: {exc}); save heights with numpy.save") from None
-    if not isinstance(heights, np.ndarray):
-        raise ConfigError(f"water.file = {str(path)!r} is a .npz archive; save one array with "
-                          f"numpy.save (.npy)")
+    heights = load_npy("water.file", path, "heights")
     if heights.dtype.kind not in "iuf":
         raise ConfigError(f"water.file = {str(path)!r} holds {heights.dtype} values; heights must be "
                           f"real numbers (float or integer) in metres")
@@ -33,9 +28,13 @@ def load_heights(name: str, base_dir: Path, resolution: int | None) -> np.ndarra
                           f"2-D array of heights, at least 4×4")
     if not np.all(np.isfinite(heights)):
         raise ConfigError(f"water.file = {str(path)!r} must hold finite numbers (found NaN or inf)")
-    if np.abs(heights).max(initial=0.0) > MAX_LENGTH_M:  # as every other length: float32 keeps them finite
-        raise ConfigError(f"water.file = {str(path)!r} holds a height of {np.abs(heights).max():.3g} m; "
-                          f"heights must lie within ±{MAX_LENGTH_M:g} m")
+    highest = float(np.abs(heights.astype(np.float64)).max(initial=0.0))
+    if highest > MAX_LENGTH_M:  # as every other length: float32 keeps them finite
+        raise ConfigError(f"water.file = {str(path)!r} holds a height of {highest:.3g} m; heights must "
+                          f"lie within ±{MAX_LENGTH_M:g} m")
+    if heights.shape[0] > MAX_FILE_RESOLUTION:
+        raise ConfigError(f"water.file = {str(path)!r} is {heights.shape[0]}×{heights.shape[0]}; "
+                          f"water.resolution allows at most {MAX_FILE_RESOLUTION} (resample it)")
     if resolution is not None and resolution != heights.shape[0]:
         raise ConfigError(f"water.resolution = {resolution} disagrees with water.file, which is "
                           f"{heights.shape[0]}×{heights.shape[0]}; remove water.resolution or set it "

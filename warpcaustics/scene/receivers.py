@@ -19,8 +19,9 @@ import numpy as np
 import warp as wp
 
 from warpcaustics.config import Config, FloorConfig, FloorShape, ReceiverConfig
+from warpcaustics.config.fields import MAX_LENGTH_M
 from warpcaustics.errors import ConfigError
-from warpcaustics.io.files import input_file
+from warpcaustics.io.files import input_file, load_npy
 from warpcaustics.optics.spectra import SpectralBins
 
 FLOOR_ID = 0
@@ -75,10 +76,7 @@ def periodic_bilinear(h: np.ndarray, extent_m: float, x: np.ndarray, y: np.ndarr
 def load_floor_relief(name: str, base_dir: Path) -> np.ndarray:
     """Read ``floor.file``: a square 2-D float array of relief [m]; one-line errors otherwise."""
     path = input_file("floor.file", name, base_dir, "a .npy file of floor relief")
-    try:
-        relief = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise ConfigError(f"floor.file = {str(path)!r} is not a readable .npy array: {exc}") from None
+    relief = load_npy("floor.file", path, "relief")
     if relief.ndim != 2 or relief.shape[0] != relief.shape[1] or relief.shape[0] < 2:
         raise ConfigError(
             f"floor.file = {str(path)!r} has shape {relief.shape}; expected a square 2-D "
@@ -86,7 +84,11 @@ def load_floor_relief(name: str, base_dir: Path) -> np.ndarray:
         )
     if not np.issubdtype(relief.dtype, np.floating) or not np.all(np.isfinite(relief)):
         raise ConfigError(f"floor.file = {str(path)!r} must hold finite float heights [m]")
-    return relief.astype(np.float64)
+    relief = relief.astype(np.float64)
+    if np.abs(relief).max() > MAX_LENGTH_M:
+        raise ConfigError(f"floor.file = {str(path)!r} holds relief of {np.abs(relief).max():.3g} m; relief "
+                          f"must lie within ±{MAX_LENGTH_M:g} m")
+    return relief
 
 
 @dataclass(frozen=True)
@@ -120,14 +122,19 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
         else:
             path = input_file(f"{key}.mesh", receiver.mesh, base_dir,
                               f"a mesh file or a built-in mesh ({', '.join(PRIMITIVES)})")
+            problem = _binary_stl_problem(path)
             try:
-                with quiet_vtk():
-                    poly = pv.read(str(path))
+                if problem is None:
+                    with quiet_vtk():
+                        poly = pv.read(str(path))
             except Exception as exc:  # pyvista raises many kinds for unreadable files
                 raise ConfigError(
                     f"{key}.mesh = {receiver.mesh!r} cannot be read by pyvista: "
                     f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}"
                 ) from None
+            problem = problem or _mesh_problem(poly, pv)  # before clean(), which follows the indices
+            if problem is not None:
+                raise ConfigError(f"{key}.mesh = {receiver.mesh!r} {problem}; repair or re-export it")
         poly = poly.extract_surface().triangulate().clean()
     if poly.n_cells == 0:
         raise ConfigError(f"{key}.mesh = {receiver.mesh!r} has no triangles")
@@ -138,6 +145,48 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
     rotation = _rot_z(rz) @ _rot_y(ry) @ _rot_x(rx)
     points = (points * scale) @ rotation.T + np.asarray(receiver.translate_m)
     return TriangleMesh(points, triangles)
+
+
+def _binary_stl_problem(path: Path) -> str | None:
+    """Why a binary STL is not whole (its size against the triangles its header declares), or None:
+    VTK reads what there is of a truncated one without a word."""
+    if path.suffix.lower() != ".stl":
+        return None
+    with open(path, "rb") as fh:
+        head = fh.read(84)
+        ascii_start = head.lstrip().lower().startswith(b"solid") and b"facet" in fh.read(1024).lower()
+    if ascii_start or len(head) < 84:
+        return None  # ASCII, or too short to say: the reader reports it
+    declared = int.from_bytes(head[80:84], "little")
+    size = path.stat().st_size
+    if size < 84 + 50 * declared:
+        return (f"is a binary STL cut short: its header declares {declared} triangles, its "
+                f"{size} bytes hold {(size - 84) // 50}")
+    return None
+
+
+def _mesh_problem(data, pv) -> str | None:
+    """What makes a mesh unusable before any filter touches it: faces that name vertices it does not
+    hold (VTK's filters then read past the end), vertices that are not finite or beyond ±1e5 m."""
+    n = data.n_points if hasattr(data, "n_points") else 0
+    if isinstance(data, pv.PolyData):
+        cells = [pv.convert_array(getattr(data, kind)().GetConnectivityArray())
+                 for kind in ("GetPolys", "GetStrips", "GetLines", "GetVerts")]
+    elif isinstance(data, pv.UnstructuredGrid):
+        cells = [np.asarray(data.cell_connectivity)]
+    else:
+        cells = []
+    for index in cells:
+        outside = index[(index < 0) | (index >= n)] if index.size else index
+        if outside.size:
+            return (f"has faces that refer to vertex {int(outside[0]) + 1}, but it holds {n} (truncated or "
+                    "corrupt)")
+    points = np.asarray(data.points, np.float64) if n else np.zeros((0, 3))
+    if not np.all(np.isfinite(points)):
+        return "has vertices that are not finite numbers"
+    if points.size and np.abs(points).max() > MAX_LENGTH_M:
+        return f"has a vertex {np.abs(points).max():.3g} m out; vertices must lie within ±{MAX_LENGTH_M:g} m"
+    return None
 
 
 @functools.cache
