@@ -303,3 +303,15 @@ def test_a_sweep_refuses_its_configured_device_before_making_its_folder(tmp_path
     with pytest.raises(wc.WarpcausticsError, match="device = 'garbage'"):
         run_sweep(load_sweep(path), tmp_path / "out", quiet=True)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_floor_relief_above_the_water_is_refused(tmp_path):
+    """A 1e4 m spike in floor.file had asked for a floor mesh reaching 4e4 m beyond the patch, refused
+    as 'needs about 0.00 GiB' of memory."""
+    relief = np.zeros((16, 16))
+    relief[0, 0] = 1e4
+    np.save(tmp_path / "spike.npy", relief)
+    with pytest.raises(wc.ConfigError, match="relief rises to z = .* above the water"):
+        wc.Renderer(wc.load_scene(CONFIGS / "ocean_floor.toml", {
+            "floor.shape": "file", "floor.file": str(tmp_path / "spike.npy"), "camera.enabled": False,
+            "water.resolution": 16, "caustics.map_resolution": 16}), "cpu")

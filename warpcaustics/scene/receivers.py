@@ -244,24 +244,14 @@ def floor_mesh(cfg: Config, relief: np.ndarray | None, periodic: bool) -> Triang
     cells = floor_mesh_cells(cfg)
     cell = extent / cells
     margin_cells = 0
+    sample = np.linspace(-extent / 2, extent / 2, 257)
+    z = None if planar else floor_relief_height(floor, relief, extent, *np.meshgrid(sample, sample))
+    if z is not None and z.max() >= 0.0:  # also what keeps the margin below finite
+        raise ConfigError(f"the floor's relief rises to z = {z.max():.4g} m, above the water's mean level "
+                          "(z = 0); lower the relief (floor.file, floor.ripple_amplitude_m) or deepen "
+                          "floor.depth_m")
     if periodic:
-        relief_range = (
-            0.0
-            if planar
-            else float(
-                np.ptp(
-                    floor_relief_height(
-                        floor,
-                        relief,
-                        extent,
-                        *np.meshgrid(
-                            np.linspace(-extent / 2, extent / 2, 257),
-                            np.linspace(-extent / 2, extent / 2, 257),
-                        ),
-                    )
-                )
-            )
-        )
+        relief_range = 0.0 if z is None else float(np.ptp(z))
         margin_cells = math.ceil((0.05 * extent + 4.0 * relief_range) / cell)
     coords = (np.arange(-margin_cells, cells + margin_cells + 1) * cell) - 0.5 * extent
     x, y = np.meshgrid(coords, coords)
