@@ -52,7 +52,7 @@ def test_irradiance_scale_and_csv_spectrum(tmp_path):
 def test_bad_sun_file_is_one_line(capsys, tmp_path):
     """A sun CSV that is missing or malformed is a one-line error naming sun.file; nothing is written."""
     (tmp_path / "bad.csv").write_text("wavelength_nm,irradiance\n500,1\n400,2\n")
-    for name, needle in (("missing.csv", "cannot be read"), ("bad.csv", "strictly")):
+    for name, needle in (("missing.csv", "does not exist"), ("bad.csv", "strictly")):
         cfg = tmp_path / "scene.toml"
         cfg.write_text(f"[sun]\nspectrum = 'file'\nfile = '{name}'\n")
         assert main(["render", str(cfg), "--out", str(tmp_path / "out"), "--device", "cpu"]) == 2
