@@ -114,12 +114,10 @@ def test_a_pool_sweep_too_short_for_its_integration_fails_before_rendering(tmp_p
     assert task.error is not None and "stats.integration_s = 10 needs frames.count" in task.error
 
 
-@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
-def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path, capsys):
-    """``config /dev/zero`` read forever; a pipe blocked."""
-    pipe = tmp_path / "pipe.toml"
-    os.mkfifo(pipe)
-    one_line_error(capsys, ["config", str(pipe)], "not a regular file")
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero here")
+def test_a_config_that_is_a_device_is_refused(capsys):
+    """``config /dev/zero`` read forever (a pipe, as from a shell's process substitution, still reads)."""
+    one_line_error(capsys, ["config", "/dev/zero"], "is a device")
 
 
 def test_a_config_with_a_byte_order_mark_loads(tmp_path):
@@ -315,3 +313,27 @@ def test_a_floor_relief_above_the_water_is_refused(tmp_path):
         wc.Renderer(wc.load_scene(CONFIGS / "ocean_floor.toml", {
             "floor.shape": "file", "floor.file": str(tmp_path / "spike.npy"), "camera.enabled": False,
             "water.resolution": 16, "caustics.map_resolution": 16}), "cpu")
+
+
+def test_a_summary_row_short_of_cells_is_one_line(tmp_path, capsys):
+    (tmp_path / "summary.csv").write_text("id,frame,time_s,floor_w_m2\nabc,0,0.0,101.0\nabd,1,0.5\n")
+    one_line_error(capsys, ["report", str(tmp_path)], "other length than the header")
+
+
+@pytest.mark.parametrize("text", ["0,1\n400,0.2\n500,0.3\n700,0.4\n",  # pandas' unnamed columns
+                                  "\ufeff400,0.2\n500,0.3\n700,0.4\n",  # a byte-order mark
+                                  "\ufeffwavelength_nm,reflectance\n400,0.2\n500,0.3\n700,0.4\n"])
+def test_a_spectrum_header_is_told_from_data(tmp_path, text):
+    from warpcaustics.optics.spectra import read_spectrum_csv
+
+    (tmp_path / "a.csv").write_text(text, encoding="utf-8")
+    nm, values = read_spectrum_csv("a.csv", tmp_path, "floor.albedo_file", "reflectance", 1.0)
+    assert nm.tolist() == [400.0, 500.0, 700.0] and values.tolist() == [0.2, 0.3, 0.4]
+
+
+def test_a_mesh_in_millimetres_scaled_to_metres_loads(tmp_path):
+    """The scene's ±1e5 m bound applies once the mesh is scaled: a 150 m object saved in mm loads."""
+    (tmp_path / "mm.obj").write_text("v 0 0 0\nv 150000 0 0\nv 0 150000 0\nf 1 2 3\n")
+    scene = wc.load_scene(CONFIGS / "ocean.toml", {"caustics.method": "photons", "receivers": [
+        {"mesh": str(tmp_path / "mm.obj"), "scale": [0.001], "translate_m": [0.0, 0.0, -2.0]}]})
+    assert scene.config.receivers[0].scale == (0.001,)

@@ -154,3 +154,65 @@ def test_a_damaged_pool_checkpoint_starts_the_animation_again(tmp_path, monkeypa
     assert calls == list(task.times_s)  # from frame 0
     assert [r["frame"] for r in again["rows"]] == [0, 1, 2, 3]
     assert [r["floor_w_m2"] for r in again["rows"]] == [r["floor_w_m2"] for r in clean["rows"]]
+
+
+def test_a_wave_pool_resumes_from_a_clean_checkpoint(tmp_path, monkeypatch):
+    """The wave pool stops at the last of its fixed steps before a frame's time, so its saved time is
+    up to a step early: a clean checkpoint must still resume (only the frames after it render)."""
+    from warpcaustics import pipeline
+
+    path = tmp_path / "wavepool.toml"
+    path.write_text(POOL.format(base=(CONFIGS / "wavepool.toml").as_posix()))
+    task = load_sweep(path).tasks[0]
+    assert task.stateful
+    base = str(CONFIGS / "wavepool.toml")
+    clean = run_task(base, task, str(tmp_path / "clean"), "cpu")
+    real_render = pipeline.Renderer.render
+    calls = []
+
+    def interrupted(self, time_s):
+        calls.append(time_s)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real_render(self, time_s)
+
+    monkeypatch.setattr(pipeline.Renderer, "render", interrupted)
+    out = tmp_path / "resumed"
+    out.mkdir()
+    with pytest.raises(KeyboardInterrupt):
+        run_task(base, task, str(out), "cpu")
+    calls.clear()
+    monkeypatch.setattr(pipeline.Renderer, "render",
+                        lambda self, t: (calls.append(t), real_render(self, t))[1])
+    resumed = run_task(base, task, str(out), "cpu")
+    assert calls == list(task.times_s[2:])
+    assert [r["floor_w_m2"] for r in resumed["rows"]] == [r["floor_w_m2"] for r in clean["rows"]]
+
+
+def test_a_pool_task_replaces_a_file_where_its_folder_goes(tmp_path):
+    path = tmp_path / "pool.toml"
+    path.write_text(POOL.format(base=(CONFIGS / "pool.toml").as_posix()))
+    task = load_sweep(path).tasks[0]
+    (tmp_path / task.id).write_text("not a folder")
+    run_task(str(CONFIGS / "pool.toml"), task, str(tmp_path), "cpu")
+    assert (tmp_path / task.id / "run.json").exists()
+
+
+def test_a_record_whose_rows_hold_lists_is_a_record():
+    """A resumed pool animation's earlier rows come back from its checkpoint with arrays as JSON lists
+    (photon tallies with bounces); such a record is whole, not damaged."""
+    from warpcaustics.batch.sweep import _is_record
+
+    row = {"id": "a", "frame": 0, "time_s": 0.0, "floor_w_m2": 1.0, "contrast": 0.1, "cv": 0.1,
+           "render_s": 0.5, "photons_reflected_w_nm": [0.1, 0.2]}
+    assert _is_record({"id": "a", "state": "done", "rows": [row]})
+    assert not _is_record({"id": "a", "state": "done", "rows": [{**row, "cv": "x"}]})
+
+
+def test_a_finished_sweep_reruns_without_its_device(swept, monkeypatch):
+    """Rerunning a finished sweep (to write its summary again) renders nothing, so it needs no device:
+    one configured for CUDA reruns on a machine without one."""
+    sweep, out, rerun = swept
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "cuda:7")
+    report = run_sweep(sweep, out, quiet=True)
+    assert report.skipped == 2 and not report.failed

@@ -38,9 +38,9 @@ def _summary_rows(path: Path) -> list[dict]:
     for k, row in enumerate(rows):
         missing = [c for c in needed if not row.get(c)]
         numbers = [c for c, _ in STAT_AXES if row.get(c) not in (None, "") and not _is_float(row[c])]
-        if missing or numbers or None in row:
+        if missing or numbers or None in row or None in row.values():
             what = (f"no {missing[0]!r}" if missing else f"{numbers[0]} = {row[numbers[0]]!r} is not a "
-                    "number" if numbers else "more cells than columns")
+                    "number" if numbers else "a row of other length than the header")
             raise WarpcausticsError(f"{str(path)!r} is not a sweep summary (row {k + 1}: {what}); {fix}")
     return rows
 

@@ -93,7 +93,7 @@ def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
     for key in scene_overrides:
         check_key(key, "study [overrides]")
         if key in STUDY_SETS:
-            raise ConfigError(f"study [overrides] sets {key}, which the study sets from its own "
+            raise ConfigError(f"study [overrides] (or --set) sets {key}, which the study sets from its own "
                               f"{STUDY_SETS[key]}; remove it and list the values in {STUDY_SETS[key]}")
     return StudyConfig(path.parent / table["scene"], tuple(water_types), depths, elevations, scene_overrides)
 

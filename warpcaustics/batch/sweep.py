@@ -317,6 +317,13 @@ NUMBER_COLUMNS = ("frame", "time_s", "floor_w_m2", "contrast", "cv", "render_s")
 """A summary row's columns that are numbers in every sweep (``warpcaustics report`` plots some)."""
 
 
+def _anything_to_render(out: Path, sweep: Sweep) -> bool:
+    """Whether a rerun into ``out`` renders anything (read only: before the folder is claimed)."""
+    records = read_manifest(out) if out.is_dir() else {}
+    return any(task.error is None and not (records.get(task.id, {}).get("state") == "done"
+                                           and _finished(out / task.id, task)) for task in sweep.tasks)
+
+
 def _finished(folder: Path, task: Task) -> bool:
     """Whether a task's folder holds its finished run: a ``run.json`` that reads as one, with a record
     for each of its frames and that frame's statistics (a damaged one renders again)."""
@@ -329,16 +336,15 @@ def _finished(folder: Path, task: Task) -> bool:
 
 
 def _is_record(rec) -> bool:
-    """A task's manifest record: an id, and if done, its rows of numbers and text."""
+    """A task's manifest record: an id, and if done, its rows, whose statistics are numbers."""
     if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)):
         return False
     if rec.get("state") != "done":
         return True
     rows = rec.get("rows")
-    cells = (int, float, str, bool, type(None))
     return isinstance(rows, list) and bool(rows) and all(
-        isinstance(row, dict) and all(isinstance(v, cells) for v in row.values())
-        and all(isinstance(row.get(c, 0.0), (int, float)) for c in NUMBER_COLUMNS) for row in rows)
+        isinstance(row, dict) and all(isinstance(row.get(c, 0.0), (int, float)) for c in NUMBER_COLUMNS)
+        for row in rows)
 
 
 def _append(out_dir: Path, record: dict) -> None:
@@ -419,7 +425,8 @@ def run_sweep(
         configured = {t.config.get("device", "auto") for t in sweep.tasks if t.config}
         if device is not None:
             device = resolve_device(device)
-        elif len(configured) == 1:  # the config's device (or $WARPCAUSTICS_DEVICE), said once
+        elif len(configured) == 1 and _anything_to_render(Path(out_dir), sweep):
+            # the config's device (or $WARPCAUSTICS_DEVICE), said once; a finished sweep needs none
             device = resolve_device(None, config_value=configured.pop())
     out = Path(out_dir)
     if out.exists() and not out.is_dir():

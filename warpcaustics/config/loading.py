@@ -278,9 +278,9 @@ def read_toml(path: str | Path) -> dict:
     """Read a TOML file, turning a missing or malformed file into a one-line ConfigError."""
     path = Path(path)
     try:
-        if path.exists() and not path.is_dir() and not path.is_file():  # reading would never end
-            raise ConfigError(f"config file {_describe(str(path))} is not a regular file (a device or a "
-                              "pipe); give the path of a .toml file")
+        if path.is_char_device() or path.is_block_device():  # reading would never end (a pipe may)
+            raise ConfigError(f"config file {_describe(str(path))} is a device, not a file; give the path "
+                              "of a .toml file")
         text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # an editor's byte-order mark
     except FileNotFoundError:
         raise ConfigError(f"config file {_describe(str(path))} does not exist; check the path") from None

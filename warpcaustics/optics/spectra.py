@@ -239,12 +239,13 @@ MAX_SPECTRUM_VALUE = 1e30
 
 
 def _numbers_only(line: str) -> bool:
-    """Whether a CSV line is data (every cell a number) rather than a header."""
+    """Whether a CSV line is data (every cell a number, the first a wavelength above 0) rather than a
+    header (pandas writes column names 0,1 for an unnamed table)."""
     try:
-        [float(cell) for cell in line.split(",")]
+        cells = [float(cell) for cell in line.split(",")]
     except ValueError:
         return False
-    return bool(line.strip())
+    return bool(line.strip()) and cells[0] > 0.0
 
 
 def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
@@ -254,11 +255,12 @@ def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
 
     path = input_file(key, name, base_dir, f"a CSV of wavelength_nm,{quantity}")
     try:
-        with open(path, encoding="utf-8") as fh:
+        with open(path, encoding="utf-8-sig") as fh:  # an editor's byte-order mark is not a cell
             first = fh.readline()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # an empty file: numpy warns, then we say it in one line
-            data = np.loadtxt(path, delimiter=",", skiprows=0 if _numbers_only(first) else 1, ndmin=2)
+            data = np.loadtxt(path, delimiter=",", skiprows=0 if _numbers_only(first) else 1, ndmin=2,
+                              encoding="utf-8-sig")
     except (OSError, ValueError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
         raise ConfigError(f"{key} = {str(path)!r} cannot be read as CSV (header line, then "
@@ -266,9 +268,9 @@ def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
     upper = min(upper, MAX_SPECTRUM_VALUE)
     if data.shape[1] < 2 or len(data) < 2 or not np.all(np.diff(data[:, 0]) > 0) \
             or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0) or np.any(data[:, 1] > upper) \
-            or np.any(np.abs(data[:, 0]) > MAX_SPECTRUM_VALUE):
+            or data[0, 0] <= 0.0 or np.any(data[:, 0] > MAX_SPECTRUM_VALUE):
         bound = f" and at most {upper:g}"
-        raise ConfigError(f"{key} = {str(path)!r} needs two columns, wavelengths strictly "
+        raise ConfigError(f"{key} = {str(path)!r} needs two columns, wavelengths [nm] above 0, strictly "
                           f"increasing and finite, non-negative {quantity} values{bound}")
     return data[:, 0], data[:, 1]
 

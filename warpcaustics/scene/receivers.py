@@ -144,6 +144,10 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
     rx, ry, rz = (math.radians(a) for a in receiver.rotate_deg)
     rotation = _rot_z(rz) @ _rot_y(ry) @ _rot_x(rx)
     points = (points * scale) @ rotation.T + np.asarray(receiver.translate_m)
+    if points.size and np.abs(points).max() > MAX_LENGTH_M:  # in the scene, after scale and placing
+        raise ConfigError(f"{key}.mesh = {receiver.mesh!r} reaches {np.abs(points).max():.3g} m from the "
+                          f"origin once scaled and placed; the scene lies within ±{MAX_LENGTH_M:g} m (check "
+                          f"the file's units against {key}.scale)")
     return TriangleMesh(points, triangles)
 
 
@@ -154,7 +158,8 @@ def _binary_stl_problem(path: Path) -> str | None:
         return None
     with open(path, "rb") as fh:
         head = fh.read(84)
-        ascii_start = head.lstrip().lower().startswith(b"solid") and b"facet" in fh.read(1024).lower()
+        start = (head + fh.read(4096)).lower()
+    ascii_start = start.removeprefix(b"\xef\xbb\xbf").lstrip().startswith(b"solid") and b"facet" in start
     if ascii_start or len(head) < 84:
         return None  # ASCII, or too short to say: the reader reports it
     declared = int.from_bytes(head[80:84], "little")
@@ -167,7 +172,7 @@ def _binary_stl_problem(path: Path) -> str | None:
 
 def _mesh_problem(data, pv) -> str | None:
     """What makes a mesh unusable before any filter touches it: faces that name vertices it does not
-    hold (VTK's filters then read past the end), vertices that are not finite or beyond ±1e5 m."""
+    hold (VTK's filters then read past the end), vertices that are not finite."""
     n = data.n_points if hasattr(data, "n_points") else 0
     if isinstance(data, pv.PolyData):
         cells = [pv.convert_array(getattr(data, kind)().GetConnectivityArray())
@@ -184,8 +189,6 @@ def _mesh_problem(data, pv) -> str | None:
     points = np.asarray(data.points, np.float64) if n else np.zeros((0, 3))
     if not np.all(np.isfinite(points)):
         return "has vertices that are not finite numbers"
-    if points.size and np.abs(points).max() > MAX_LENGTH_M:
-        return f"has a vertex {np.abs(points).max():.3g} m out; vertices must lie within ±{MAX_LENGTH_M:g} m"
     return None
 
 
