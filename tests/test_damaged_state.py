@@ -102,34 +102,49 @@ fps = 4.0
 """
 
 
+def interrupted_animation(tmp_path, monkeypatch, config: str):
+    """A pool animation of 4 frames rendered whole (its rows), then again into ``tmp_path/out``
+    stopped during its third frame, and a function that reruns it there and returns its rows and the
+    times it rendered."""
+    from warpcaustics import pipeline
+
+    path = tmp_path / "anim.toml"
+    path.write_text(POOL.format(base=(CONFIGS / config).as_posix()))
+    task = load_sweep(path).tasks[0]
+    assert task.stateful and len(task.times_s) == 4
+    base = str(CONFIGS / config)
+    clean = run_task(base, task, str(tmp_path / "clean"), "cpu")["rows"]
+    real_render = pipeline.Renderer.render
+    calls = []
+
+    def counted(self, time_s):
+        calls.append(time_s)
+        if len(calls) == 3 and stop:
+            raise KeyboardInterrupt
+        return real_render(self, time_s)
+
+    stop = True
+    monkeypatch.setattr(pipeline.Renderer, "render", counted)
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.raises(KeyboardInterrupt):
+        run_task(base, task, str(out), "cpu")
+
+    def rerun():
+        nonlocal stop
+        stop = False
+        calls.clear()
+        return run_task(base, task, str(out), "cpu")["rows"], list(calls)
+
+    return task, clean, out / f".{task.id}.partial", rerun
+
+
 @pytest.mark.parametrize("damage", ["cut npz", "list json", "one entry", "other time", "nan state"])
 def test_a_damaged_pool_checkpoint_starts_the_animation_again(tmp_path, monkeypatch, damage):
     """Cut short, not the pair written together, or a state that is not this animation's at its last
     frame: the checkpoint is dropped and the animation rendered from frame 0, to the same frames as
     an uninterrupted run (it had failed the task on every rerun, or resumed into wrong frames)."""
-    from warpcaustics import pipeline
-
-    path = tmp_path / "pool.toml"
-    path.write_text(POOL.format(base=(CONFIGS / "pool.toml").as_posix()))
-    task = load_sweep(path).tasks[0]
-    base = str(CONFIGS / "pool.toml")
-    clean = run_task(base, task, str(tmp_path / "clean"), "cpu")
-
-    real_render = pipeline.Renderer.render
-    calls = []
-
-    def interrupted(self, time_s):
-        calls.append(time_s)
-        if len(calls) == 3:
-            raise KeyboardInterrupt
-        return real_render(self, time_s)
-
-    monkeypatch.setattr(pipeline.Renderer, "render", interrupted)
-    out = tmp_path / "damaged"
-    out.mkdir()
-    with pytest.raises(KeyboardInterrupt):
-        run_task(base, task, str(out), "cpu")
-    partial = out / f".{task.id}.partial"
+    task, clean, partial, rerun = interrupted_animation(tmp_path, monkeypatch, "pool.toml")
     npz, meta = partial / CHECKPOINT, partial / CHECKPOINT_META
     if damage == "cut npz":
         npz.write_bytes(npz.read_bytes()[:100])
@@ -147,46 +162,19 @@ def test_a_damaged_pool_checkpoint_starts_the_animation_again(tmp_path, monkeypa
         else:
             state["h"] = np.full_like(state["h"], np.nan)
         np.savez(npz, **state)
-    calls.clear()
-    monkeypatch.setattr(pipeline.Renderer, "render",
-                        lambda self, t: (calls.append(t), real_render(self, t))[1])
-    again = run_task(base, task, str(out), "cpu")
-    assert calls == list(task.times_s)  # from frame 0
-    assert [r["frame"] for r in again["rows"]] == [0, 1, 2, 3]
-    assert [r["floor_w_m2"] for r in again["rows"]] == [r["floor_w_m2"] for r in clean["rows"]]
+    rows, rendered = rerun()
+    assert rendered == list(task.times_s)  # from frame 0
+    assert [r["frame"] for r in rows] == [0, 1, 2, 3]
+    assert [r["floor_w_m2"] for r in rows] == [r["floor_w_m2"] for r in clean]
 
 
 def test_a_wave_pool_resumes_from_a_clean_checkpoint(tmp_path, monkeypatch):
     """The wave pool stops at the last of its fixed steps before a frame's time, so its saved time is
     up to a step early: a clean checkpoint must still resume (only the frames after it render)."""
-    from warpcaustics import pipeline
-
-    path = tmp_path / "wavepool.toml"
-    path.write_text(POOL.format(base=(CONFIGS / "wavepool.toml").as_posix()))
-    task = load_sweep(path).tasks[0]
-    assert task.stateful
-    base = str(CONFIGS / "wavepool.toml")
-    clean = run_task(base, task, str(tmp_path / "clean"), "cpu")
-    real_render = pipeline.Renderer.render
-    calls = []
-
-    def interrupted(self, time_s):
-        calls.append(time_s)
-        if len(calls) == 3:
-            raise KeyboardInterrupt
-        return real_render(self, time_s)
-
-    monkeypatch.setattr(pipeline.Renderer, "render", interrupted)
-    out = tmp_path / "resumed"
-    out.mkdir()
-    with pytest.raises(KeyboardInterrupt):
-        run_task(base, task, str(out), "cpu")
-    calls.clear()
-    monkeypatch.setattr(pipeline.Renderer, "render",
-                        lambda self, t: (calls.append(t), real_render(self, t))[1])
-    resumed = run_task(base, task, str(out), "cpu")
-    assert calls == list(task.times_s[2:])
-    assert [r["floor_w_m2"] for r in resumed["rows"]] == [r["floor_w_m2"] for r in clean["rows"]]
+    task, clean, _, rerun = interrupted_animation(tmp_path, monkeypatch, "wavepool.toml")
+    rows, rendered = rerun()
+    assert rendered == list(task.times_s[2:])
+    assert [r["floor_w_m2"] for r in rows] == [r["floor_w_m2"] for r in clean]
 
 
 def test_a_pool_task_replaces_a_file_where_its_folder_goes(tmp_path):
