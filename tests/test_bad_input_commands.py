@@ -337,3 +337,17 @@ def test_a_mesh_in_millimetres_scaled_to_metres_loads(tmp_path):
     scene = wc.load_scene(CONFIGS / "ocean.toml", {"caustics.method": "photons", "receivers": [
         {"mesh": str(tmp_path / "mm.obj"), "scale": [0.001], "translate_m": [0.0, 0.0, -2.0]}]})
     assert scene.config.receivers[0].scale == (0.001,)
+
+
+def test_info_tells_the_device_a_render_would_take(capsys, monkeypatch):
+    """`info` had printed "default device: cpu" for a $WARPCAUSTICS_DEVICE that every render refuses,
+    and a blank value had been refused as device = '' where an empty one means auto."""
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "garbage")
+    assert cli.main(["info"]) == 0
+    assert "default device: none: device = 'garbage' is not allowed" in capsys.readouterr().out
+    monkeypatch.setenv("WARPCAUSTICS_DEVICE", "   ")
+    assert cli.main(["info"]) == 0
+    assert "default device: " in capsys.readouterr().out
+    from warpcaustics.device import resolve_device
+
+    assert resolve_device(None, config_value="cpu") == "cpu"

@@ -420,7 +420,12 @@ def _info() -> int:
     for d in wp.get_devices():
         extra = f"  {d.total_memory / 1024**3:.1f} GiB" if d.is_cuda else ""
         print(f"  {d.alias:8s}{d.name}{extra}")
-    default = "cuda:0" if wp.get_cuda_device_count() else "cpu"
+    from warpcaustics.device import resolve_device
+
+    try:  # what a render without --device would take: $WARPCAUSTICS_DEVICE first, as a render reads it
+        default = resolve_device(None)
+    except WarpcausticsError as exc:
+        default = f"none: {exc}"
     print(f"default device: {default}  (override: --device or ${DEVICE_ENV}="
           f"{os.environ.get(DEVICE_ENV, '')})")
     return 0

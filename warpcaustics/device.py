@@ -56,7 +56,8 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
     """
     if requested is not None and not isinstance(requested, str):
         raise DeviceError(f"device = {requested!r} must be a name: auto, cpu, cuda or cuda:N")
-    choice = requested or os.environ.get(DEVICE_ENV) or config_value or "auto"
+    from_env = (os.environ.get(DEVICE_ENV) or "").strip() or None  # set but blank: not set
+    choice = requested or from_env or config_value or "auto"
     choice = choice.strip().lower()
     wp = _warp()
     if choice == "cpu":
