@@ -217,15 +217,22 @@ def _out_folder(text: str) -> Path:
     return out
 
 
-@contextlib.contextmanager
-def _made_out(out: Path):
-    """Make ``out`` now, before anything renders (one line if it cannot be made), and remove what
-    this made if the command fails before it is done: no folder left behind as if it were a result."""
-    made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)  # the first folder made
+def _make(out: Path) -> Path | None:
+    """Make the folder ``out`` (one line if it cannot be made); the first folder this made (None: it
+    was there), which a command that fails removes."""
+    made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
+    return made
+
+
+@contextlib.contextmanager
+def _made_out(out: Path):
+    """Make ``out`` now, before anything renders, and remove what this made if the command fails
+    before it is done: no folder left behind as if it were a result."""
+    made = _make(out)
     try:
         yield out
     except BaseException:
@@ -259,11 +266,7 @@ def _render(args: argparse.Namespace) -> int:
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
-    made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)  # the first folder made
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
+    made = _make(out)
     results = []
     from warpcaustics.batch.sweep import Progress
     from warpcaustics.io.manifest import claim
@@ -440,7 +443,7 @@ def one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        if args.command not in ("preview", "report") and isinstance(getattr(args, "out", None), str):
+        if args.command in ("sweep", "field"):  # render, study and compare check theirs as they use it
             _out_folder(args.out)  # an empty --out would write into the working folder
         if args.command == "render":
             return _render(args)

@@ -317,11 +317,12 @@ NUMBER_COLUMNS = ("frame", "time_s", "floor_w_m2", "contrast", "cv", "render_s")
 """A summary row's columns that are numbers in every sweep (``warpcaustics report`` plots some)."""
 
 
-def _anything_to_render(out: Path, sweep: Sweep) -> bool:
-    """Whether a rerun into ``out`` renders anything (read only: before the folder is claimed)."""
+def _finished_ids(out: Path, sweep: Sweep) -> set[str]:
+    """The tasks a rerun into ``out`` skips: recorded as done, their folders whole (read only, so it
+    can be asked before the folder is claimed)."""
     records = read_manifest(out) if out.is_dir() else {}
-    return any(task.error is None and not (records.get(task.id, {}).get("state") == "done"
-                                           and _finished(out / task.id, task)) for task in sweep.tasks)
+    return {task.id for task in sweep.tasks
+            if records.get(task.id, {}).get("state") == "done" and _finished(out / task.id, task)}
 
 
 def _finished(folder: Path, task: Task) -> bool:
@@ -419,16 +420,17 @@ def run_sweep(
         raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
     if workers < 1:
         raise WarpcausticsError(f"--workers = {workers} must be at least 1")
+    out = Path(out_dir)
+    finished = _finished_ids(out, sweep)
     if executor == "local":  # checked once here, before anything is written
         from warpcaustics.device import resolve_device
 
         configured = {t.config.get("device", "auto") for t in sweep.tasks if t.config}
         if device is not None:
             device = resolve_device(device)
-        elif len(configured) == 1 and _anything_to_render(Path(out_dir), sweep):
+        elif len(configured) == 1 and any(t.error is None and t.id not in finished for t in sweep.tasks):
             # the config's device (or $WARPCAUSTICS_DEVICE), said once; a finished sweep needs none
             device = resolve_device(None, config_value=configured.pop())
-    out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     try:
@@ -438,7 +440,6 @@ def run_sweep(
     _claim(out, sweep, force)
     for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
         shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
-    records = read_manifest(out)
     report = SweepReport()
     todo = []
     for task in sweep.tasks:
@@ -455,8 +456,7 @@ def run_sweep(
             )
             report.failed.append((task.id, task.error))
             continue
-        rec = records.get(task.id)
-        if rec is not None and rec.get("state") == "done" and _finished(out / task.id, task):
+        if task.id in finished:
             report.skipped += 1
         else:
             todo.append(task)

@@ -71,6 +71,12 @@ CHECKPOINT = "checkpoint.npz"
 CHECKPOINT_META = "checkpoint.json"
 
 
+def _at_frame(saved_s: float, frame_s: float, renderer) -> bool:
+    """Whether a pool saved at ``saved_s`` stood at the frame of ``frame_s``: the pool stops at its
+    frame's time, the wave pool at the last of its fixed steps before it."""
+    return -1e-6 <= frame_s - saved_s <= getattr(renderer.water, "dt", 0.0) + 1e-6
+
+
 def _resume(partial: Path, renderer, task: Task) -> tuple[list[dict], list[dict]]:
     """The frames' records and summary rows of an interrupted pool animation, its pool's state loaded
     into ``renderer``; none (start again at frame 0) when there is no checkpoint or it cannot be
@@ -86,10 +92,8 @@ def _resume(partial: Path, renderer, task: Task) -> tuple[list[dict], list[dict]
         done = int(state.pop("frames_done"))
         entries, rows = meta["entries"], meta["rows"]
         state["time_s"] = float(state["time_s"])
-        # the pool stops at its frame's time; the wave pool at the last of its fixed steps before it
-        behind = task.times_s[done - 1] - state["time_s"] if done > 0 else -1.0
         trusted = (done == meta["frames_done"] and 0 < done <= len(task.times_s) and len(entries) == done
-                   and len(rows) == done and -1e-6 <= behind <= getattr(renderer.water, "dt", 0.0) + 1e-6
+                   and len(rows) == done and _at_frame(state["time_s"], task.times_s[done - 1], renderer)
                    and all(a.dtype.kind in "fiu" and np.all(np.isfinite(a)) for a in state.values()
                            if isinstance(a, np.ndarray)))
         if trusted:
