@@ -104,11 +104,6 @@ MAX_TIME_S = 1e9
 random-phase sea looks the same at any time, so nothing is lost by the bound)."""
 
 
-def _short_repr(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def check_time(name: str, time_s: float) -> None:
     """Refuse a render time that is not finite or beyond :data:`MAX_TIME_S`, in one line naming
     ``name`` (a flag or an argument)."""
@@ -130,7 +125,7 @@ class Renderer:
     def __init__(self, scene: Scene, device: str | None = None):
         if not isinstance(scene, Scene):
             raise ConfigError(f"a render takes a Scene from warpcaustics.load_scene(path); got "
-                              f"{type(scene).__name__} {_short_repr(scene)}")
+                              f"{type(scene).__name__} {scene!r:.60}")
         cfg = scene.config
         self.scene = scene
         self.device = devices.resolve_device(device, config_value=cfg.device.value)
