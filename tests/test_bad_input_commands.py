@@ -168,6 +168,16 @@ def test_cuda_minus_one_is_refused():
         _cuda_index("cuda:-1")
 
 
+@pytest.mark.parametrize("name", ["cuda:x", "cuda:-1", "cuda:"])
+def test_a_malformed_cuda_name_is_told_its_form_with_or_without_a_gpu(name):
+    """The name's fix does not depend on the machine: it had been told 'no CUDA device' without one."""
+    from warpcaustics.device import resolve_device
+    from warpcaustics.errors import DeviceError
+
+    with pytest.raises(DeviceError, match=f"device = '{name}' is not allowed; use cuda:N"):
+        resolve_device(name)
+
+
 def test_a_column_too_deep_for_the_small_angle_transfer_is_refused_before_rendering(tmp_path, capsys):
     """Turbid water 100 m deep: the unscattered map underflows float32 and the transfer had printed
     overflow warnings, then walked its spread for minutes or ended in 'not finite'."""
@@ -224,6 +234,17 @@ def test_preview_names_its_output_problem_not_pyvista(tmp_path, capsys):
                             *TINY], "is a folder")
 
 
+def test_preview_keeps_vtk_s_own_warnings_off_the_terminal(tmp_path, capfd, monkeypatch):
+    """Without an X server VTK logged "bad X server connection" from C++ before every preview,
+    though the picture was drawn; nothing but our own lines reaches stderr now."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    assert cli.main(["preview", str(CONFIGS / "ocean.toml"), "--out", str(tmp_path / "p.png"), *TINY]) == 0
+    err = capfd.readouterr().err
+    assert (tmp_path / "p.png").stat().st_size > 0
+    ours = ("warpcaustics:", "Warp")
+    assert [line for line in err.splitlines() if line and not line.startswith(ours)] == []
+
+
 def test_a_ray_address_without_the_ray_executor_is_refused(tmp_path, capsys):
     one_line_error(capsys, ["sweep", str(CONFIGS / "sweeps" / "water_types.toml"), "--out",
                             str(tmp_path / "s"), "--address", "auto"], "--executor ray")
@@ -246,6 +267,14 @@ def test_a_spectrum_of_1e308_is_refused_before_it_overflows(tmp_path):
         wc.load_scene(CONFIGS / "ocean.toml", {"sun.spectrum": "file", "sun.file": str(tmp_path / "big.csv")})
 
 
+def test_a_spectrum_file_of_several_columns_is_refused_not_read_by_its_first(tmp_path):
+    """A third column (ASTM G173's layout: three spectra) had been ignored without a word."""
+    path = tmp_path / "g173.csv"
+    path.write_text("nm,etr,global,direct\n380,1.1,0.4,0.3\n780,1.2,1.0,0.9\n")
+    with pytest.raises(wc.ConfigError, match="sun.file = .* has 4 columns; it needs two, wavelength_nm,"):
+        wc.load_scene(CONFIGS / "ocean.toml", {"sun.spectrum": "file", "sun.file": str(path)})
+
+
 def receiver_scene(mesh):
     return {"caustics.method": "photons", "receivers": [{"mesh": str(mesh), "translate_m": [0.0, 0.0, -1.0]}]}
 
@@ -263,6 +292,40 @@ def test_a_broken_receiver_mesh_is_one_line(tmp_path, name, content, needle):
     path = tmp_path / name
     path.write_bytes(content if isinstance(content, bytes) else content.encode())
     with pytest.raises(wc.ConfigError, match=r"receivers\[0\].mesh = .*" + needle):
+        wc.load_scene(CONFIGS / "ocean.toml", receiver_scene(path))
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".obj"])
+def test_a_mesh_file_with_a_byte_order_mark_reads_as_without(tmp_path, suffix):
+    """VTK's STL reader read nothing of an ASCII STL an editor had saved with a UTF-8 BOM ("has no
+    triangles"); its OBJ reader drops the line the BOM sits on (here the first vertex)."""
+    import pyvista as pv
+
+    from warpcaustics.config import ReceiverConfig
+    from warpcaustics.scene.receivers import load_receiver_mesh
+
+    sphere = pv.Sphere(theta_resolution=8, phi_resolution=6).triangulate()
+    plain = tmp_path / f"plain{suffix}"
+    sphere.save(plain, binary=False) if suffix == ".stl" else sphere.save(plain)
+    text = plain.read_bytes()
+    if suffix == ".obj":
+        text = b"".join(line for line in text.splitlines(keepends=True) if not line.startswith(b"#"))
+        plain.write_bytes(text)
+    assert text[:1] in (b"s", b"v")  # the BOM goes on the line that matters
+    bom = tmp_path / f"bom{suffix}"
+    bom.write_bytes(b"\xef\xbb\xbf" + text)
+    a = load_receiver_mesh(ReceiverConfig(mesh=str(plain)), tmp_path, "receivers[0]")
+    b = load_receiver_mesh(ReceiverConfig(mesh=str(bom)), tmp_path, "receivers[0]")
+    assert len(a.triangles) == sphere.n_cells
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    np.testing.assert_array_equal(a.points, b.points)
+
+
+def test_a_file_that_is_no_mesh_says_so(tmp_path):
+    path = tmp_path / "picture.obj"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)))
+    with pytest.raises(wc.ConfigError, match="no triangles: an empty mesh, or a file pyvista could not make "
+                                             "sense of"):
         wc.load_scene(CONFIGS / "ocean.toml", receiver_scene(path))
 
 

@@ -71,11 +71,11 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
             _notice_given = True
         return "cpu"
     if choice == "cuda" or choice.startswith("cuda:"):
+        index = 0 if choice == "cuda" else _cuda_index(choice)  # the name's form first: its fix is the name
         count = wp.get_cuda_device_count()
         if count == 0:
             raise DeviceError(f"device = {choice!r} was asked for but no CUDA device is available "
                               f"(driver missing or no GPU); use --device cpu or device = \"auto\"")
-        index = 0 if choice == "cuda" else _cuda_index(choice)
         if index >= count:
             raise DeviceError(f"device = {choice!r} does not exist; this machine has {count} CUDA "
                               f"device(s): cuda:0..cuda:{count - 1}")

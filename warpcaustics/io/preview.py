@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +17,28 @@ import numpy as np
 from warpcaustics.errors import WarpcausticsError
 
 
+@contextmanager
+def vtk_errors_only():
+    """VTK's own log on stderr cut to its errors: an off-screen window without an X server logs a
+    warning ("bad X server connection") from C++ every time, though it renders; a failure still
+    reaches us as an exception, which we report in one line."""
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    previous = vtkLogger.GetCurrentVerbosityCutoff()
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+    try:
+        yield
+    finally:
+        vtkLogger.SetStderrVerbosity(previous)
+
+
 def preview_png(result, path: Path, *, width: int = 960, height: int = 640) -> Path:
     """Draw ``result`` (a RenderResult) into a PNG at ``path`` (written atomically)."""
+    with vtk_errors_only():
+        return _draw(result, path, width, height)
+
+
+def _draw(result, path: Path, width: int, height: int) -> Path:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         import pyvista as pv

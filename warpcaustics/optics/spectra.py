@@ -266,6 +266,9 @@ def read_spectrum_csv(name: str, base_dir: Path | None, key: str = "sun.file",
         raise ConfigError(f"{key} = {str(path)!r} cannot be read as CSV (header line, then "
                           f"wavelength_nm,{quantity}): {reason}") from None
     upper = min(upper, MAX_SPECTRUM_VALUE)
+    if data.shape[1] > 2:  # which of the values is meant? (ASTM G173, say, holds three spectra)
+        raise ConfigError(f"{key} = {str(path)!r} has {data.shape[1]} columns; it needs two, wavelength_nm,"
+                          f"{quantity}: keep the one {quantity} column you mean")
     if data.shape[1] < 2 or len(data) < 2 or not np.all(np.diff(data[:, 0]) > 0) \
             or not np.all(np.isfinite(data[:, :2])) or np.any(data[:, 1] < 0) or np.any(data[:, 1] > upper) \
             or data[0, 0] <= 0.0 or np.any(data[:, 0] > MAX_SPECTRUM_VALUE):

@@ -10,6 +10,8 @@ from __future__ import annotations
 import functools
 import logging
 import math
+import shutil
+import tempfile
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -125,8 +127,8 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
             problem = _binary_stl_problem(path)
             try:
                 if problem is None:
-                    with quiet_vtk():
-                        poly = pv.read(str(path))
+                    with quiet_vtk(), _without_bom(path) as readable:
+                        poly = pv.read(str(readable))
             except Exception as exc:  # pyvista raises many kinds for unreadable files
                 raise ConfigError(
                     f"{key}.mesh = {receiver.mesh!r} cannot be read by pyvista: "
@@ -137,7 +139,9 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
                 raise ConfigError(f"{key}.mesh = {receiver.mesh!r} {problem}; repair or re-export it")
         poly = poly.extract_surface().triangulate().clean()
     if poly.n_cells == 0:
-        raise ConfigError(f"{key}.mesh = {receiver.mesh!r} has no triangles")
+        raise ConfigError(f"{key}.mesh = {receiver.mesh!r} has no triangles: an empty mesh, or a file "
+                          f"pyvista could not make sense of (check that it is a mesh in the format its "
+                          f"suffix names)")
     points = np.asarray(poly.points, np.float64)
     triangles = np.asarray(poly.faces, np.int64).reshape(-1, 4)[:, 1:]
     scale = np.broadcast_to(np.asarray(receiver.scale, np.float64), (3,))
@@ -149,6 +153,24 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
                           f"origin once scaled and placed; the scene lies within ±{MAX_LENGTH_M:g} m (check "
                           f"the file's units against {key}.scale)")
     return TriangleMesh(points, triangles)
+
+
+@contextmanager
+def _without_bom(path: Path):
+    """The file, or a copy of it without the UTF-8 byte-order mark some editors write at the start of
+    text files: VTK's STL reader reads none of such a file, its OBJ reader loses the first line."""
+    with open(path, "rb") as fh:
+        start = fh.read(64)
+        fh.seek(3)
+        binary_stl = path.suffix.lower() == ".stl" and not start[3:].lstrip().lower().startswith(b"solid")
+        if not start.startswith(b"\xef\xbb\xbf") or binary_stl:  # a binary STL's header is any 80 bytes
+            yield path
+            return
+        with tempfile.TemporaryDirectory() as folder:
+            copy = Path(folder) / path.name
+            with open(copy, "wb") as out:
+                shutil.copyfileobj(fh, out)
+            yield copy
 
 
 def _binary_stl_problem(path: Path) -> str | None:
