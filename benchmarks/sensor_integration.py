@@ -21,7 +21,9 @@ E(t) sampled at 6 Hz for SECONDS at 8 × 8 points of the window, its CV per poin
 90th percentiles, and all samples pooled) beside the spatial CV of the same maps: when do the two
 agree? Also the period of the strongest fluctuation (the points' mean periodogram's peak; the
 paper's T_max, in the `jerlov` record) and the CV and that period left after running means of 1/3,
-1/2, 1 and 2 s of the samples (what a slow sensor would read).
+1/2, 1 and 2 s of the samples (what a slow sensor would read). ``--save NPZ`` keeps the samples;
+``--nest A.npz B.npz`` gives the same statistics of records of independent scales multiplied at each
+point (the scene's patch and the waves longer than it, as the field comparison nests them).
 """
 
 from __future__ import annotations
@@ -66,7 +68,7 @@ def field_window(zenith: float, quick: bool, start: dict | None = None, extra: d
     start = BEFORE if start is None else start
     scene = wc.load_scene(ROOT / "configs/field/gernez2009.toml", {**start, **overrides, **(extra or {})})
     cfg = scene.config
-    texel = cfg.caustics.map_extent_m / cfg.caustics.map_resolution
+    texel = (cfg.caustics.map_extent_m or cfg.water.extent_m) / cfg.caustics.map_resolution  # 0: the patch
     return wc.Renderer(scene, device="cpu"), cfg, texel, cfg.stats.collector_mm * 1e-3
 
 
@@ -98,12 +100,12 @@ def measure(zeniths, windows, dt_s: float, frames: int, quick: bool, start: dict
 
 
 def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quick: bool,
-                start: dict | None = None, extra: dict | None = None) -> dict:
+                start: dict | None = None, extra: dict | None = None, save: Path | None = None) -> dict:
     """The buoy's statistic beside the model's: the CV of E(t) at ``probes``² points of the window
     (the collector-averaged map sampled at ``rate_hz`` for ``seconds``; the median over points and
     the CV of all samples pooled) against the spatial CV of the same maps pooled — equal for a
     stationary, homogeneous sea once the record is long against the pattern's correlation time.
-    ``start`` and ``extra``: as :func:`field_window`'s."""
+    ``start`` and ``extra``: as :func:`field_window`'s; ``save``: an .npz for the samples."""
     renderer, cfg, texel, collector = field_window(zenith, quick, start, extra)
     m = cfg.caustics.map_resolution
     at = ((np.arange(probes) + 0.5) * m / probes).astype(int)  # probes spread evenly over the window
@@ -116,12 +118,23 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
     from warpcaustics.batch.field.common import pooled_statistics
 
     series = np.array(samples)  # (time, point)
+    if save is not None:
+        np.savez(save, series=series, rate_hz=rate_hz, sun_zenith_deg=zenith, overrides=repr(extra))
+    row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
+           **series_statistics(series, rate_hz), "cv_spatial": float(pooled_statistics(spatial)[1])}
+    row["wall_s"] = time.perf_counter() - start
+    _print(row)
+    return row
+
+
+def series_statistics(series: np.ndarray, rate_hz: float) -> dict:
+    """The statistics of (time, point) samples: each point's CV (median, 10th and 90th percentiles,
+    and all samples pooled), the period of the strongest fluctuation, and both after running means of
+    1/3, 1/2, 1 and 2 s of the samples (what a slow sensor would read)."""
     per_point = series.std(axis=0) / series.mean(axis=0)
     p10, p50, p90 = np.percentile(per_point, [10, 50, 90])
-    row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
-           "cv_time_median": float(p50), "cv_time_p10": float(p10), "cv_time_p90": float(p90),
+    row = {"cv_time_median": float(p50), "cv_time_p10": float(p10), "cv_time_p90": float(p90),
            "cv_time_pooled": float(series.std() / series.mean()),
-           "cv_spatial": float(pooled_statistics(spatial)[1]),
            "peak_period_s": peak_period(series, rate_hz)}
     # the CV left after a running mean of the 6 Hz samples over n of them (a sensor's response of
     # n/rate seconds, sampled as the buoy sampled: a coarse stand-in for a continuous average), and
@@ -133,7 +146,29 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
         smooth = np.apply_along_axis(lambda x, k=kernel: np.convolve(x, k, mode="valid"), 0, series)
         row[f"cv_time_mean_{n / rate_hz:.3g}s"] = float(np.median(smooth.std(axis=0) / smooth.mean(axis=0)))
         row[f"peak_period_mean_{n / rate_hz:.3g}s"] = peak_period(smooth, rate_hz)
-    row["wall_s"] = time.perf_counter() - start
+    return row
+
+
+def nested_series(paths: list[Path]) -> dict:
+    """The statistics of the light under seas of independent scales (the scene's patch, the waves
+    longer than it: ``--long-waves``), each saved by ``--series --save``: at a point E(t) is their
+    product, each over its own mean, as the field comparison nests their CVs (1 + CV² multiplies).
+    The records are paired point by point (any pairing of independent points will do) and cut to the
+    shortest."""
+    records = [np.load(path) for path in paths]
+    rates = {float(r["rate_hz"]) for r in records}
+    if len(rates) != 1:
+        raise SystemExit(f"--nest: the records were sampled at different rates {sorted(rates)}")
+    length = min(r["series"].shape[0] for r in records)
+    product = np.ones_like(records[0]["series"][:length], dtype=np.float64)
+    for r in records:
+        series = r["series"][:length].astype(np.float64)
+        product *= series / series.mean(axis=0)
+    row = {"records": " + ".join(str(p) for p in paths), "seconds": length / rates.pop(),
+           **series_statistics(product, float(records[0]["rate_hz"]))}
+    for path, r in zip(paths, records):
+        alone = series_statistics(r["series"][:length], float(r["rate_hz"]))
+        row[f"cv_time_median_{Path(path).stem}"] = alone["cv_time_median"]
     _print(row)
     return row
 
@@ -169,7 +204,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="the config as it is (not the set-up before issue 27, BEFORE)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="a config override on top (repeatable), e.g. water.resolution=2048")
+    parser.add_argument("--save", type=Path, metavar="NPZ",
+                        help="with --series: keep the samples (one zenith)")
+    parser.add_argument("--nest", nargs="+", type=Path, metavar="NPZ",
+                        help="instead: the statistics of records saved by --save, multiplied (nested seas)")
     args = parser.parse_args(argv)
+    if args.nest:
+        nested_series(args.nest)
+        return 0
     from warpcaustics.config import parse_override
 
     start = {} if args.configured else BEFORE
@@ -179,8 +221,11 @@ def main(argv: list[str] | None = None) -> int:
         time_series(20.0, 1.0, 6.0, 4, True)
         return 0
     if args.series > 0.0:
-        for zenith in args.zeniths.split(","):
-            time_series(float(zenith), args.series, 6.0, 8, False, start, extra)
+        zeniths = args.zeniths.split(",")
+        if args.save is not None and len(zeniths) > 1:
+            raise SystemExit("--save keeps one zenith's samples: give one in --zeniths")
+        for zenith in zeniths:
+            time_series(float(zenith), args.series, 6.0, 8, False, start, extra, args.save)
         return 0
     measure([float(z) for z in args.zeniths.split(",")], [1.0 / 12.0, 1.0 / 6.0], args.dt, args.frames, False,
             start, extra)
