@@ -118,12 +118,12 @@ def time_series(zenith: float, seconds: float, rate_hz: float, probes: int, quic
     from warpcaustics.batch.field.common import pooled_statistics
 
     series = np.array(samples)  # (time, point)
-    if save is not None:
-        np.savez(save, series=series, rate_hz=rate_hz, sun_zenith_deg=zenith, overrides=repr(extra))
     row = {"sun_zenith_deg": zenith, "seconds": seconds, "rate_hz": rate_hz, "points": probes**2,
            **series_statistics(series, rate_hz), "cv_spatial": float(pooled_statistics(spatial)[1])}
     row["wall_s"] = time.perf_counter() - start
     _print(row)
+    if save is not None:
+        np.savez(save, series=series, rate_hz=rate_hz, sun_zenith_deg=zenith, overrides=repr(extra))
     return row
 
 
@@ -153,22 +153,27 @@ def nested_series(paths: list[Path]) -> dict:
     """The statistics of the light under seas of independent scales (the scene's patch, the waves
     longer than it: ``--long-waves``), each saved by ``--series --save``: at a point E(t) is their
     product, each over its own mean, as the field comparison nests their CVs (1 + CV² multiplies).
-    The records are paired point by point (any pairing of independent points will do) and cut to the
-    shortest."""
-    records = [np.load(path) for path in paths]
-    rates = {float(r["rate_hz"]) for r in records}
-    if len(rates) != 1:
-        raise SystemExit(f"--nest: the records were sampled at different rates {sorted(rates)}")
-    length = min(r["series"].shape[0] for r in records)
-    product = np.ones_like(records[0]["series"][:length], dtype=np.float64)
-    for r in records:
-        series = r["series"][:length].astype(np.float64)
+    The records are paired point by point (any pairing of independent points will do) and must be
+    alike in rate, length and points. Like the comparison's nesting, this takes the scales as
+    independent: at a low sun the long waves' tilt also changes the short waves' contrast, which it
+    leaves out."""
+    records = []
+    for path in paths:
+        with np.load(path) as data:
+            records.append((np.asarray(data["series"], np.float64), float(data["rate_hz"])))
+    if len({rate for _, rate in records}) != 1 or len({series.shape for series, _ in records}) != 1:
+        raise SystemExit("--nest: the records differ in rate, length or points "
+                         f"({[(series.shape, rate) for series, rate in records]}); record them alike")
+    if any(np.any(series.mean(axis=0) <= 0.0) for series, _ in records):
+        raise SystemExit("--nest: a point of a record has no light on average")
+    rate = records[0][1]
+    product = np.ones_like(records[0][0])
+    for series, _ in records:
         product *= series / series.mean(axis=0)
-    row = {"records": " + ".join(str(p) for p in paths), "seconds": length / rates.pop(),
-           **series_statistics(product, float(records[0]["rate_hz"]))}
-    for path, r in zip(paths, records):
-        alone = series_statistics(r["series"][:length], float(r["rate_hz"]))
-        row[f"cv_time_median_{Path(path).stem}"] = alone["cv_time_median"]
+    row = {"records": " + ".join(str(p) for p in paths), "seconds": product.shape[0] / rate,
+           **series_statistics(product, rate)}
+    for path, (series, _) in zip(paths, records):
+        row[f"cv_time_median_{Path(path).stem}"] = series_statistics(series, rate)["cv_time_median"]
     _print(row)
     return row
 
@@ -212,6 +217,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.nest:
         nested_series(args.nest)
         return 0
+    if args.save is not None:  # found wanting before the run, not after it
+        if args.series <= 0.0 or args.quick:
+            raise SystemExit("--save keeps the samples of --series (not with --quick)")
+        args.save.parent.mkdir(parents=True, exist_ok=True)
     from warpcaustics.config import parse_override
 
     start = {} if args.configured else BEFORE

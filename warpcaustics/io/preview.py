@@ -24,7 +24,7 @@ def vtk_errors_only():
     reaches us as an exception, which we report in one line."""
     from vtkmodules.vtkCommonCore import vtkLogger
 
-    previous = vtkLogger.GetCurrentVerbosityCutoff()
+    previous = vtkLogger.GetCurrentVerbosityCutoff()  # stderr's level where it is the only log (default)
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
     try:
         yield

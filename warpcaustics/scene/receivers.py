@@ -155,22 +155,33 @@ def load_receiver_mesh(receiver: ReceiverConfig, base_dir: Path, key: str) -> Tr
     return TriangleMesh(points, triangles)
 
 
+BOM_TEXT_FORMATS = (".stl", ".obj", ".ply", ".vtk", ".off")
+"""Mesh formats whose VTK readers choke on a UTF-8 byte-order mark (the XML formats read it, and a
+multi-file one must stay beside its parts)."""
+
+
 @contextmanager
 def _without_bom(path: Path):
     """The file, or a copy of it without the UTF-8 byte-order mark some editors write at the start of
     text files: VTK's STL reader reads none of such a file, its OBJ reader loses the first line."""
     with open(path, "rb") as fh:
-        start = fh.read(64)
-        fh.seek(3)
-        binary_stl = path.suffix.lower() == ".stl" and not start[3:].lstrip().lower().startswith(b"solid")
-        if not start.startswith(b"\xef\xbb\xbf") or binary_stl:  # a binary STL's header is any 80 bytes
+        start = fh.read(4096)
+        binary_stl = path.suffix.lower() == ".stl" and not _ascii_stl(start)  # its header is any 80 bytes
+        if not start.startswith(b"\xef\xbb\xbf") or binary_stl or path.suffix.lower() not in BOM_TEXT_FORMATS:
             yield path
             return
+        fh.seek(3)
         with tempfile.TemporaryDirectory() as folder:
             copy = Path(folder) / path.name
             with open(copy, "wb") as out:
                 shutil.copyfileobj(fh, out)
             yield copy
+
+
+def _ascii_stl(start: bytes) -> bool:
+    """Whether a file's first bytes are an ASCII STL's (``solid``, then a facet), a BOM aside."""
+    start = start.lower()
+    return start.removeprefix(b"\xef\xbb\xbf").lstrip().startswith(b"solid") and b"facet" in start
 
 
 def _binary_stl_problem(path: Path) -> str | None:
@@ -180,9 +191,8 @@ def _binary_stl_problem(path: Path) -> str | None:
         return None
     with open(path, "rb") as fh:
         head = fh.read(84)
-        start = (head + fh.read(4096)).lower()
-    ascii_start = start.removeprefix(b"\xef\xbb\xbf").lstrip().startswith(b"solid") and b"facet" in start
-    if ascii_start or len(head) < 84:
+        start = head + fh.read(4096)
+    if _ascii_stl(start) or len(head) < 84:
         return None  # ASCII, or too short to say: the reader reports it
     declared = int.from_bytes(head[80:84], "little")
     size = path.stat().st_size
