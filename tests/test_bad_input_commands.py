@@ -284,6 +284,8 @@ def receiver_scene(mesh):
     ("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not finite"),
     ("far.obj", "v 1e30 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "within ±100000 m"),
     ("cut.stl", b"\0" * 80 + (50_000_000).to_bytes(4, "little") + b"\0" * 50, "declares 50000000 triangles"),
+    ("picture.stl", b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 2,
+     "not a whole binary STL .cut short, or not a"),
 ])
 def test_a_broken_receiver_mesh_is_one_line(tmp_path, name, content, needle):
     """Faces naming vertices the file lacks had crashed the process in VTK (a segfault) or raised an

@@ -197,8 +197,8 @@ def _binary_stl_problem(path: Path) -> str | None:
     declared = int.from_bytes(head[80:84], "little")
     size = path.stat().st_size
     if size < 84 + 50 * declared:
-        return (f"is a binary STL cut short: its header declares {declared} triangles, its "
-                f"{size} bytes hold {(size - 84) // 50}")
+        return (f"is not a whole binary STL (cut short, or not an STL at all): its header declares "
+                f"{declared} triangles, its {size} bytes hold {(size - 84) // 50}")
     return None
 
 
