@@ -154,16 +154,21 @@ def nested_series(paths: list[Path]) -> dict:
     longer than it: ``--long-waves``), each saved by ``--series --save``: at a point E(t) is their
     product, each over its own mean, as the field comparison nests their CVs (1 + CV² multiplies).
     The records are paired point by point (any pairing of independent points will do) and must be
-    alike in rate, length and points. Like the comparison's nesting, this takes the scales as
+    alike in rate and points; longer ones are cut to the shortest (each starts at t = 1 s, so that is
+    the record a shorter run gives). Like the comparison's nesting, this takes the scales as
     independent: at a low sun the long waves' tilt also changes the short waves' contrast, which it
     leaves out."""
     records = []
     for path in paths:
         with np.load(path) as data:
             records.append((np.asarray(data["series"], np.float64), float(data["rate_hz"])))
-    if len({rate for _, rate in records}) != 1 or len({series.shape for series, _ in records}) != 1:
-        raise SystemExit("--nest: the records differ in rate, length or points "
+    if len({rate for _, rate in records}) != 1 or len({series.shape[1] for series, _ in records}) != 1:
+        raise SystemExit("--nest: the records differ in rate or points "
                          f"({[(series.shape, rate) for series, rate in records]}); record them alike")
+    length = min(series.shape[0] for series, _ in records)
+    if any(series.shape[0] != length for series, _ in records):  # every record starts at t = 1 s
+        print(f"# the records cut to the shortest, {length} samples: as if all were recorded that long")
+        records = [(series[:length], rate) for series, rate in records]
     if any(np.any(series.mean(axis=0) <= 0.0) for series, _ in records):
         raise SystemExit("--nest: a point of a record has no light on average")
     rate = records[0][1]
