@@ -46,6 +46,30 @@ def test_nested_scales_give_the_cv_of_the_whole_sea():
     assert field.nested_cv() == 0.0
 
 
+def test_nested_point_records_give_the_whole_sea_s_cv_and_the_slow_scale_s_period(tmp_path):
+    """``benchmarks.sensor_integration --nest``: two independent records at 64 points, a fast one
+    (a 0.5 s sinusoid of random phase, CV 0.3/√2) and a slow one (3 s, CV 0.1/√2), each at its own
+    level. Their product's CV is (1 + a²)(1 + b²) − 1 under the root, analytic; a 1 s running mean
+    removes the fast one (its whole periods) and leaves the slow one's CV times sin(π/3)/(π/3); the
+    strongest fluctuation is the larger's period."""
+    from benchmarks.sensor_integration import nested_series
+
+    rate, n = 6.0, 180
+    t = np.arange(n)[:, None] / rate
+    rng = np.random.default_rng(3)
+    fast = 5.0 * (1.0 + 0.3 * np.sin(2 * np.pi * t / 0.5 + rng.uniform(0, 2 * np.pi, 64)))
+    slow = 0.2 * (1.0 + 0.1 * np.sin(2 * np.pi * t / 3.0 + rng.uniform(0, 2 * np.pi, 64)))
+    for name, series in (("fast", fast), ("slow", slow)):
+        np.savez(tmp_path / f"{name}.npz", series=series, rate_hz=rate)
+    row = nested_series([tmp_path / "fast.npz", tmp_path / "slow.npz"])
+    a, b = 0.3 / math.sqrt(2), 0.1 / math.sqrt(2)
+    assert row["cv_time_median"] == pytest.approx(math.sqrt((1 + a * a) * (1 + b * b) - 1), rel=1e-3)
+    assert row["cv_time_median_fast"] == pytest.approx(a, rel=1e-3)
+    assert row["peak_period_s"] == pytest.approx(0.5)
+    sinc = math.sin(math.pi / 3) / (math.pi / 3)
+    assert row["cv_time_mean_1s"] == pytest.approx(b * sinc, rel=0.02)
+
+
 def test_a_window_and_its_patchs_windows_give_the_patchs_cv():
     """Frames of a periodic patch whose light varies at scales above a window: the CV from one
     window per frame and the means of all the patch's windows (the law of total variance) equals
