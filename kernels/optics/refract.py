@@ -37,6 +37,32 @@ def refract_to_floor(
     transmittance[g, iy, ix] = T
 
 
+@wp.kernel
+def view_weight(
+    positions: wp.array2d[wp.vec3],
+    hit_xy: wp.array3d[wp.vec2],
+    path_m: wp.array3d[wp.float32],
+    floor_z: float,
+    axis: wp.vec3,
+    cos_half: float,
+    transmittance: wp.array3d[wp.float32],
+):
+    """A radiance sensor's cone (``floor.view_*``, caustics/view.py): scale vertex (iy, ix)'s
+    transmittance for group g by 1/|t_z| where its refracted ray t arrives at the floor from within
+    the cone about ``axis`` (−t·axis ≥ cos_half), by 0 elsewhere: the deposit then carries ∫ L dω
+    over the cone instead of the irradiance."""
+    g, iy, ix = wp.tid()
+    v = positions[iy, ix]
+    h = hit_xy[g, iy, ix]
+    ell = path_m[g, iy, ix]
+    w = float(0.0)
+    if ell > 0.0:
+        t = wp.vec3(h[0] - v[0], h[1] - v[1], floor_z - v[2]) / ell
+        if -wp.dot(t, axis) >= cos_half and t[2] < 0.0:
+            w = 1.0 / (-t[2])
+    transmittance[g, iy, ix] = transmittance[g, iy, ix] * w
+
+
 @wp.func
 def surface_height(positions: wp.array2d[wp.vec3], extent_m: float, x: float, y: float) -> float:
     """Height of a cell-centre height field at (x, y) [m]: periodic bilinear interpolation

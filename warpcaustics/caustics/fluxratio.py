@@ -12,6 +12,7 @@ from warpcaustics.caustics.multiple import MultipleScattering
 from warpcaustics.caustics.sky_cones import SkyCones
 from warpcaustics.caustics.small_angle import SmallAngleScattering
 from warpcaustics.caustics.stage import CausticStage, Frame, Lighting, StageOutput
+from warpcaustics.caustics.view import ViewCone
 from warpcaustics.config import FloorShape, Scattering, SkyModel, SkySampling
 from warpcaustics.kernels.caustics import coarse as coarse_kernels
 from warpcaustics.kernels.caustics import coverage as cover_kernels
@@ -63,8 +64,10 @@ def coarse_resolution(cfg, periodic: bool) -> int:
 
 
 def sky_in_cones(cfg) -> bool:
-    """A sky whose directions are spread over their cells (``sky.sampling = "cones"``)."""
-    return cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
+    """A sky whose directions are spread over their cells (``sky.sampling = "cones"``); a radiance
+    sensor (``floor.view_fov_deg``) traces the sky back instead."""
+    return (cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
+            and not cfg.floor.view_fov_deg)
 
 
 def needs_coarse(cfg) -> bool:
@@ -266,6 +269,7 @@ class FluxRatioStage(CausticStage):
             self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
                                                     light.optics.absorption_per_m,
                                                     light.optics.scattering_per_m)
+        self.view = ViewCone(cfg, light, device) if cfg.floor.view_fov_deg else None
         self.cones = None
         if sky_in_cones(cfg):
             self.cones = SkyCones(cfg, light.sky_directions, scene.sun_direction, float(light.group_ior[0]))
@@ -325,7 +329,13 @@ class FluxRatioStage(CausticStage):
                 centre = np.mean(self.light.sun_directions, axis=0)
                 self.small_angle.add(floor_np, centre / np.linalg.norm(centre), flux[1], coarse=coarse)
         single_sky = coarse_sky = None
-        if self.light.sky_directions is not None:
+        if self.view is not None and self.light.sky_directions is not None:
+            with watch.stage("sky"):  # traced back from the texels through the sensor's cone
+                sky_np = self.view.sky(frame.surface, self.scene.sun_direction)
+            extra["sky_floor_irradiance"] = sky_np
+            extra["sky_floor_irradiance_even"] = None
+            floor_np = floor_np + sky_np
+        elif self.light.sky_directions is not None:
             sky_np, sky_flux, even, coarse_sky = self._sky(frame)
             extra["sky_floor_irradiance"] = single_sky = sky_np
             extra["sky_floor_irradiance_even"] = single_even = even
@@ -443,6 +453,8 @@ class FluxRatioStage(CausticStage):
         with frame.watch.stage(stages[0]):
             refracted = refract_to_floor(frame.surface, visible, self.light.group_ior, direction,
                                          -self.scene.config.floor.depth_m, self.device, out=out)
+            if self.view is not None:  # the light arriving within a radiance sensor's cone alone
+                self.view.weight(frame.surface, refracted, -self.scene.config.floor.depth_m)
         with frame.watch.stage(stages[1]):
             floor = floor_caustics.run(frame.surface, refracted, direction, clear=clear,
                                        irradiance=irradiance, bands=bands)

@@ -193,6 +193,32 @@ def _check_scattering(cfg: Config) -> None:
                           + "; ".join(needs))
 
 
+def _check_view(cfg: Config) -> None:
+    """A radiance sensor's field of view (``floor.view_*``): the sun's light through the flux-ratio
+    deposit, the sky's traced back from each texel through the height field (caustics/view.py)."""
+    f = cfg.floor
+    if not f.view_fov_deg:
+        return
+    needs = []
+    if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
+        needs.append(f"caustics.method = \"fluxratio\" (not {cfg.caustics.method.value!r})")
+    if cfg.optics.scattering is not Scattering.SINGLE:
+        needs.append(f"optics.scattering = \"single\" (not {cfg.optics.scattering.value!r}: the scattered "
+                     "light's transfer is of irradiance)")
+    if not cfg.water.periodic:
+        needs.append(f"a periodic sea (not water.model = {cfg.water.model.value!r})")
+    if cfg.water.choppiness:
+        needs.append(f"water.choppiness = 0 (not {cfg.water.choppiness:g}: the sky is traced back "
+                     "through a height field)")
+    if needs:
+        raise ConfigError(f"floor.view_fov_deg = {f.view_fov_deg:g} (a radiance sensor) needs "
+                          + "; ".join(needs))
+    if f.view_zenith_deg + 0.5 * f.view_fov_deg > 90.0:
+        raise ConfigError(f"floor.view_zenith_deg = {f.view_zenith_deg:g} with floor.view_fov_deg = "
+                          f"{f.view_fov_deg:g} looks below the horizontal, at the upwelling light, which "
+                          f"is not modelled; use a zenith of at most {90.0 - 0.5 * f.view_fov_deg:g}")
+
+
 def _check_stats(cfg: Config) -> None:
     side, (cx, cy) = cfg.map_window
     half = 0.5 * side
@@ -309,6 +335,7 @@ def _check_photon_scene(cfg: Config) -> None:
     _check_map_window(cfg)
     _check_sky(cfg)
     _check_scattering(cfg)
+    _check_view(cfg)
     _check_stats(cfg)
     photons = cfg.caustics.method.uses_receivers
     needs = []

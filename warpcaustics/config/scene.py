@@ -42,6 +42,17 @@ class FloorConfig:
     albedo_file: str | None = None
     """CSV of a measured reflectance spectrum (header line, then wavelength [nm], reflectance 0…1);
     replaces ``albedo``. Relative paths start at the config file's folder."""
+    view_fov_deg: float = field(default=0.0, metadata=_range(0.0, 60.0))
+    """Full angle of the field of view of an upward-looking radiance sensor at every texel of the
+    floor map (``fluxratio``, single scattering, a periodic sea without chop): the map then holds the
+    light arriving within that cone, ∫ L dω over it [W m⁻² nm⁻¹], not the irradiance; divided by
+    the cone's solid angle, the radiance the sensor reads (Darecki et al. 2011's radiometers: 4.5°).
+    0 = the irradiance (the default) [deg]."""
+    view_zenith_deg: float = field(default=0.0, metadata=_range(0.0, 90.0))
+    """Zenith angle of the radiance sensor's axis, looking up (``view_fov_deg``) [deg]."""
+    view_azimuth_deg: float = field(default=0.0, metadata=_range(-360.0, 360.0))
+    """Azimuth towards which the radiance sensor's axis leans, from +x towards +y as the sun's
+    (the sun's azimuth: looking towards the sun) [deg]."""
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,9 @@ of ``benchmarks/``.
 - :mod:`~warpcaustics.reference.photons`: photon splatting with the exact or Shah's Newton
   intersection (``kernels/caustics/photons.py``);
 - :mod:`~warpcaustics.reference.beams`: the beam rasteriser's surface gather and scan-plane shafts
-  (``kernels/caustics/beams/``).
+  (``kernels/caustics/beams/``);
+- :mod:`~warpcaustics.reference.view`: a radiance sensor's sky traced back through the height field
+  (``kernels/optics/view.py``).
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ def sun_visibility(positions, sun_dir, extent_m):
     return sweep_visibility(positions, sun_dir, extent_m)
 
 
-def _bilinear_heights(z: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def bilinear_periodic(z: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Periodic bilinear heights of cell-centre heights ``z`` (N, N) at cell coordinates (u, v)."""
     n = z.shape[0]
     i0, j0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
@@ -62,7 +62,7 @@ def sweep_visibility(positions, sun_dir, extent_m):
     for i in range(steps - 1, -1, -1):
         x = (-half + i * spacing) * along[0] + r * across[0] + 0.5 * extent_m
         y = (-half + i * spacing) * along[1] + r * across[1] + 0.5 * extent_m
-        h = _bilinear_heights(z, x * n / extent_m - 0.5, y * n / extent_m - 0.5)
+        h = bilinear_periodic(z, x * n / extent_m - 0.5, y * n / extent_m - 0.5)
         best = np.maximum(best, h - i * rise)
         if i < stored:
             horizon[i] = best + i * rise
@@ -94,7 +94,7 @@ def march_visibility(positions, sun_dir, extent_m, step_cells=0.5):
     steps = np.ceil((z.max() - z) / (s[2] * step)).astype(np.int64) + 1
     for i in range(1, int(steps.max()) + 1):
         q = positions + (i * step) * s
-        h = _bilinear_heights(z, (q[..., 0] + 0.5 * extent_m) * n / extent_m - 0.5,
+        h = bilinear_periodic(z, (q[..., 0] + 0.5 * extent_m) * n / extent_m - 0.5,
                               (q[..., 1] + 0.5 * extent_m) * n / extent_m - 0.5)
         visible[(i <= steps) & (h > q[..., 2] + 1e-4 * cell)] = 0.0
     return visible
@@ -186,15 +186,29 @@ def _area(px, py, count):
     return 0.5 * np.abs(np.sum(np.where(valid, px * ny - nx * py, 0.0), axis=1))
 
 
+def view_weights(positions, hit, ell, floor_z, axis, cos_half):
+    """(N, N) a radiance sensor's weight of each vertex's refracted ray (``floor.view_*``): 1/|t_z|
+    where the ray t (from the vertex to its floor hit) arrives from within the cone of half-angle
+    acos(``cos_half``) about the upward ``axis``, 0 elsewhere."""
+    t = np.concatenate([hit - positions[..., :2], (floor_z - positions[..., 2])[..., None]], axis=-1)
+    t = t / ell[..., None]
+    inside = (-(t @ np.asarray(axis, np.float64)) >= cos_half) & (t[..., 2] < 0.0)
+    return np.where(inside, 1.0 / np.where(inside, -t[..., 2], 1.0), 0.0)
+
+
 def floor_caustics(positions, normals, sun_dir, ior, floor_depth_m, sun_irradiance,
-                   attenuation_per_m, extent_m, map_resolution):
-    """Floor irradiance (K, M, M) [W m^-2 nm^-1] and per-triangle flux (K, T) [W nm^-1]."""
+                   attenuation_per_m, extent_m, map_resolution, view=None):
+    """Floor irradiance (K, M, M) [W m^-2 nm^-1] and per-triangle flux (K, T) [W nm^-1]; with
+    ``view`` = (axis, cos_half), the light within a radiance sensor's cone, ∫ L dω [W m^-2 nm^-1]
+    (:func:`view_weights`)."""
     positions = np.asarray(positions, np.float64)
     normals = np.asarray(normals, np.float64)
     n = positions.shape[0]
     m = map_resolution
     visible = sun_visibility(positions, sun_dir, extent_m)
     hit, ell, trans = refract_to_floor(positions, normals, sun_dir, ior, -floor_depth_m, visible)
+    if view is not None:
+        trans = trans * view_weights(positions, hit, ell, -floor_depth_m, *view)
     idx, shift = triangles(n, extent_m)
     p = positions.reshape(-1, 3)[idx]
     p[..., :2] += shift
