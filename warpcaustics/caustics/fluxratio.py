@@ -296,7 +296,8 @@ class FluxRatioStage(CausticStage):
         coarse = k * coarse_resolution(cfg, cfg.water.periodic) ** 2 * 8 if needs_coarse(cfg) else 0
         n, ns = scene.water_resolution, scene.sky_resolution
         sky = floor_bytes(ns, m, k, groups) + coarse if ns != n else 0  # the sky's surface's own buffers
-        return floor_bytes(n, m, k, groups) + walk + coarse + sky
+        view = k * m * m * 4 if cfg.floor.view_fov_deg else 0  # a radiance sensor's traced sky
+        return floor_bytes(n, m, k, groups) + walk + coarse + sky + view
 
     def render(self, frame: Frame) -> StageOutput:
         floor, transmitted, extra, single = self.flux_ratio(frame)

@@ -1,8 +1,9 @@
 """An upward-looking radiance sensor at every texel of the floor map (``floor.view_fov_deg``).
 
-Darecki et al. (2011, §2, Fig. 15) measured the radiance at 532 nm in 4.5° fields of view looking up
-at thirteen zenith angles in the sun's plane. What such a sensor reads, ∫ L dω over its cone C, is
-built here from the two parts of the light that the flux-ratio map already separates:
+Darecki et al. (2011, Fig. 15; the field of view on their p. 4) measured the radiance at 532 nm in
+4.5° fields of view looking up at thirteen zenith angles in the sun's plane. What such a sensor
+reads, ∫ L dω over its cone C, is built here from the two parts of the light that the flux-ratio
+map already separates:
 
 * **The sun**, through the flux-ratio deposit itself: each vertex's refracted ray t reaches the floor
   carrying its share of the sun's flux; it counts only where it arrives from within C (−t·v ≥
@@ -19,9 +20,10 @@ built here from the two parts of the light that the flux-ratio map already separ
   in the sky's radiance (it is the first part); a backward ray through a facet tilted so far that it
   leaves below the horizon sees another wave and gets 0.
 
-Scattered light is not included (``optics.scattering = "single"``, c = a + b): its radiance near the
-sun's direction is smoother than the glints', so the CV the map gives is what the unscattered light
-alone would give (an upper bound where the scattered light is smooth; docs/validation.md).
+Scattered light is not included (``optics.scattering = "single"``, c = a + b): near the sun's
+direction its radiance is smoother than the glints', so there it would only lower the CV the map
+gives; away from the sun, where the map holds the sky alone, the scattered light's own flicker is
+missing too (docs/validation.md, "Radiance seen from below").
 """
 
 from __future__ import annotations
@@ -69,11 +71,6 @@ def cone_directions(axis: np.ndarray, fov_deg: float, count: int) -> tuple[np.nd
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(a, e1)
     return local @ np.stack([e1, e2, a]), 2.0 * math.pi * (1.0 - cos_half) / count
-
-
-def cone_solid_angle(fov_deg: float) -> float:
-    """Solid angle of a cone of full angle ``fov_deg`` [sr]."""
-    return 2.0 * math.pi * (1.0 - math.cos(math.radians(0.5 * fov_deg)))
 
 
 class ViewCone:
