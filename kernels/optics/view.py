@@ -3,7 +3,7 @@ its float64 twin is ``warpcaustics/reference/view.py``)."""
 
 import warp as wp
 
-from warpcaustics.kernels.geometry import bilerp, bilinear_cell, fresnel_transmittance, refract
+from warpcaustics.kernels.geometry import fresnel_transmittance, grid_bilinear, refract
 
 wp.set_module_options({"enable_backward": False})
 
@@ -47,7 +47,6 @@ def view_sky(
     and Σ_u n² T L_sky(out) exp(−c ℓ) dω into ``out[k, iy, ix]`` per band k (L_sky = L_zenith ×
     the CIE shape, or L_zenith for a uniform sky)."""
     iy, ix = wp.tid()
-    n = positions.shape[0]
     x = origin[0] + (float(ix) + 0.5) * texel_m
     y = origin[1] + (float(iy) + 0.5) * texel_m
     bands = ior.shape[0]
@@ -58,18 +57,11 @@ def view_sky(
         if u[2] <= 0.0:
             continue
         h = float(0.0)
-        for _ in range(iterations):
+        for _k in range(iterations):  # as the sun map's backward rays (kernels/caustics/sunmap.py)
             run = (h - floor_z) / u[2]
-            i0, j0, i1, j1, tu, tv = bilinear_cell(n, extent_m, x + run * u[0], y + run * u[1])
-            h = bilerp(positions[j0, i0][2], positions[j0, i1][2], positions[j1, i0][2], positions[j1, i1][2],
-                       tu, tv)
+            h = grid_bilinear(positions, extent_m, 1, x + run * u[0], y + run * u[1])[2]
         ell = (h - floor_z) / u[2]
-        i0, j0, i1, j1, tu, tv = bilinear_cell(n, extent_m, x + ell * u[0], y + ell * u[1])
-        a = normals[j0, i0]
-        b = normals[j0, i1]
-        c = normals[j1, i0]
-        d = normals[j1, i1]
-        normal = wp.normalize((1.0 - tv) * ((1.0 - tu) * a + tu * b) + tv * ((1.0 - tu) * c + tu * d))
+        normal = wp.normalize(grid_bilinear(normals, extent_m, 1, x + ell * u[0], y + ell * u[1]))
         cos_w = wp.dot(normal, u)
         for k in range(bands):
             eta = ior[k]
