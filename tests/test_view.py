@@ -154,12 +154,37 @@ def test_sky_kernel_on_a_wavy_sea_matches_float64_numpy(device):
     assert np.std(expected[0]) / np.mean(expected[0]) > 0.01
 
 
+def test_the_flux_fields_count_the_light_entering_the_water_not_the_cone(device):
+    """With a sensor the transmitted flux is still the light entering the water (the irradiance
+    map's own, 1e-6), whichever way the cone looks; the delivered flux, which the cone's ∫ L dω is
+    not, is None; the map stays float32 with a traced sky; PAR is not reported of ∫ L dω."""
+    from warpcaustics.batch.stats import frame_statistics
+
+    plain = wc.render(flat_water_scene(50.0, 2.0, "jerlov_IB"), device=device)
+    zenith = _refracted_zenith_deg(50.0, float(plain.ior[0]))
+    for azimuth in (37.0, 217.0):
+        seen = wc.render(flat_water_scene(50.0, 2.0, "jerlov_IB", **_view(zenith, azimuth)), device=device)
+        np.testing.assert_allclose(seen.transmitted_flux_w_nm, plain.transmitted_flux_w_nm, rtol=1e-6)
+        assert seen.delivered_flux_w_nm is None
+    sky_args = {"sky.model": "cie_clear", "sky.diffuse_fraction": 0.2}
+    sky_scene = flat_water_scene(50.0, 2.0, "jerlov_IB", **_view(zenith, 37.0), **sky_args)
+    sky = wc.render(sky_scene, device=device)
+    assert sky.floor_irradiance.dtype == np.float32 and sky.sky_floor_irradiance.dtype == np.float32
+    stats = frame_statistics(sky, sky.scene.config.stats)
+    assert "irradiance_w_m2" in stats and "par_umol_m2_s" not in stats
+    assert "par_umol_m2_s" in frame_statistics(plain, plain.scene.config.stats)
+
+
 @pytest.mark.parametrize("overrides, needle", [
     ({"caustics.method": "photons"}, 'caustics.method = "fluxratio"'),
     ({"optics.scattering": "small_angle"}, 'optics.scattering = "single"'),
     ({"water.model": "procedural"}, "a periodic sea"),
     ({"water.model": "fft", "water.choppiness": 1.0}, "water.choppiness = 0"),
     ({"floor.view_zenith_deg": 89.0}, "use a zenith of at most 87.75"),
+    ({"output.netcdf": True}, "output.netcdf = false"),
+    ({"output.npz": True}, "output.npz = false"),
+    ({"floor.view_fov_deg": 0.0, "floor.view_zenith_deg": 20.0}, "floor.view_zenith_deg = 20 is only read"),
+    ({"floor.view_fov_deg": 0.0, "floor.view_azimuth_deg": 90.0}, "set floor.view_fov_deg"),
 ])
 def test_a_view_it_cannot_render_is_refused_in_one_line(overrides, needle):
     with pytest.raises(ConfigError) as err:

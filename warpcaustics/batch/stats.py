@@ -186,9 +186,11 @@ def patch_windows(result, views: dict | None = None, parts: dict | None = None) 
 
 def frame_statistics(result, cfg: StatsConfig) -> dict:
     """The statistics of one frame's floor map: total irradiance [W m⁻²] (with a sky, also its
-    direct-sun and sky parts alone), PAR [µmol m⁻² s⁻¹] and, if ``cfg.wavelength_nm`` is set, the
-    band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every band (``bands``; with a sky, each
-    band's sky and direct-sun parts too, ``bands_sky`` and ``bands_direct``), after the collector.
+    direct-sun and sky parts alone; with a radiance sensor, ``floor.view_fov_deg``, the map's ∫ L dω
+    under the same names), PAR [µmol m⁻² s⁻¹] (not with a radiance sensor) and, if
+    ``cfg.wavelength_nm`` is set, the band holding it [W m⁻² nm⁻¹], and with ``cfg.per_band`` every
+    band (``bands``; with a sky, each band's sky and direct-sun parts too, ``bands_sky`` and
+    ``bands_direct``), after the collector.
     Where the sky's map comes in two halves (``result.sky_floor_irradiance_even``), each of these
     but the direct sun's also has ``continuous_sky`` (:func:`continuous_sky_moments`, with
     its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
@@ -199,7 +201,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
     covered = None
-    if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0]:
+    scene = getattr(result, "scene", None)
+    radiance = scene is not None and bool(scene.config.floor.view_fov_deg)  # ∫ L dω: no PAR of it
+    if edges is not None and edges[0] < PAR_BAND_NM[1] and edges[-1] > PAR_BAND_NM[0] and not radiance:
         views["par_umol_m2_s"] = lambda m: par_map(m, edges)
         # PAR counts only what the bins hold: say so when they cover less than 400-700 nm
         covered = [max(float(edges[0]), PAR_BAND_NM[0]), min(float(edges[-1]), PAR_BAND_NM[1])]

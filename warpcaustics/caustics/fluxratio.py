@@ -170,6 +170,21 @@ class FloorCaustics:
         ``bands = False`` leaves :attr:`irradiance` as it was, for a run whose map a later one adds
         to (the prefix sums of the deposit's differences are taken once, when the map is read)."""
         quads = self.flux.shape[0]
+        per_group = self.triangle_flux(surface, refracted, sun_dir, irradiance)
+        if self.coarse is not None:
+            if clear:
+                self.coarse.zero_()
+            wp.launch(coarse_kernels.splat_quads, dim=(refracted.hit_xy.shape[0], quads, quads),
+                      inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
+                              self.coarse.shape[0] / float(surface.extent_m)],
+                      outputs=[self.coarse], device=self.device)
+        return self.deposit(surface, refracted, clear=clear, bands=bands)
+
+    def triangle_flux(self, surface: Surface, refracted: Refracted, sun_dir: np.ndarray,
+                      irradiance: wp.array | None = None) -> int:
+        """Each triangle's flux (:attr:`flux`, delivered; :attr:`entering`, into the water) from
+        ``refracted``, with ``irradiance`` (K,) or the sun's; returns the bands per index group."""
+        quads = self.flux.shape[0]
         self.last_irradiance = self.sun_irradiance if irradiance is None else irradiance
         if quads != (surface.resolution if surface.periodic else surface.resolution + 1):
             raise ValueError("FloorCaustics was built for the other kind of surface (periodic/walled)")
@@ -181,14 +196,7 @@ class FloorCaustics:
                           self.attenuation_per_m, per_group, float(surface.extent_m),
                           int(surface.periodic)],
                   outputs=[self.flux, self.entering], device=self.device)
-        if self.coarse is not None:
-            if clear:
-                self.coarse.zero_()
-            wp.launch(coarse_kernels.splat_quads, dim=(refracted.hit_xy.shape[0], quads, quads),
-                      inputs=[refracted.hit_xy, self.flux, per_group, float(surface.extent_m),
-                              self.coarse.shape[0] / float(surface.extent_m)],
-                      outputs=[self.coarse], device=self.device)
-        return self.deposit(surface, refracted, clear=clear, bands=bands)
+        return per_group
 
     def deposit(self, surface: Surface, refracted: Refracted, *, clear: bool = True,
                 bands: bool = True) -> wp.array3d:
@@ -345,7 +353,8 @@ class FluxRatioStage(CausticStage):
             extra["coarse_floor_irradiance"] = coarse if coarse_sky is None else coarse + coarse_sky
             extra["coarse_sky_floor_irradiance"] = coarse_sky
         transmitted = flux[0]
-        extra["delivered_flux_w_nm"] = flux[1]
+        # a radiance sensor's map sums L dω over its cone, not a flux: no delivered flux
+        extra["delivered_flux_w_nm"] = None if self.view is not None else flux[1]
         if self.multiple is None:
             return floor_np, transmitted, extra, None
         # the walk's maps replace the single-scattering ones
@@ -454,12 +463,15 @@ class FluxRatioStage(CausticStage):
         with frame.watch.stage(stages[0]):
             refracted = refract_to_floor(frame.surface, visible, self.light.group_ior, direction,
                                          -self.scene.config.floor.depth_m, self.device, out=out)
-            if self.view is not None:  # the light arriving within a radiance sensor's cone alone
+            entering = None
+            if self.view is not None:  # the light entering the water, then only what reaches the cone
+                floor_caustics.triangle_flux(frame.surface, refracted, direction, irradiance)
+                entering = floor_caustics.entering_flux()
                 self.view.weight(frame.surface, refracted, -self.scene.config.floor.depth_m)
         with frame.watch.stage(stages[1]):
             floor = floor_caustics.run(frame.surface, refracted, direction, clear=clear,
                                        irradiance=irradiance, bands=bands)
-            flux = np.stack([floor_caustics.entering_flux(),
+            flux = np.stack([floor_caustics.entering_flux() if entering is None else entering,
                              floor_caustics.flux.numpy().sum(axis=(0, 1, 2), dtype=np.float64)])
         return floor, flux
 

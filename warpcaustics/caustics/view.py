@@ -90,6 +90,7 @@ class ViewCone:
         directions, self.d_omega = cone_directions(self.axis, self.fov_deg, SKY_SAMPLES)
         self.directions = wp.array(directions.astype(np.float32), dtype=wp.vec3, device=device)
         self._sky = None
+        """The traced sky's (K, M, M) map on the device, reused from frame to frame."""
 
     def weight(self, surface, refracted, floor_z: float) -> None:
         """Scale ``refracted.transmittance`` in place: 1/|t_z| where the vertex's ray arrives from
@@ -104,6 +105,9 @@ class ViewCone:
         """(K, M, M) the sky's ∫ L dω over the cone at every texel [W m⁻² nm⁻¹]: one kernel over the
         texels (``kernels/optics/view.py``), read back."""
         light = self.light
+        k = len(light.ior)
+        # the sun's refractive indices (one per band, or the first bin's for all without dispersion)
+        ior = np.repeat(np.asarray(light.group_ior, np.float32), k // len(light.group_ior))
         if self._sky is None:
             self._sky = wp.empty((len(light.ior), *self.window.texel_x.shape), dtype=wp.float32,
                                  device=self.device)
@@ -118,12 +122,12 @@ class ViewCone:
         wp.launch(view_kernels.view_sky, dim=self.window.texel_x.shape,
                   inputs=[surface.positions, surface.normals, float(surface.extent_m), origin, float(t),
                           self.floor_z, self.directions, self.d_omega, HEIGHT_ITERATIONS,
-                          wp.array(np.asarray(light.ior, np.float32), **f32),
+                          wp.array(ior, **f32),
                           wp.array(np.asarray(light.attenuation_per_m, np.float32), **f32),
                           wp.array(zenith.astype(np.float32), **f32), int(self.sky_type is None),
                           wp.vec3(*sun.astype(np.float32)), cie, cie_e, cie_scale],
                   outputs=[self._sky], device=self.device)
-        return self._sky.numpy().astype(np.float64)
+        return self._sky.numpy().copy()  # float32, as the sun's map
 
 
 def cie_parameters(sky_type: int | None, sun_direction: np.ndarray) -> tuple[wp.vec4, float, float]:

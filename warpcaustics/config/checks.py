@@ -198,6 +198,10 @@ def _check_view(cfg: Config) -> None:
     deposit, the sky's traced back from each texel through the height field (caustics/view.py)."""
     f = cfg.floor
     if not f.view_fov_deg:
+        for key in ("view_zenith_deg", "view_azimuth_deg"):
+            if getattr(f, key):
+                raise ConfigError(f"floor.{key} = {getattr(f, key):g} is only read by a radiance sensor: set "
+                                  "floor.view_fov_deg (e.g. 4.5) or leave it out")
         return
     needs = []
     if cfg.caustics.method is not CausticsMethod.FLUXRATIO:
@@ -210,6 +214,10 @@ def _check_view(cfg: Config) -> None:
     if cfg.water.choppiness:
         needs.append(f"water.choppiness = 0 (not {cfg.water.choppiness:g}: the sky is traced back "
                      "through a height field)")
+    for key in ("npz", "netcdf"):
+        if getattr(cfg.output, key):
+            needs.append(f"output.{key} = false (its arrays are labelled irradiance and PAR; the EXR and "
+                         "run.json hold the sensor's map)")
     if needs:
         raise ConfigError(f"floor.view_fov_deg = {f.view_fov_deg:g} (a radiance sensor) needs "
                           + "; ".join(needs))

@@ -53,10 +53,13 @@ class Scene:
     @property
     def sky_resolution(self) -> int:
         """Vertices a side of the surface the sky's directions are refracted through: the water's
-        own, or ``sky.surface_resolution`` where the sky is in cones over an FFT ocean of a finer grid."""
+        own, or ``sky.surface_resolution`` where the sky is in cones over an FFT ocean of a finer grid
+        (not for a radiance sensor, ``floor.view_fov_deg``, which traces the sky back through the water's
+        own surface)."""
         cfg = self.config
         applies = (cfg.sky.model is not SkyModel.NONE and cfg.sky.sampling is SkySampling.CONES
-                   and cfg.water.model is WaterModel.FFT and cfg.sky.surface_resolution)
+                   and cfg.water.model is WaterModel.FFT and cfg.sky.surface_resolution
+                   and not cfg.floor.view_fov_deg)
         return min(cfg.sky.surface_resolution, self.water_resolution) if applies else self.water_resolution
 
     def sun_disk_directions(self) -> np.ndarray:
