@@ -277,7 +277,7 @@ class FluxRatioStage(CausticStage):
             self.small_angle = SmallAngleScattering(cfg, float(light.group_ior[0]),
                                                     light.optics.absorption_per_m,
                                                     light.optics.scattering_per_m)
-        self.view = ViewCone(cfg, light, device) if cfg.floor.view_fov_deg else None
+        self.view = ViewCone(cfg, light, scene.sun_direction, device) if cfg.floor.view_fov_deg else None
         self.cones = None
         if sky_in_cones(cfg):
             self.cones = SkyCones(cfg, light.sky_directions, scene.sun_direction, float(light.group_ior[0]))
@@ -340,9 +340,8 @@ class FluxRatioStage(CausticStage):
         single_sky = coarse_sky = None
         if self.view is not None and self.light.sky_directions is not None:
             with watch.stage("sky"):  # traced back from the texels through the sensor's cone
-                sky_np = self.view.sky(frame.surface, self.scene.sun_direction)
+                sky_np = self.view.sky(frame.surface)
             extra["sky_floor_irradiance"] = sky_np
-            extra["sky_floor_irradiance_even"] = None
             floor_np = floor_np + sky_np
         elif self.light.sky_directions is not None:
             sky_np, sky_flux, even, coarse_sky = self._sky(frame)

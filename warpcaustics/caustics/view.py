@@ -36,7 +36,7 @@ import warp as wp
 from warpcaustics.caustics.window import MapWindow
 from warpcaustics.kernels.optics import refract as refract_kernels
 from warpcaustics.kernels.optics import view as view_kernels
-from warpcaustics.optics.sky import cie_sky_type, cie_sky_types, sky_radiance
+from warpcaustics.optics.sky import cie_sky_type, cie_sky_types, cie_zenith_value, sky_radiance
 
 SKY_SAMPLES = 64
 """Directions Q over the cone for the sky: about 0.5° apart in a 4.5° field of view, finer than the
@@ -77,7 +77,7 @@ class ViewCone:
     """The radiance sensor of ``floor.view_*``: weights the sun's refracted rays by the cone, and
     traces the sky back from the texels."""
 
-    def __init__(self, cfg, light, device: str):
+    def __init__(self, cfg, light, sun_direction: np.ndarray, device: str):
         f = cfg.floor
         self.fov_deg = float(f.view_fov_deg)
         self.axis = view_axis(f.view_zenith_deg, f.view_azimuth_deg)
@@ -85,12 +85,33 @@ class ViewCone:
         self.floor_z = -float(f.depth_m)
         self.device = device
         self.window = MapWindow(cfg)
-        self.light = light
-        self.sky_type = cie_sky_type(cfg.sky)
-        directions, self.d_omega = cone_directions(self.axis, self.fov_deg, SKY_SAMPLES)
-        self.directions = wp.array(directions.astype(np.float32), dtype=wp.vec3, device=device)
-        self._sky = None
-        """The traced sky's (K, M, M) map on the device, reused from frame to frame."""
+        self._sky = self._sky_inputs = None
+        if light.sky_directions is not None:
+            self._prepare_sky(cfg, light, sun_direction)
+
+    def _prepare_sky(self, cfg, light, sun_direction: np.ndarray) -> None:
+        """What every frame's sky trace takes but the surface, on the device once: the cone's
+        directions, the texels' grid, the sun's refractive indices (one per band, or the first bin's
+        for all without dispersion), the attenuation, the sky's zenith radiance and CIE shape."""
+        k = len(light.ior)
+        f32 = dict(dtype=wp.float32, device=self.device)
+        sky_type = cie_sky_type(cfg.sky)
+        sun = np.asarray(sun_direction, np.float64)
+        zenith = sky_radiance(sky_type, np.array([0.0, 0.0, 1.0]), sun,
+                              np.asarray(light.sky_irradiance_horizontal, np.float64))
+        directions, d_omega = cone_directions(self.axis, self.fov_deg, SKY_SAMPLES)
+        t = self.window.texel_m
+        self._sky = wp.empty((k, *self.window.texel_x.shape), **f32)
+        """The traced sky's (K, M, M) map, reused from frame to frame."""
+        x0, y0 = self.window.texel_x[0, 0] - 0.5 * t, self.window.texel_y[0, 0] - 0.5 * t
+        ior = np.repeat(np.asarray(light.group_ior, np.float32), k // len(light.group_ior))
+        self._sky_inputs = [
+            wp.vec2(float(x0), float(y0)), float(t), self.floor_z,
+            wp.array(directions.astype(np.float32), dtype=wp.vec3, device=self.device), float(d_omega),
+            HEIGHT_ITERATIONS, wp.array(ior, **f32),
+            wp.array(np.asarray(light.attenuation_per_m, np.float32), **f32),
+            wp.array(zenith.astype(np.float32), **f32), int(sky_type is None),
+            wp.vec3(*sun.astype(np.float32)), *cie_parameters(sky_type, sun)]
 
     def weight(self, surface, refracted, floor_z: float) -> None:
         """Scale ``refracted.transmittance`` in place: 1/|t_z| where the vertex's ray arrives from
@@ -101,33 +122,14 @@ class ViewCone:
                           wp.vec3(*self.axis.astype(np.float32)), float(self.cos_half)],
                   outputs=[refracted.transmittance], device=self.device)
 
-    def sky(self, surface, sun_direction: np.ndarray) -> np.ndarray:
+    def sky(self, surface) -> np.ndarray:
         """(K, M, M) the sky's ∫ L dω over the cone at every texel [W m⁻² nm⁻¹]: one kernel over the
         texels (``kernels/optics/view.py``), read back."""
-        light = self.light
-        k = len(light.ior)
-        # the sun's refractive indices (one per band, or the first bin's for all without dispersion)
-        ior = np.repeat(np.asarray(light.group_ior, np.float32), k // len(light.group_ior))
-        if self._sky is None:
-            self._sky = wp.empty((len(light.ior), *self.window.texel_x.shape), dtype=wp.float32,
-                                 device=self.device)
-        sun = np.asarray(sun_direction, np.float64)
-        zenith = sky_radiance(self.sky_type, np.array([0.0, 0.0, 1.0]), sun,
-                              np.asarray(light.sky_irradiance_horizontal, np.float64))
-        cie, cie_e, cie_scale = cie_parameters(self.sky_type, sun)
-        t = self.window.texel_m
-        origin = wp.vec2(float(self.window.texel_x[0, 0] - 0.5 * t),
-                         float(self.window.texel_y[0, 0] - 0.5 * t))
-        f32 = dict(dtype=wp.float32, device=self.device)
         wp.launch(view_kernels.view_sky, dim=self.window.texel_x.shape,
-                  inputs=[surface.positions, surface.normals, float(surface.extent_m), origin, float(t),
-                          self.floor_z, self.directions, self.d_omega, HEIGHT_ITERATIONS,
-                          wp.array(ior, **f32),
-                          wp.array(np.asarray(light.attenuation_per_m, np.float32), **f32),
-                          wp.array(zenith.astype(np.float32), **f32), int(self.sky_type is None),
-                          wp.vec3(*sun.astype(np.float32)), cie, cie_e, cie_scale],
+                  inputs=[surface.positions, surface.normals, float(surface.extent_m), *self._sky_inputs],
                   outputs=[self._sky], device=self.device)
         return self._sky.numpy().copy()  # float32, as the sun's map
+
 
 
 def cie_parameters(sky_type: int | None, sun_direction: np.ndarray) -> tuple[wp.vec4, float, float]:
@@ -136,6 +138,4 @@ def cie_parameters(sky_type: int | None, sun_direction: np.ndarray) -> tuple[wp.
     if sky_type is None:
         return wp.vec4(0.0, 0.0, 0.0, 0.0), 0.0, 1.0
     t = cie_sky_types()[sky_type]
-    zenith = math.acos(min(max(float(sun_direction[2]), -1.0), 1.0))
-    f_sun = 1.0 + t.c * (math.exp(t.d * zenith) - math.exp(t.d * math.pi / 2.0)) + t.e * math.cos(zenith) ** 2
-    return wp.vec4(t.a, t.b, t.c, t.d), float(t.e), 1.0 / (f_sun * (1.0 + t.a * math.exp(t.b)))
+    return wp.vec4(t.a, t.b, t.c, t.d), float(t.e), 1.0 / cie_zenith_value(sky_type, sun_direction)

@@ -69,6 +69,15 @@ def _indicatrix(t: CieSkyType, chi: np.ndarray) -> np.ndarray:
     return 1.0 + t.c * (np.exp(t.d * chi) - math.exp(t.d * math.pi / 2.0)) + t.e * np.cos(chi) ** 2
 
 
+def cie_zenith_value(sky_type: int, sun_direction: np.ndarray) -> float:
+    """f(Z_sun) φ(0): the CIE type's unnormalised radiance at the zenith, which
+    :func:`cie_relative_radiance` divides by (and the radiance sensor's kernel, caustics/view.py)."""
+    t = cie_sky_types()[sky_type]
+    s = np.asarray(sun_direction, np.float64)
+    sun_zenith = math.acos(min(max(float(s[2] / np.linalg.norm(s)), -1.0), 1.0))
+    return float(_indicatrix(t, np.array(sun_zenith)) * _gradation(t, np.array(1.0)))
+
+
 def cie_relative_radiance(sky_type: int, directions: np.ndarray, sun_direction: np.ndarray) -> np.ndarray:
     """L / L_zenith of each unit direction (…, 3) towards the sky (z up) for CIE type ``sky_type``
     with the sun towards ``sun_direction`` (float64)."""
@@ -77,9 +86,7 @@ def cie_relative_radiance(sky_type: int, directions: np.ndarray, sun_direction: 
     s = np.asarray(sun_direction, np.float64)
     s = s / np.linalg.norm(s)
     chi = np.arccos(np.clip(d @ s, -1.0, 1.0))
-    sun_zenith = math.acos(min(max(float(s[2]), -1.0), 1.0))
-    scale = _indicatrix(t, np.array(sun_zenith)) * _gradation(t, np.array(1.0))
-    return _indicatrix(t, chi) * _gradation(t, d[..., 2]) / scale
+    return _indicatrix(t, chi) * _gradation(t, d[..., 2]) / cie_zenith_value(sky_type, s)
 
 
 def sky_radiance(sky_type: int | None, directions: np.ndarray, sun_direction: np.ndarray,

@@ -1,7 +1,8 @@
 """The under-water pinhole camera (host side): G-buffer, photon caustic map, light shafts, shading.
 
 The camera looks at the receivers from inside the water (the camera above the water, looking
-through the refracting surface, is ``scene/above.py``); neither looks up at the surface from below.
+through the refracting surface, is ``scene/above.py``; what a radiance sensor looking up at the
+surface from below reads is the floor map's, ``floor.view_*``, ``caustics/view.py``).
 Receivers are static, so the G-buffer is cast once per scene; each frame splats the photons into a
 camera caustic map, draws their light shafts and shades (``kernels/scene/camera/`` has the
 equations).
