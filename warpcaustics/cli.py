@@ -15,7 +15,7 @@ from warpcaustics import __version__
 from warpcaustics.batch.compare import FLOOR_METHODS
 from warpcaustics.errors import ConfigError, WarpcausticsError
 
-FIELD_DATASETS = ("gernez2009", "gernez2009_bands", "darecki2011", "darecki2011_wind")
+FIELD_DATASETS = ("gernez2009", "gernez2009_bands", "darecki2011", "darecki2011_wind", "darecki2011_radiance")
 """The names of ``warpcaustics.batch.field.DATASETS``, spelled here because importing that package
 costs 0.7 s (scipy) at every start of the command (tests/test_field.py checks that they agree)."""
 
@@ -145,13 +145,20 @@ def _field_parser(sub) -> None:
                          "give the model's CV(z) with no measurement beside it)")
     fd.add_argument("--winds", metavar="LIST",
                     help="darecki2011_wind: only these measured winds [m/s], comma-separated (default all)")
+    fd.add_argument("--panels", metavar="LIST",
+                    help="darecki2011_radiance: only these of Fig. 15's panels, comma-separated "
+                         "(default a,b,c)")
+    fd.add_argument("--view-zeniths", metavar="LIST",
+                    help="darecki2011_radiance: only these of the record's sensor zeniths [deg] (+: towards "
+                         "the sun), comma-separated (default those inside Snell's window, -30 to 40)")
     fd.add_argument("--long-waves", type=float, metavar="M",
                     help="gernez2009(_bands), darecki2011: side [m] of a patch of the waves longer than the "
                          "scene's, rendered too (default 128 and 0); 0: the scene's waves alone")
-    fd.add_argument("--frames", type=int, default=3, metavar="N", help="frames pooled per point (default 3)")
+    fd.add_argument("--frames", type=int, metavar="N",
+                    help="frames pooled per point (default 3; darecki2011_radiance 2)")
     fd.add_argument("--frame-interval", type=float, metavar="S",
-                    help="seconds between a point's frames (default: gernez2009(_bands) 2, darecki2011 and "
-                         "darecki2011_wind 5); "
+                    help="seconds between a point's frames (default: gernez2009(_bands) 2, the darecki2011 "
+                         "data sets 5); "
                          "frames further apart than the waves' periods are independent samples")
     fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
     _device_arg(fd)
@@ -192,10 +199,12 @@ def _field(args: argparse.Namespace) -> int:
         text = getattr(args, name)
         if text is not None:  # else the data set's own default: all its points
             flag = "--" + name.replace("_", "-")
-            points[name] = tuple(text.split(",")) if name == "series" else _floats(text, flag)
-    common = dict(frames=args.frames, workers=args.workers, device=args.device, quick=args.quick,
+            points[name] = tuple(text.split(",")) if name in ("series", "panels") else _floats(text, flag)
+    common = dict(workers=args.workers, device=args.device, quick=args.quick,
                   quiet=args.quiet, force=args.force, overrides=_overrides(args))
-    if args.frame_interval is not None:  # else each data set's own default
+    if args.frames is not None:  # else each data set's own default
+        common["frames"] = args.frames
+    if args.frame_interval is not None:
         common["frame_interval_s"] = args.frame_interval
     if args.long_waves is not None:
         if args.dataset not in LONG_WAVES_DATASETS:

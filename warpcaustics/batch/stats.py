@@ -24,6 +24,11 @@ PAR_BAND_NM = (400.0, 700.0)
 PDF_EDGES = np.linspace(0.0, 5.0, 51)
 """Bins of E/Ē for the probability density (E above 5Ē is counted in the last bin)."""
 
+SUN_IN_VIEW = 0.1
+"""A radiance sensor's texel holds the sun in its cone where the sun's part exceeds this share of the
+sky's mean there (``sun_in_view`` of :func:`frame_statistics`): a cone that takes only the disk's
+faint edge, or a ray's sliver, is not counted as seeing it."""
+
 
 def par_weights(edges_nm: np.ndarray, band_nm: tuple[float, float] = PAR_BAND_NM) -> np.ndarray:
     """(K,) weights w_k with PAR = Σ_k E_k w_k [µmol m⁻² s⁻¹] for bin averages E_k [W m⁻² nm⁻¹]:
@@ -196,7 +201,8 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
     its octave-band cross-powers ``band_cov``) and the frame's ``cv_continuous_sky``
     (:func:`continuous_sky_cv`). Where the map is a window of a periodic sea that tiles the patch,
     every field also has ``patch_windows``: the means over the whole patch's windows, from its
-    coarse map (:func:`window_means`)."""
+    coarse map (:func:`window_means`). With a radiance sensor and a sky, each direct-sun part also has
+    ``sun_in_view``: the share of texels whose cone holds the sun (:data:`SUN_IN_VIEW`)."""
     widths = result.bin_widths_nm
     views = {"irradiance_w_m2": lambda m: band_integrated(m, widths)}
     edges = result.bins.edges_nm if result.bins is not None else None
@@ -245,6 +251,9 @@ def frame_statistics(result, cfg: StatsConfig) -> dict:
             stats["continuous_sky"] = continuous_sky_moments(
                 averaged, sky_part, even_part, extent_m=result.map_extent_m, periodic=result.map_periodic)
             stats["cv_continuous_sky"] = continuous_sky_cv([stats["continuous_sky"]])
+        if radiance and sky is not None and "direct" in name:
+            sky_mean = float(collector(fields[name.replace("direct", "sky")]).mean())
+            stats["sun_in_view"] = float(np.mean(averaged > SUN_IN_VIEW * sky_mean))
         group, _, band_name = name.rpartition("/")
         (out.setdefault(group, {}) if group else out)[band_name] = stats
     return out
