@@ -29,6 +29,29 @@ def test_pooled_statistics_equal_those_of_all_texels():
     assert cv == pytest.approx(every.std() / every.mean(), rel=1e-12)
 
 
+def test_a_weaker_sun_is_rescaled_exactly_from_the_parts_statistics():
+    """``with_beam_scaled``: each frame's (mean, CV) with its direct part scaled, from the map's and
+    its two correlated parts' (mean, CV) alone, equals numpy's over the texels of a·direct + sky
+    (1e-12); ``weakest_clear_sun`` is (1 − f − 0.15)/(1 − f), 0 where the sky alone passes 0.85."""
+    from warpcaustics.batch.field.common import with_beam_scaled
+    from warpcaustics.batch.field.gernez2009 import weakest_clear_sun
+
+    rng = np.random.default_rng(5)
+    direct = [rng.gamma(2.0, 1.0, (32, 32)) for _ in range(3)]
+    sky = [0.3 + 0.05 * d + rng.normal(0.0, 0.02, d.shape) for d in direct]  # correlated with the sun
+    stats = [[(m.mean(), m.std() / m.mean()) for m in maps]
+             for maps in ([d + s for d, s in zip(direct, sky)], direct, sky)]
+    for a in (1.0, 0.5, 0.0):
+        got = with_beam_scaled(*stats, a)
+        want = [(a * d + s).mean() for d, s in zip(direct, sky)], [
+            (a * d + s).std() / (a * d + s).mean() for d, s in zip(direct, sky)]
+        assert [m for m, _ in got] == pytest.approx(want[0], rel=1e-12)
+        assert [c for _, c in got] == pytest.approx(want[1], rel=1e-12)
+    assert weakest_clear_sun(0.7) == pytest.approx(0.5)
+    assert weakest_clear_sun(0.21) == pytest.approx(0.64 / 0.79)
+    assert weakest_clear_sun(0.85) == weakest_clear_sun(0.95) == weakest_clear_sun(1.0) == 0.0
+
+
 def test_nested_scales_give_the_cv_of_the_whole_sea():
     """A sea's map E = L·S, a smooth large-scale L (the long waves') times an independent fine
     pattern S: the CV from S's and L's relative variances equals numpy's over all of E's texels (to
@@ -190,7 +213,7 @@ def test_command_on_still_water_measures_no_fluctuation(tmp_path, capsys):
     rows = list(csv.DictReader((out / "gernez2009.csv").open()))
     assert [(r["series"], float(r["sun_zenith_deg"])) for r in rows] == [
         ("zenith", 20.0), ("zenith", 85.0), ("wind", 40.0)]
-    cvs = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered")
+    cvs = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered", "model_cv_weakest_clear_sun")
     assert all(float(r[c]) < 1e-5 for r in rows for c in cvs) and all(int(r["frames"]) == 2 for r in rows)
     measured = jerlov.gernez2009_cv_by_sun_zenith().cv
     assert float(rows[0]["measured_cv"]) == pytest.approx(measured[0], abs=1e-4)

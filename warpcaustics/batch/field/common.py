@@ -133,6 +133,22 @@ def with_background(frames: list[tuple[float, float]], background: list[float]) 
     return [(m + b, c * m / (m + b) if m + b > 0 else 0.0) for (m, c), b in zip(frames, background)]
 
 
+def with_beam_scaled(total: list[tuple[float, float]], direct: list[tuple[float, float]],
+                     sky: list[tuple[float, float]], scale: float) -> list[tuple[float, float]]:
+    """Each frame's (mean, CV) were its direct sun's part ``scale`` times as strong, from the (mean,
+    CV) of the map (``total``) and of its two parts (total = direct + sky, texel by texel): the
+    covariance of the parts is what the total's variance holds beyond theirs, so the scaled map's
+    variance is scale² σ_d² + σ_s² + 2 scale cov, exactly, without the maps."""
+    frames = []
+    for (m, c), (md, cd), (ms, cs) in zip(total, direct, sky):
+        var_d, var_s = (md * cd) ** 2, (ms * cs) ** 2
+        cov = 0.5 * ((m * c) ** 2 - var_d - var_s)
+        mean = scale * md + ms
+        var = scale * scale * var_d + var_s + 2.0 * scale * cov
+        frames.append((mean, math.sqrt(max(var, 0.0)) / mean if mean > 0 else 0.0))
+    return frames
+
+
 def nested_cv(*relative_variances: float) -> float:
     """The CV of a field built of nested, independent scales, each given by its relative variance
     r = CV²: 1 + CV² = Π (1 + rᵢ). For a window of a patch, the law of total variance splits the

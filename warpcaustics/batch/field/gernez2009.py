@@ -47,6 +47,7 @@ from warpcaustics.batch.field.common import (
     render_points,
     sea_cv,
     with_background,
+    with_beam_scaled,
 )
 from warpcaustics.config import Scattering, SkyModel, WaterType
 from warpcaustics.errors import ConfigError
@@ -67,6 +68,22 @@ overcast minutes had less than 0.6 of the clear-sky model's irradiance above wat
 OVERCAST_DIFFUSE_FRACTION = 0.99
 """The largest share ``sky.diffuse_fraction`` takes: the sun keeps 1 %, and the overcast series
 compares the sky's part of the map alone (run.json's ``sky_irradiance_w_m2``)."""
+
+CLEAR_SELECTION = 0.85
+"""The paper's clear minutes: above-water irradiance at least this share of its clear-sky model's
+(``jerlov.gernez2009_cv_by_sun_zenith().sky``). A hazier sky than the model's, as far as the selection
+admits, takes 1 − 0.85 of the total from the sun's beam: the ``model_cv_weakest_clear_sun`` column
+(:func:`weakest_clear_sun`)."""
+
+
+def weakest_clear_sun(diffuse_fraction: float) -> float:
+    """The sun's beam, as a share of the sky model's, on the haziest sky the paper's selection admits
+    (:data:`CLEAR_SELECTION`), the sky's light as modelled: (1 − f − 0.15)/(1 − f) for the diffuse
+    share f, 0 where the sky alone passes it. A bound of what the record may hold, not a condition
+    it is known to hold."""
+    direct = 1.0 - diffuse_fraction
+    return max(direct - (1.0 - CLEAR_SELECTION), 0.0) / direct if direct > 0 else 0.0
+
 
 WIND_SERIES_ZENITH_DEG = 40.0
 """Sun zenith of the wind series. The paper's Fig. 8c pools all zeniths; 40° is our choice, near the
@@ -323,10 +340,12 @@ def _scene_value(config, key: str):
     return value.value if isinstance(value, Enum) else value
 
 
-def _columns(stats: list[dict], t: float, *, overcast: bool = False, key=lambda s: s) -> dict:
+def _columns(stats: list[dict], t: float, *, overcast: bool = False, key=lambda s: s,
+             weakest_sun: float = 1.0) -> dict:
     """Each frame's (mean, CV) of the map as rendered, with the sky as a uniform background (its
-    directions' own caustics removed), and with the sun's scattered light, lost by single
-    scattering (direct transmission ``t``), back as a uniform background too; ``key`` picks the
+    directions' own caustics removed), with the sun's scattered light, lost by single
+    scattering (direct transmission ``t``), back as a uniform background too, and with the sun's
+    part ``weakest_sun`` times as strong (:func:`weakest_clear_sun`); ``key`` picks the
     texels' statistics or the patch's windows' (``patch_windows``: None where a frame has none).
     Under an overcast sky the map is the sky's part alone, and the two columns that remove the
     sky's own pattern have nothing left to say."""
@@ -338,11 +357,12 @@ def _columns(stats: list[dict], t: float, *, overcast: bool = False, key=lambda 
 
     if overcast:
         return {"model_cv": frames("sky_irradiance_w_m2")}
-    total, direct = frames("irradiance_w_m2"), frames("direct_irradiance_w_m2")
-    sky = [m for m, _ in frames("sky_irradiance_w_m2")]
-    scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky)]
-    return {"model_cv": total, "model_cv_uniform_sky": with_background(direct, sky),
-            "model_cv_uniform_sky_scattered": with_background(direct, scattered)}
+    total, direct, sky = (frames(name) for name in STAT_FIELDS)
+    sky_mean = [m for m, _ in sky]
+    scattered = [m_sky + m * (1.0 / t - 1.0) for (m, _), m_sky in zip(direct, sky_mean)]
+    return {"model_cv": total, "model_cv_uniform_sky": with_background(direct, sky_mean),
+            "model_cv_uniform_sky_scattered": with_background(direct, scattered),
+            "model_cv_weakest_clear_sun": with_beam_scaled(total, direct, sky, weakest_sun)}
 
 
 STAT_FIELDS = ("irradiance_w_m2", "direct_irradiance_w_m2", "sky_irradiance_w_m2")
@@ -367,7 +387,8 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
             b = float(water_optics(optics, bins).scattering_per_m[band])
             t = direct_transmission(point.sun_zenith_deg, config.floor.depth_m, float(config.optics.ior), b)
         sea = whole_sea(stats, None if long is None else frame_statistics_of(*long, o), t,
-                        overcast=point.series == "overcast")
+                        overcast=point.series == "overcast",
+                        weakest_sun=weakest_clear_sun(point.diffuse_fraction))
         mean = sea.pop("model_mean_w_m2")
         wind = point.wind_m_s if point.wind_m_s is not None else config.water.wind_speed_m_s
         rows.append(
@@ -391,16 +412,18 @@ def _rows(points: list[Point], overrides: list[dict], fine, long, config) -> lis
     return rows
 
 
-def whole_sea(stats: list[dict], longer: list[dict] | None, t: float, *, overcast: bool = False) -> dict:
+def whole_sea(stats: list[dict], longer: list[dict] | None, t: float, *, overcast: bool = False,
+              weakest_sun: float = 1.0) -> dict:
     """The model's columns at one point from its frames' statistics (``stats``: each frame's fields
     :data:`STAT_FIELDS`) and, where rendered, the longer waves' (``longer``): each of
     :data:`CV_COLUMNS` over the whole sea (:func:`_columns` with the sun's direct transmission ``t``,
     pooled within the window and between the patch's windows, nested with the longer waves), the
     window alone, the patch, the longer waves alone, the frames' spread of the window's CV and its
     mean."""
-    window = _columns(stats, t, overcast=overcast)
-    windows = _columns(stats, t, overcast=overcast, key=lambda s: s.get("patch_windows"))
-    waves = None if longer is None else _columns(longer, t, overcast=overcast)
+    kw = dict(overcast=overcast, weakest_sun=weakest_sun)
+    window = _columns(stats, t, **kw)
+    windows = _columns(stats, t, key=lambda s: s.get("patch_windows"), **kw)
+    waves = None if longer is None else _columns(longer, t, **kw)
     mean, cv_window = pooled_statistics(window["model_cv"])
     # within the window, between the windows of the whole patch, and over the longer waves' patch
     sea = {name: sea_cv(frames, None if windows is None else windows[name],
@@ -416,7 +439,8 @@ def whole_sea(stats: list[dict], longer: list[dict] | None, t: float, *, overcas
     }
 
 
-CV_COLUMNS = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered")
+CV_COLUMNS = ("model_cv", "model_cv_uniform_sky", "model_cv_uniform_sky_scattered",
+              "model_cv_weakest_clear_sun")
 """The model's CVs from the scene's patch and, with ``--long-waves``, the longer waves' (:func:`_columns`)."""
 
 PLOT_NEEDS = "the comparison's plot needs"

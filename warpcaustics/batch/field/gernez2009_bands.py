@@ -47,6 +47,7 @@ from warpcaustics.batch.field.gernez2009 import (
     check_conditions,
     diffuse_fraction,
     direct_transmission,
+    weakest_clear_sun,
     whole_sea,
 )
 from warpcaustics.config import Scattering
@@ -167,7 +168,8 @@ def _zenith_rows(scene, zenith: float, wavelengths_nm, measured, stats: list[dic
         if config.optics.scattering is Scattering.SINGLE:
             t = direct_transmission(zenith, config.floor.depth_m, float(config.optics.ior),
                                     float(scattering[j]))
-        sea = whole_sea(frames, None if longer is None else band_frames(longer, float(nm)), t)
+        sea = whole_sea(frames, None if longer is None else band_frames(longer, float(nm)), t,
+                        weakest_sun=weakest_clear_sun(config.sky.diffuse_fraction))
         mean = sea.pop("model_mean_w_m2")  # of the band: W m⁻² nm⁻¹
         sky = float(np.mean([f["sky_irradiance_w_m2"]["mean"] for f in frames]))
         cv = float(measured[j])
