@@ -54,7 +54,8 @@ def test_command_on_still_water_sees_the_sun_only_in_its_refracted_direction(tmp
     """End to end (--quick, panel a) under still water: looking at 25°, whose 4.5° cone holds the
     refracted sun (Snell's law: 23.97°), every texel sees the sun and the sky is a small share of the
     light; looking 30° away from it none sees the sun and the light is the sky's alone. The map is
-    uniform either way (CV 0), beside the record's values; a plot is written."""
+    uniform either way (CV 0, with the scattered light too), beside the record's values; a plot is
+    written."""
     pytest.importorskip("matplotlib")
     flat = tmp_path / "flat.toml"
     flat.write_text(RADIANCE.read_text().replace('model = "fft"', 'model = "flat"'))
@@ -66,8 +67,11 @@ def test_command_on_still_water_sees_the_sun_only_in_its_refracted_direction(tmp
     refracted = math.degrees(math.asin(math.sin(math.radians(rec.sun_zenith_deg)) / 1.336))
     assert abs(refracted - 25.0) < 0.5 * rec.field_of_view_deg
     assert [(r["panel"], float(r["zenith_deg"])) for r in rows] == [("a", -30.0), ("a", 25.0)]
-    assert all(float(r["model_cv"]) < 1e-5 for r in rows)
+    assert all(float(r["model_cv"]) < 1e-5 and float(r["model_cv_scattered_smooth"]) < 1e-5 for r in rows)
     away, towards = rows
+    # the light scattered into the cone by more than 3°: a share of the sky's view, little beside the sun
+    assert 0.01 < float(away["model_scattered_share"]) < 0.9
+    assert 0.0 < float(towards["model_scattered_share"]) < 0.01
     assert float(away["model_sun_in_view"]) == 0.0 and float(away["model_sky_share"]) == 1.0
     assert float(towards["model_sun_in_view"]) == 1.0 and float(towards["model_sky_share"]) < 0.05
     assert [float(r["measured_cv"]) for r in rows] == pytest.approx(

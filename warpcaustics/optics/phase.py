@@ -138,6 +138,18 @@ def station_mean_cosine(station: str) -> float:
     return mean_cosine(*phase_quadrature(PhaseFunctionKind.PETZOLD, None, station))
 
 
+def phase_values(optics: OpticsConfig, theta: np.ndarray) -> np.ndarray:
+    """The configured phase function p(θ) [1/sr] at scattering angles ``theta`` [rad] > 0, float64:
+    Henyey–Greenstein in closed form (mean cosine ``optics.hg_g`` or the station's), or the Petzold
+    station's table with its power-law cone (:func:`table_on_grid`)."""
+    station = optics.petzold_station.value
+    theta = np.maximum(np.asarray(theta, np.float64), 1e-12)
+    if optics.phase_function is PhaseFunctionKind.HENYEY_GREENSTEIN:
+        g = station_mean_cosine(station) if optics.hg_g is None else optics.hg_g
+        return (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * np.cos(theta)) ** 1.5)
+    return table_on_grid(*petzold_table(station), theta)
+
+
 def quadrature_for(optics: OpticsConfig) -> tuple[np.ndarray, np.ndarray]:
     """The configured phase function's :func:`phase_quadrature`."""
     return phase_quadrature(optics.phase_function, optics.hg_g, optics.petzold_station.value)

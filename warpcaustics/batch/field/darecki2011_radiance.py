@@ -33,6 +33,7 @@ from warpcaustics.batch.field.common import (
     check_frames,
     check_overrides,
     frame_statistics_of,
+    pooled_statistics,
     render_points,
     select_measured,
 )
@@ -165,8 +166,10 @@ def run_darecki2011_radiance(
         stats = frame_statistics_of(sweep, out, variant)
         sky = [s["bands_sky"][band]["mean"] / s["bands"][band]["mean"] for s in stats]
         sun = [s["bands_direct"][band]["sun_in_view"] for s in stats]
+        frames = [s["bands"][band] for s in stats]
         rows.append({"panel": panel, "zenith_deg": zenith, "measured_cv": round(measured, 4),
-                     **_shared(band_row([s["bands"][band] for s in stats], measured)),
+                     **_shared(band_row(frames, measured)),
+                     **scattered_columns(load_scene(scene_path, {**fixed, **variant}), frames, measured),
                      "model_sun_in_view": float(np.mean(sun)),
                      "model_sky_share": round(float(np.mean(sky)), 4),
                      "depth_m": float(rec.depth_m), "sun_zenith_deg": float(rec.sun_zenith_deg),
@@ -180,6 +183,25 @@ def run_darecki2011_radiance(
     write_csv(paths["csv"], rows)
     plot(rows, paths["png"], quick)
     return paths
+
+
+def scattered_columns(scene, frames: list[dict], measured: float) -> dict:
+    """The light scattered once into the sensor (:func:`~warpcaustics.caustics.path_radiance.
+    sensor_path_radiance`), which the rendered map leaves out: the share of the cone's light
+    scattered by more than a few degrees (``model_scattered_share``), and the CV with it
+    (``model_cv_scattered_smooth``), the light scattered by less following the map (it comes from
+    nearly the directions the sensor sees) and the rest a uniform background (its own flicker left
+    out: the light of the whole lit water column)."""
+    from warpcaustics.caustics.path_radiance import sensor_path_radiance
+
+    near, wide = (float(x[0]) for x in sensor_path_radiance(scene))
+    window = [(b["mean"], b["cv"]) for b in frames]
+    mean, _ = pooled_statistics(window)
+    gain = 1.0 + near / mean if mean > 0 else 1.0
+    _, cv = pooled_statistics([(m * gain, c) for m, c in window], [wide] * len(window))
+    return {"model_scattered_share": round(wide / (mean * gain + wide), 4),
+            "model_cv_scattered_smooth": round(cv, 4),
+            "model_scattered_smooth_over_measured": round(cv / measured, 3)}
 
 
 def _shared(row: dict) -> dict:

@@ -1,0 +1,179 @@
+"""The light scattered once into a radiance sensor's line of sight, its mean: what the sensor of
+``floor.view_*`` (:mod:`warpcaustics.caustics.view`), which takes the unscattered light alone
+(single scattering, c = a + b), leaves out.
+
+Along the line of sight from the sensor at depth D towards v (v_z > 0) to the still surface, a
+point s metres away lies at depth z = D − s v_z. Light crossing it in direction d (μ = −d_z > 0),
+of radiance L₀(d) just below the surface, is scattered into the line of sight with the phase
+function p at the angle ψ between d and −v, and attenuated on to the sensor:
+
+    L_p(v) = b ∫₀^ℓ e^{−c s} ∫ p(ψ) L₀(d) e^{−c z(s)/μ} dω_d ds,   ℓ = D / v_z,
+
+the radiative transfer equation's source term integrated along the ray once (the single-scattering
+solution; the same integrand as the camera's in-scattering, docs/physics.md, "The view from above").
+The s-integral is closed: e^{−cD/μ} (1 − e^{−κℓ})/κ with κ = c (1 − v_z/μ). The light is the
+refracted sun's beam, E⊥ = E_sun T(θ_s) cos θ_s / cos θ_w just below the surface, and the sky's,
+L₀ = n² T(θ_a) L_sky (the n² law), from the CIE sky the scene has; both as through still water, so
+the result is the scattered light's mean under a wavy sea to the order the waves' tilts average out.
+The sensor reads P = ∫ L_p dω over its cone. Near the sun's direction the phase function's forward
+peak (Petzold's power law below 0.1°) is integrated in polar angles about the refracted sun, and the
+sky's forward light within :data:`FORWARD_DEG` of the line of sight as the sky's radiance along it
+times the phase function's share there.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from warpcaustics.caustics.view import cone_directions, view_axis
+from warpcaustics.optics.phase import phase_quadrature, phase_values
+from warpcaustics.optics.sky import cie_sky_type, sky_radiance
+from warpcaustics.optics.snell import fresnel_transmittance, refract
+
+FORWARD_DEG = 3.0
+"""The sky's light scattered by less than this into the line of sight is taken as the sky's
+radiance along the line of sight times the phase function's share below it."""
+
+CONE_SAMPLES = 64
+"""Directions over the sensor's cone for the sky's scattered light (smooth across the cone)."""
+
+SKY_RINGS = 192
+"""Rings of the sky's quadrature (equal in sin²θ above the water, twice as many azimuths)."""
+
+SUN_NODES = (1000, 1024)
+"""Polar nodes (angle from the refracted sun, log-spaced; azimuth) of the sun's scattered light."""
+
+
+def _path_integral(c: float, depth_m: float, v_z: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """∫₀^ℓ e^{−c s} e^{−c (D − s v_z)/μ} ds, ℓ = D / v_z, in closed form."""
+    length = depth_m / v_z
+    kappa = c * (1.0 - v_z / mu)
+    x = kappa * length
+    small = np.abs(x) < 1e-8
+    ratio = np.where(small, length * (1.0 - 0.5 * x), -np.expm1(-x) / np.where(small, 1.0, kappa))
+    return np.exp(-c * depth_m / mu) * ratio
+
+
+def sun_part(axis: np.ndarray, fov_deg: float, depth_m: float, sun_down: np.ndarray, beam: float,
+             c: float, b: float, phase) -> tuple[float, float]:
+    """∫ over the cone of the refracted sun's scattered radiance [W m⁻² (per nm)], (scattered by
+    less than :data:`FORWARD_DEG`, by more): ``sun_down`` the unit direction its light travels in
+    the water, ``beam`` its irradiance across the beam just below the surface, ``phase`` p(ψ)
+    [1/sr] of angles [rad]; in polar angles (ψ, φ) about the direction the sensor would look to
+    see the sun, where the forward peak is."""
+    half = math.radians(0.5 * fov_deg)
+    seen = -np.asarray(sun_down, np.float64)
+    off = math.acos(min(1.0, float(seen @ axis)))
+    lo, hi = max(off - half, 0.0), min(off + half, math.pi)
+    psi = np.geomspace(max(lo, 1e-9), hi, SUN_NODES[0])
+    helper = np.array([1.0, 0.0, 0.0]) if abs(seen[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(seen, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(seen, e1)
+    # the azimuths about the sun that can reach the cone: all where the cone holds the sun, else
+    # those within the cone's angular half-width seen from the sun (its widest, at ψ = lo)
+    width = math.pi if lo == 0.0 else min(math.pi, 1.01 * math.asin(min(1.0, math.sin(half) / math.sin(lo))))
+    centre = math.atan2(float(axis @ e2), float(axis @ e1))
+    phi = centre + width * ((np.arange(SUN_NODES[1]) + 0.5) * 2.0 / SUN_NODES[1] - 1.0)
+    sp, cp = np.sin(psi)[:, None, None], np.cos(psi)[:, None, None]
+    v = cp * seen + sp * (np.cos(phi)[None, :, None] * e1 + np.sin(phi)[None, :, None] * e2)
+    inside = (v @ axis >= math.cos(half)) & (v[..., 2] > 1e-6)
+    v_z = np.where(inside, v[..., 2], 1.0)
+    path = np.where(inside, _path_integral(c, depth_m, v_z, -sun_down[2]), 0.0)
+    ring = path.sum(axis=1) * (2.0 * width / SUN_NODES[1])  # ∫ dφ at each ψ
+    integrand = phase(psi) * np.sin(psi) * ring
+    forward = psi < math.radians(FORWARD_DEG)
+    near = float(np.trapezoid(np.where(forward, integrand, 0.0), psi))
+    wide = float(np.trapezoid(np.where(forward, 0.0, integrand), psi))
+    if lo == 0.0:  # below the first node: p's share there, the path as at the node
+        near += float(ring[0]) / (2.0 * math.pi) * _share_below(phase, psi[0])
+    return b * beam * near, b * beam * wide
+
+
+def _share_below(phase, theta: float) -> float:
+    """∫ p dω below ``theta`` (tiny): by the power law through p at theta/2 and theta."""
+    p1, p2 = phase(np.array([0.5 * theta, theta]))
+    m = min(max(math.log(p1 / p2) / math.log(2.0), 0.0), 1.99)
+    return 2.0 * math.pi * float(p2) * theta ** 2 / (2.0 - m)
+
+
+def sky_part(axis: np.ndarray, fov_deg: float, depth_m: float, sky_radiance_of, ior: float, c: float,
+             b: float, phase, forward_share: float) -> tuple[float, float]:
+    """∫ over the cone of the sky's scattered radiance, (scattered by less than :data:`FORWARD_DEG`,
+    by more): ``sky_radiance_of`` the sky's radiance above the water towards unit directions
+    (..., 3); ``forward_share`` the phase function's share below :data:`FORWARD_DEG`."""
+    views, d_omega = cone_directions(axis, fov_deg, CONE_SAMPLES)
+    rings = SKY_RINGS
+    sin2 = (np.arange(rings) + 0.5) / rings
+    phi = (np.arange(2 * rings) + 0.5) * math.pi / rings
+    sin_a = np.sqrt(sin2)[:, None]
+    cos_a = np.sqrt(1.0 - sin2)[:, None] * np.ones_like(phi)
+    up = np.stack(np.broadcast_arrays(sin_a * np.cos(phi), sin_a * np.sin(phi), cos_a), axis=-1)
+    up = up.reshape(-1, 3)
+    down = refract(-up, np.array([0.0, 0.0, 1.0]), 1.0 / ior)
+    mu = -down[:, 2]
+    # L₀ dω in the water = T L_sky μ_a dω_a / μ (the n² law and Snell's solid angles); μ_a dω_a = π/(2R²)
+    cell = math.pi / (2 * rings**2)
+    weight = fresnel_transmittance(up[:, 2], 1.0 / ior) * sky_radiance_of(up) * cell / mu
+    forward = math.radians(FORWARD_DEG)
+    near = wide = 0.0
+    for v in views:
+        cos_psi = np.clip(down @ -v, -1.0, 1.0)
+        psi = np.arccos(cos_psi)
+        far = psi >= forward
+        scattered = np.sum(np.where(far, phase(psi) * weight * _path_integral(c, depth_m, v[2], mu), 0.0))
+        sin_a = ior * math.sqrt(max(0.0, 1.0 - v[2] ** 2))  # the sky along the line of sight, if any
+        along = 0.0
+        if sin_a < 1.0:
+            toward = np.array([v[0] * ior, v[1] * ior, math.sqrt(1.0 - sin_a**2)])
+            t = float(fresnel_transmittance(toward[2], 1.0 / ior))
+            seen = ior**2 * t * float(sky_radiance_of(toward))
+            along = seen * float(_path_integral(c, depth_m, v[2], v[2]))
+        near += forward_share * along
+        wide += scattered
+    return b * near * d_omega, b * wide * d_omega
+
+
+def sensor_path_radiance(scene) -> tuple[np.ndarray, np.ndarray]:
+    """The mean light scattered once into the scene's radiance sensor (``floor.view_*``), ∫ L_p dω
+    over its cone [W m⁻² nm⁻¹], per band (K,): (scattered by less than :data:`FORWARD_DEG`, by
+    more), the sun's beam's and the sky's together, as through still water (module docstring). The
+    first comes from nearly the directions the sensor sees and flickers with them; the second from
+    the whole lit water column."""
+    from warpcaustics.config import SkyModel
+    from warpcaustics.optics import spectra
+
+    cfg = scene.config
+    f = cfg.floor
+    if not f.view_fov_deg:
+        raise ValueError("sensor_path_radiance needs a radiance sensor (floor.view_fov_deg)")
+    bins = spectra.bins_for(cfg.optics)
+    sun = spectra.sun_irradiance(bins, cfg.sun, scene.base_dir)
+    ior = spectra.refractive_index(cfg.optics, bins)
+    water = spectra.water_optics(cfg.optics, bins)
+    axis = view_axis(f.view_zenith_deg, f.view_azimuth_deg)
+    to_sun = scene.sun_direction
+
+    def phase(theta):
+        return phase_values(cfg.optics, theta)
+
+    theta, w = phase_quadrature(cfg.optics.phase_function, cfg.optics.hg_g, cfg.optics.petzold_station.value)
+    forward = float(w[theta < math.radians(FORWARD_DEG)].sum() / w.sum())
+    sky = None if cfg.sky.model is SkyModel.NONE else scene.sky_irradiance(sun)
+    sky_type = cie_sky_type(cfg.sky)
+    near, wide = np.zeros(len(bins.centres_nm)), np.zeros(len(bins.centres_nm))
+    for k in range(len(near)):
+        n, a, b = float(ior[k]), float(water.absorption_per_m[k]), float(water.scattering_per_m[k])
+        down = refract(-to_sun, np.array([0.0, 0.0, 1.0]), 1.0 / n)
+        mu_s = float(to_sun[2])
+        beam = float(sun[k]) * float(fresnel_transmittance(mu_s, 1.0 / n)) * mu_s / -float(down[2])
+        near[k], wide[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b, phase)
+        if sky is not None:
+            def radiance(d, k=k):
+                return sky_radiance(sky_type, d, to_sun, sky[k:k + 1])[..., 0]
+            parts = sky_part(axis, f.view_fov_deg, f.depth_m, radiance, n, a + b, b, phase, forward)
+            near[k] += parts[0]
+            wide[k] += parts[1]
+    return near, wide
