@@ -61,7 +61,7 @@ def test_command_on_still_water_sees_the_sun_only_in_its_refracted_direction(tmp
     flat.write_text(RADIANCE.read_text().replace('model = "fft"', 'model = "flat"'))
     out = tmp_path / "o"
     assert main(["field", "darecki2011_radiance", str(flat), "--out", str(out), "--quick", "--frames", "1",
-                 "--view-zeniths", "25,-30", "--panels", "a", "--device", "cpu", "--quiet"]) == 0
+                 "--view-zeniths", "-30,25", "--panels", "a", "--device", "cpu", "--quiet"]) == 0
     rows = list(csv.DictReader((out / "darecki2011_radiance.csv").open()))
     rec = jerlov.darecki2011_radiance_cv("a")
     refracted = math.degrees(math.asin(math.sin(math.radians(rec.sun_zenith_deg)) / 1.336))

@@ -449,8 +449,23 @@ def one_line(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+SIGNED_LIST_FLAGS = ("--view-zeniths",)
+"""Flags whose list may start with a negative number, which argparse would take for a flag."""
+
+
+def _signed_lists(argv: list[str]) -> list[str]:
+    """``--view-zeniths -30,0`` as ``--view-zeniths=-30,0``, so that argparse takes the list."""
+    out = []
+    for arg in argv:
+        if out and out[-1] in SIGNED_LIST_FLAGS and arg[:1] == "-" and arg[1:2].isdigit():
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    args = _parser().parse_args(_signed_lists(sys.argv[1:] if argv is None else list(argv)))
     try:
         if args.command in ("sweep", "field"):  # render, study and compare check theirs as they use it
             _out_folder(args.out)  # an empty --out would write into the working folder
