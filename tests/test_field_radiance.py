@@ -112,7 +112,8 @@ def test_bad_input_is_one_line(tmp_path, capsys):
                            ({"stats.per_band": False}, "stats.per_band = true"),
                            ({"sun.azimuth_deg": 90.0}, "sun.azimuth_deg = 0"),
                            ({"sky.model": "none", "sky.diffuse_fraction": 0.0}, "sky.model = 'cie_clear'"),
-                           ({"optics.scattering": "small_angle"}, 'optics.scattering = "single"')):
+                           ({"optics.scattering": "small_angle"}, 'optics.scattering = "single"'),
+                           ({"caustics.map_extent_m": 1.0}, "set caustics.map_extent_m = 0")):
         with pytest.raises(ConfigError, match=fix):
             run(RADIANCE, tmp_path / "o", overrides=overrides, quick=True)
     assert main(["field", "darecki2011_radiance", str(RADIANCE), "--out", str(tmp_path / "o"),

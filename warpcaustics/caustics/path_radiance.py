@@ -15,20 +15,21 @@ The s-integral is closed: e^{−cD/μ} (1 − e^{−κℓ})/κ with κ = c (1 �
 refracted sun's beam, E⊥ = E_sun T(θ_s) cos θ_s / cos θ_w just below the surface, and the sky's,
 L₀ = n² T(θ_a) L_sky (the n² law), from the CIE sky the scene has; both as through still water, so
 the result is the scattered light's mean under a wavy sea to the order the waves' tilts average out.
-The sensor reads P = ∫ L_p dω over its cone. Near the sun's direction the phase function's forward
-peak (Petzold's power law below 0.1°) is integrated in polar angles about the refracted sun, and the
-sky's forward light within :data:`FORWARD_DEG` of the line of sight as the sky's radiance along it
-times the phase function's share there.
+The sensor reads P = ∫ L_p dω over its cone. The phase function's forward peak (Petzold's power law
+below 0.1°) is integrated in polar angles: about the refracted sun for the sun's light, about each
+line of sight for the sky's within :data:`INNER_DEG`; the rest of the sky on rings. The light
+scattered by less than :data:`FORWARD_DEG` is kept apart (:class:`Scattered`).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from warpcaustics.caustics.view import cone_directions, view_axis
-from warpcaustics.optics.phase import phase_quadrature, phase_values
+from warpcaustics.optics.phase import phase_values
 from warpcaustics.optics.sky import cie_sky_type, sky_radiance
 from warpcaustics.optics.snell import fresnel_transmittance, refract
 
@@ -40,7 +41,15 @@ CONE_SAMPLES = 64
 """Directions over the sensor's cone for the sky's scattered light (smooth across the cone)."""
 
 SKY_RINGS = 192
-"""Rings of the sky's quadrature (equal in sin²θ above the water, twice as many azimuths)."""
+"""Rings of the sky's quadrature (equal in sin²θ above the water, twice as many azimuths), for its
+light scattered by more than :data:`INNER_DEG`."""
+
+INNER_DEG = 10.0
+"""The sky's light scattered by less than this into a line of sight is integrated in polar angles
+about it (:data:`INNER_NODES`: log-spaced angles, split at :data:`FORWARD_DEG`; azimuths), where the
+phase function's forward peak is."""
+
+INNER_NODES = (400, 128)
 
 SUN_NODES = (1000, 1024)
 """Polar nodes (angle from the refracted sun, log-spaced; azimuth) of the sun's scattered light."""
@@ -67,14 +76,21 @@ def sun_part(axis: np.ndarray, fov_deg: float, depth_m: float, sun_down: np.ndar
     seen = -np.asarray(sun_down, np.float64)
     off = math.acos(min(1.0, float(seen @ axis)))
     lo, hi = max(off - half, 0.0), min(off + half, math.pi)
-    psi = np.geomspace(max(lo, 1e-9), hi, SUN_NODES[0])
+    split = math.radians(FORWARD_DEG)
+    if lo < split < hi:  # a node at the split, so that each side is integrated on its own nodes
+        count = SUN_NODES[0] // 2
+        segments = [np.geomspace(max(lo, 1e-9), split, count), np.geomspace(split, hi, count)]
+    else:
+        segments = [np.geomspace(max(lo, 1e-9), hi, SUN_NODES[0])]
+    psi = np.concatenate(segments)
     helper = np.array([1.0, 0.0, 0.0]) if abs(seen[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = np.cross(seen, helper)
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(seen, e1)
     # the azimuths about the sun that can reach the cone: all where the cone holds the sun, else
-    # those within the cone's angular half-width seen from the sun (its widest, at ψ = lo)
-    width = math.pi if lo == 0.0 else min(math.pi, 1.01 * math.asin(min(1.0, math.sin(half) / math.sin(lo))))
+    # those within the cone's angular half-width seen from the sun, asin(sin h / sin off)
+    tangent = math.asin(min(1.0, math.sin(half) / math.sin(off))) if off > half else math.pi
+    width = min(math.pi, 1.01 * tangent)
     centre = math.atan2(float(axis @ e2), float(axis @ e1))
     phi = centre + width * ((np.arange(SUN_NODES[1]) + 0.5) * 2.0 / SUN_NODES[1] - 1.0)
     sp, cp = np.sin(psi)[:, None, None], np.cos(psi)[:, None, None]
@@ -84,9 +100,14 @@ def sun_part(axis: np.ndarray, fov_deg: float, depth_m: float, sun_down: np.ndar
     path = np.where(inside, _path_integral(c, depth_m, v_z, -sun_down[2]), 0.0)
     ring = path.sum(axis=1) * (2.0 * width / SUN_NODES[1])  # ∫ dφ at each ψ
     integrand = phase(psi) * np.sin(psi) * ring
-    forward = psi < math.radians(FORWARD_DEG)
-    near = float(np.trapezoid(np.where(forward, integrand, 0.0), psi))
-    wide = float(np.trapezoid(np.where(forward, 0.0, integrand), psi))
+    parts, start = [], 0
+    for nodes in segments:
+        parts.append(float(np.trapezoid(integrand[start:start + len(nodes)], nodes)))
+        start += len(nodes)
+    if len(parts) == 2:
+        near, wide = parts
+    else:  # wholly inside the split, or wholly outside it
+        near, wide = (parts[0], 0.0) if hi <= split else (0.0, parts[0])
     if lo == 0.0:  # below the first node: p's share there, the path as at the node
         near += float(ring[0]) / (2.0 * math.pi) * _share_below(phase, psi[0])
     return b * beam * near, b * beam * wide
@@ -99,11 +120,25 @@ def _share_below(phase, theta: float) -> float:
     return 2.0 * math.pi * float(p2) * theta ** 2 / (2.0 - m)
 
 
+def _in_water_sky(down: np.ndarray, sky_radiance_of, ior: float) -> np.ndarray:
+    """The sky's radiance in the water along unit directions ``down`` (..., 3) its light travels in:
+    n² T(θ_a) L_sky towards the direction above the water it came from (the n² law), 0 outside
+    Snell's window."""
+    horizontal = -ior * down[..., :2]
+    sin2 = np.sum(horizontal**2, axis=-1)
+    inside = (sin2 < 1.0) & (down[..., 2] < 0.0)
+    up = np.concatenate([horizontal, np.sqrt(np.maximum(1.0 - sin2, 0.0))[..., None]], axis=-1)
+    up = np.where(inside[..., None], up, np.array([0.0, 0.0, 1.0]))
+    value = ior**2 * fresnel_transmittance(up[..., 2], 1.0 / ior) * sky_radiance_of(up)
+    return np.where(inside, value, 0.0)
+
+
 def sky_part(axis: np.ndarray, fov_deg: float, depth_m: float, sky_radiance_of, ior: float, c: float,
-             b: float, phase, forward_share: float) -> tuple[float, float]:
+             b: float, phase) -> tuple[float, float]:
     """∫ over the cone of the sky's scattered radiance, (scattered by less than :data:`FORWARD_DEG`,
     by more): ``sky_radiance_of`` the sky's radiance above the water towards unit directions
-    (..., 3); ``forward_share`` the phase function's share below :data:`FORWARD_DEG`."""
+    (..., 3). The light from within :data:`INNER_DEG` of each line of sight, where the phase
+    function's forward peak is, in polar angles about it; the rest on the sky's rings."""
     views, d_omega = cone_directions(axis, fov_deg, CONE_SAMPLES)
     rings = SKY_RINGS
     sin2 = (np.arange(rings) + 0.5) / rings
@@ -117,31 +152,64 @@ def sky_part(axis: np.ndarray, fov_deg: float, depth_m: float, sky_radiance_of, 
     # L₀ dω in the water = T L_sky μ_a dω_a / μ (the n² law and Snell's solid angles); μ_a dω_a = π/(2R²)
     cell = math.pi / (2 * rings**2)
     weight = fresnel_transmittance(up[:, 2], 1.0 / ior) * sky_radiance_of(up) * cell / mu
-    forward = math.radians(FORWARD_DEG)
+    inner, split = math.radians(INNER_DEG), math.radians(FORWARD_DEG)
+    count = INNER_NODES[0] // 2
+    segments = [np.geomspace(1e-7, split, count), np.geomspace(split, inner, count)]
+    turns = (np.arange(INNER_NODES[1]) + 0.5) * 2.0 * math.pi / INNER_NODES[1]
     near = wide = 0.0
     for v in views:
-        cos_psi = np.clip(down @ -v, -1.0, 1.0)
-        psi = np.arccos(cos_psi)
-        far = psi >= forward
-        scattered = np.sum(np.where(far, phase(psi) * weight * _path_integral(c, depth_m, v[2], mu), 0.0))
-        sin_a = ior * math.sqrt(max(0.0, 1.0 - v[2] ** 2))  # the sky along the line of sight, if any
-        along = 0.0
-        if sin_a < 1.0:
-            toward = np.array([v[0] * ior, v[1] * ior, math.sqrt(1.0 - sin_a**2)])
-            t = float(fresnel_transmittance(toward[2], 1.0 / ior))
-            seen = ior**2 * t * float(sky_radiance_of(toward))
-            along = seen * float(_path_integral(c, depth_m, v[2], v[2]))
-        near += forward_share * along
-        wide += scattered
+        psi = np.arccos(np.clip(down @ -v, -1.0, 1.0))
+        far = psi >= inner
+        wide += np.sum(np.where(far, phase(psi) * weight * _path_integral(c, depth_m, v[2], mu), 0.0))
+        helper = np.array([1.0, 0.0, 0.0]) if abs(v[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
+        e1 = np.cross(v, helper)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(v, e1)
+        for k, nodes in enumerate(segments):  # the light travels along d, ψ from −v
+            sp, cp = np.sin(nodes)[:, None, None], np.cos(nodes)[:, None, None]
+            d = -cp * v + sp * (np.cos(turns)[None, :, None] * e1 + np.sin(turns)[None, :, None] * e2)
+            mu_d = np.maximum(-d[..., 2], 1e-9)
+            ring = np.sum(_in_water_sky(d, sky_radiance_of, ior) * _path_integral(c, depth_m, v[2], mu_d),
+                          axis=1) * (2.0 * math.pi / INNER_NODES[1])
+            part = float(np.trapezoid(phase(nodes) * np.sin(nodes) * ring, nodes))
+            if k == 0:
+                near += part
+            else:
+                wide += part
     return b * near * d_omega, b * wide * d_omega
 
 
-def sensor_path_radiance(scene) -> tuple[np.ndarray, np.ndarray]:
-    """The mean light scattered once into the scene's radiance sensor (``floor.view_*``), ∫ L_p dω
-    over its cone [W m⁻² nm⁻¹], per band (K,): (scattered by less than :data:`FORWARD_DEG`, by
-    more), the sun's beam's and the sky's together, as through still water (module docstring). The
-    first comes from nearly the directions the sensor sees and flickers with them; the second from
-    the whole lit water column."""
+@dataclass
+class Scattered:
+    """The mean light scattered once into a radiance sensor's cone, ∫ L_p dω [W m⁻² nm⁻¹], per band
+    (K,): scattered by less than :data:`FORWARD_DEG`, the sun's (``near_sun``) and the sky's
+    (``near_sky``), which come from nearly the directions the sensor sees and flicker with them; and
+    scattered by more, both together (``wide``), which come from the whole lit water column."""
+
+    near_sun: np.ndarray
+    near_sky: np.ndarray
+    wide: np.ndarray
+
+
+def refracted_beam(scene, k: int) -> tuple[np.ndarray, float]:
+    """Band ``k``'s refracted sun through still water: the unit direction its light travels in the
+    water and its irradiance across the beam just below the surface, E⊥ = E_sun T(θ_s) cos θ_s /
+    cos θ_w [W m⁻² nm⁻¹] (the sun's disk as its centre)."""
+    from warpcaustics.optics import spectra
+
+    cfg = scene.config
+    bins = spectra.bins_for(cfg.optics)
+    sun = float(spectra.sun_irradiance(bins, cfg.sun, scene.base_dir)[k])
+    n = float(spectra.refractive_index(cfg.optics, bins)[k])
+    to_sun = scene.sun_direction
+    down = refract(-to_sun, np.array([0.0, 0.0, 1.0]), 1.0 / n)
+    mu_s = float(to_sun[2])
+    return down, sun * float(fresnel_transmittance(mu_s, 1.0 / n)) * mu_s / -float(down[2])
+
+
+def sensor_path_radiance(scene) -> Scattered:
+    """The mean light scattered once into the scene's radiance sensor (``floor.view_*``), the sun's
+    beam's and the sky's, as through still water (module docstring)."""
     from warpcaustics.config import SkyModel
     from warpcaustics.optics import spectra
 
@@ -159,21 +227,16 @@ def sensor_path_radiance(scene) -> tuple[np.ndarray, np.ndarray]:
     def phase(theta):
         return phase_values(cfg.optics, theta)
 
-    theta, w = phase_quadrature(cfg.optics.phase_function, cfg.optics.hg_g, cfg.optics.petzold_station.value)
-    forward = float(w[theta < math.radians(FORWARD_DEG)].sum() / w.sum())
     sky = None if cfg.sky.model is SkyModel.NONE else scene.sky_irradiance(sun)
     sky_type = cie_sky_type(cfg.sky)
-    near, wide = np.zeros(len(bins.centres_nm)), np.zeros(len(bins.centres_nm))
-    for k in range(len(near)):
+    out = Scattered(*(np.zeros(len(bins.centres_nm)) for _ in range(3)))
+    for k in range(len(out.wide)):
         n, a, b = float(ior[k]), float(water.absorption_per_m[k]), float(water.scattering_per_m[k])
-        down = refract(-to_sun, np.array([0.0, 0.0, 1.0]), 1.0 / n)
-        mu_s = float(to_sun[2])
-        beam = float(sun[k]) * float(fresnel_transmittance(mu_s, 1.0 / n)) * mu_s / -float(down[2])
-        near[k], wide[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b, phase)
+        down, beam = refracted_beam(scene, k)
+        out.near_sun[k], out.wide[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b, phase)
         if sky is not None:
             def radiance(d, k=k):
                 return sky_radiance(sky_type, d, to_sun, sky[k:k + 1])[..., 0]
-            parts = sky_part(axis, f.view_fov_deg, f.depth_m, radiance, n, a + b, b, phase, forward)
-            near[k] += parts[0]
-            wide[k] += parts[1]
-    return near, wide
+            near, wide = sky_part(axis, f.view_fov_deg, f.depth_m, radiance, n, a + b, b, phase)
+            out.near_sky[k], out.wide[k] = near, out.wide[k] + wide
+    return out

@@ -134,17 +134,19 @@ def with_background(frames: list[tuple[float, float]], background: list[float]) 
 
 
 def with_beam_scaled(total: list[tuple[float, float]], direct: list[tuple[float, float]],
-                     sky: list[tuple[float, float]], scale: float) -> list[tuple[float, float]]:
-    """Each frame's (mean, CV) were its direct sun's part ``scale`` times as strong, from the (mean,
-    CV) of the map (``total``) and of its two parts (total = direct + sky, texel by texel): the
-    covariance of the parts is what the total's variance holds beyond theirs, so the scaled map's
-    variance is scale² σ_d² + σ_s² + 2 scale cov, exactly, without the maps."""
+                     sky: list[tuple[float, float]], scale: float,
+                     sky_scale: float = 1.0) -> list[tuple[float, float]]:
+    """Each frame's (mean, CV) were its direct sun's part ``scale`` times as strong (and its sky's
+    ``sky_scale`` times), from the (mean, CV) of the map (``total``) and of its two parts (total =
+    direct + sky, texel by texel): the covariance of the parts is what the total's variance holds
+    beyond theirs, so the scaled map's variance is a² σ_d² + s² σ_s² + 2 a s cov, exactly, without
+    the maps."""
     frames = []
     for (m, c), (md, cd), (ms, cs) in zip(total, direct, sky):
         var_d, var_s = (md * cd) ** 2, (ms * cs) ** 2
         cov = 0.5 * ((m * c) ** 2 - var_d - var_s)
-        mean = scale * md + ms
-        var = scale * scale * var_d + var_s + 2.0 * scale * cov
+        mean = scale * md + sky_scale * ms
+        var = scale * scale * var_d + sky_scale**2 * var_s + 2.0 * scale * sky_scale * cov
         frames.append((mean, math.sqrt(max(var, 0.0)) / mean if mean > 0 else 0.0))
     return frames
 

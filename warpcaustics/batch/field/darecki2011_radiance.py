@@ -36,6 +36,7 @@ from warpcaustics.batch.field.common import (
     pooled_statistics,
     render_points,
     select_measured,
+    with_beam_scaled,
 )
 from warpcaustics.batch.field.darecki2011 import PLOT_NEEDS, beam_attenuation, chlorophyll_for
 from warpcaustics.config import SkyModel
@@ -97,7 +98,8 @@ def view(zenith_deg: float) -> dict:
 
 def check_scene(config, rec) -> None:
     """The record's band and field of view, per-band statistics, a sky, the sun in the sensor's
-    plane, a stateless sea (the rest a radiance sensor needs, the scene's own checks say)."""
+    plane, a stateless sea, the map the whole patch (the rest a radiance sensor needs, the scene's
+    own checks say)."""
     if tuple(config.optics.wavelengths.list_nm) != (float(rec.wavelength_nm),):
         raise ConfigError(f"the Darecki 2011 radiance comparison is of one band: set optics.wavelengths = "
                           f"[{rec.wavelength_nm:g}]")
@@ -116,6 +118,10 @@ def check_scene(config, rec) -> None:
     if config.water.stateful:
         raise ConfigError(f"water.model = {config.water.model.value!r} is stateful; the comparison pools "
                           "independent frames of a wind sea: use water.model = 'fft'")
+    if config.map_window[0] < config.water.extent_m * (1.0 - 1e-9):
+        raise ConfigError(f"caustics.map_extent_m = {config.caustics.map_extent_m:g}: the radiance "
+                          "comparison pools the whole patch's texels; set caustics.map_extent_m = 0 (finer "
+                          "texels: caustics.map_resolution)")
 
 
 def run_darecki2011_radiance(
@@ -169,7 +175,7 @@ def run_darecki2011_radiance(
         frames = [s["bands"][band] for s in stats]
         rows.append({"panel": panel, "zenith_deg": zenith, "measured_cv": round(measured, 4),
                      **_shared(band_row(frames, measured)),
-                     **scattered_columns(load_scene(scene_path, {**fixed, **variant}), frames, measured),
+                     **scattered_columns(load_scene(scene_path, {**fixed, **variant}), stats, band, measured),
                      "model_sun_in_view": float(np.mean(sun)),
                      "model_sky_share": round(float(np.mean(sky)), 4),
                      "depth_m": float(rec.depth_m), "sun_zenith_deg": float(rec.sun_zenith_deg),
@@ -185,21 +191,31 @@ def run_darecki2011_radiance(
     return paths
 
 
-def scattered_columns(scene, frames: list[dict], measured: float) -> dict:
+def scattered_columns(scene, stats: list[dict], band: str, measured: float) -> dict:
     """The light scattered once into the sensor (:func:`~warpcaustics.caustics.path_radiance.
-    sensor_path_radiance`), which the rendered map leaves out: the share of the cone's light
-    scattered by more than a few degrees (``model_scattered_share``), and the CV with it
-    (``model_cv_scattered_smooth``), the light scattered by less following the map (it comes from
-    nearly the directions the sensor sees) and the rest a uniform background (its own flicker left
-    out: the light of the whole lit water column)."""
+    sensor_path_radiance`), which the rendered map leaves out, from the frames' statistics ``stats``
+    of ``band``: the share of the cone's light scattered by more than a few degrees
+    (``model_scattered_share``), and the CV with it (``model_cv_scattered_smooth``), the light
+    scattered by less following the part it comes from (the sun's the map's direct part, the sky's
+    its sky part: from nearly the directions the sensor sees) and the rest a uniform background
+    (its own flicker left out: the light of the whole lit water column)."""
     from warpcaustics.caustics.path_radiance import sensor_path_radiance
 
-    near, wide = (float(x[0]) for x in sensor_path_radiance(scene))
-    window = [(b["mean"], b["cv"]) for b in frames]
-    mean, _ = pooled_statistics(window)
-    gain = 1.0 + near / mean if mean > 0 else 1.0
-    _, cv = pooled_statistics([(m * gain, c) for m, c in window], [wide] * len(window))
-    return {"model_scattered_share": round(wide / (mean * gain + wide), 4),
+    scattered = sensor_path_radiance(scene)
+    parts = [[(s[group][band]["mean"], s[group][band]["cv"]) for s in stats]
+             for group in ("bands", "bands_direct", "bands_sky")]
+    background = float(scattered.wide[0])
+    gains = []
+    for near, frames in ((float(scattered.near_sun[0]), parts[1]), (float(scattered.near_sky[0]), parts[2])):
+        mean = float(np.mean([m for m, _ in frames]))
+        if mean > 0.0:
+            gains.append(1.0 + near / mean)
+        else:  # the part is never in view: its forward light, if any, a background too
+            gains.append(1.0)
+            background += near
+    scaled = with_beam_scaled(*parts, *gains)
+    mean, cv = pooled_statistics(scaled, [background] * len(scaled))
+    return {"model_scattered_share": round(float(scattered.wide[0]) / mean, 4),
             "model_cv_scattered_smooth": round(cv, 4),
             "model_scattered_smooth_over_measured": round(cv / measured, 3)}
 
