@@ -26,8 +26,9 @@ PDF_EDGES = np.linspace(0.0, 5.0, 51)
 
 SUN_IN_VIEW = 0.1
 """A radiance sensor's texel holds the sun in its cone where the sun's part exceeds this share of the
-sky's mean there (``sun_in_view`` of :func:`frame_statistics`): a cone that takes only the disk's
-faint edge, or a ray's sliver, is not counted as seeing it."""
+sky's mean there (``sun_in_view`` of :func:`frame_statistics`). The whole beam is some 10³ times the
+sky's light in a 4.5° cone, so a texel that takes any fair part of it counts; the threshold keeps
+float32 rounding and the faintest slivers of the cone's edge from counting as sun."""
 
 
 def par_weights(edges_nm: np.ndarray, band_nm: tuple[float, float] = PAR_BAND_NM) -> np.ndarray:

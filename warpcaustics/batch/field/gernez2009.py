@@ -71,16 +71,17 @@ compares the sky's part of the map alone (run.json's ``sky_irradiance_w_m2``).""
 
 CLEAR_SELECTION = 0.85
 """The paper's clear minutes: above-water irradiance at least this share of its clear-sky model's
-(``jerlov.gernez2009_cv_by_sun_zenith().sky``). A hazier sky than the model's, as far as the selection
-admits, takes 1 − 0.85 of the total from the sun's beam: the ``model_cv_weakest_clear_sun`` column
-(:func:`weakest_clear_sun`)."""
+(``jerlov.gernez2009_cv_by_sun_zenith().sky``). With the sky's light as modelled, the selection
+admits a sun's beam weaker by up to 1 − 0.85 of the total: the ``model_cv_weakest_clear_sun``
+column (:func:`weakest_clear_sun`)."""
 
 
 def weakest_clear_sun(diffuse_fraction: float) -> float:
-    """The sun's beam, as a share of the sky model's, on the haziest sky the paper's selection admits
-    (:data:`CLEAR_SELECTION`), the sky's light as modelled: (1 − f − 0.15)/(1 − f) for the diffuse
-    share f, 0 where the sky alone passes it. A bound of what the record may hold, not a condition
-    it is known to hold."""
+    """The weakest sun's beam, as a share of the sky model's, that the paper's selection admits with
+    the sky's light as modelled (:data:`CLEAR_SELECTION`): (1 − f − 0.15)/(1 − f) for the diffuse
+    share f, 0 where the sky alone passes it. A sensitivity, not a bound: a haze that turns beam into
+    sky light lets a weaker beam pass and smooths the light further; nor is it a condition the
+    record is known to hold."""
     direct = 1.0 - diffuse_fraction
     return max(direct - (1.0 - CLEAR_SELECTION), 0.0) / direct if direct > 0 else 0.0
 
