@@ -246,6 +246,8 @@ def plot(rows: list[dict], path: Path, quick: bool = False) -> None:
         ax.plot(rec.zenith_deg, rec.cv, "ko-", label="Darecki et al. 2011, Fig. 15")
         ax.plot([r["zenith_deg"] for r in rs], [r["model_cv"] for r in rs], "s--", color="tab:blue",
                 label="model, unscattered light")
+        ax.plot([r["zenith_deg"] for r in rs], [r["model_cv_scattered_smooth"] for r in rs], "v:",
+                color="tab:green", label="model, with the scattered light smooth")
         ax.axvline(rec.refracted_sun_zenith_deg, color="tab:orange", lw=0.8, label="refracted sun")
         ax.set_yscale("log")
         ax.set_title(f"{panel}: {rec.depth_m:g} m, sun {rec.sun_zenith_deg:g}°, {rec.wind_m_s:g} m/s",
