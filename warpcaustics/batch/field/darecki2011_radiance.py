@@ -19,7 +19,10 @@ one resumable sweep, pools each point's texels and frames and writes ``darecki20
 and ``darecki2011_radiance.png`` (CV against zenith per panel, as the paper plots it). The model's
 CV is spatial over the patch's texels, the measurement's temporal at one sensor, as in
 :mod:`.darecki2011`. The paper gives no wind direction: the scene puts the wind along the sun's
-plane (``--set water.wind_direction_deg=90``: across it).
+plane (``--set water.wind_direction_deg=90``: across it). The map holds the unscattered light;
+beside it each row gives the mean light scattered once into the cone
+(:mod:`warpcaustics.caustics.path_radiance`): its share of the cone's light and the CV with it
+(:func:`scattered_columns`).
 """
 
 from __future__ import annotations
