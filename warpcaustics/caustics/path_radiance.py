@@ -200,8 +200,12 @@ def refracted_beam(scene, k: int) -> tuple[np.ndarray, float]:
     cfg = scene.config
     bins = spectra.bins_for(cfg.optics)
     sun = float(spectra.sun_irradiance(bins, cfg.sun, scene.base_dir)[k])
-    n = float(spectra.refractive_index(cfg.optics, bins)[k])
-    to_sun = scene.sun_direction
+    return _beam(scene.sun_direction, sun, float(spectra.refractive_index(cfg.optics, bins)[k]))
+
+
+def _beam(to_sun: np.ndarray, sun: float, n: float) -> tuple[np.ndarray, float]:
+    """:func:`refracted_beam` from the direction towards the sun, its beam-normal irradiance above
+    the water and the water's index."""
     down = refract(-to_sun, np.array([0.0, 0.0, 1.0]), 1.0 / n)
     mu_s = float(to_sun[2])
     return down, sun * float(fresnel_transmittance(mu_s, 1.0 / n)) * mu_s / -float(down[2])
@@ -232,7 +236,7 @@ def sensor_path_radiance(scene) -> Scattered:
     out = Scattered(*(np.zeros(len(bins.centres_nm)) for _ in range(3)))
     for k in range(len(out.wide)):
         n, a, b = float(ior[k]), float(water.absorption_per_m[k]), float(water.scattering_per_m[k])
-        down, beam = refracted_beam(scene, k)
+        down, beam = _beam(to_sun, float(sun[k]), n)
         out.near_sun[k], out.wide[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b, phase)
         if sky is not None:
             def radiance(d, k=k):

@@ -131,7 +131,6 @@ class ViewCone:
         return self._sky.numpy().copy()  # float32, as the sun's map
 
 
-
 def cie_parameters(sky_type: int | None, sun_direction: np.ndarray) -> tuple[wp.vec4, float, float]:
     """((a, b, c, d), e, 1/(f(Z_sun) φ(0))) of CIE type ``sky_type`` for the kernel's
     :func:`~warpcaustics.kernels.optics.view.cie_relative` (zeros for a uniform sky)."""

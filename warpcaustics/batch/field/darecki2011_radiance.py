@@ -176,15 +176,16 @@ def run_darecki2011_radiance(
         sky = [s["bands_sky"][band]["mean"] / s["bands"][band]["mean"] for s in stats]
         sun = [s["bands_direct"][band]["sun_in_view"] for s in stats]
         frames = [s["bands"][band] for s in stats]
+        at = load_scene(scene_path, {**fixed, **variant})
         rows.append({"panel": panel, "zenith_deg": zenith, "measured_cv": round(measured, 4),
                      **_shared(band_row(frames, measured)),
-                     **scattered_columns(load_scene(scene_path, {**fixed, **variant}), stats, band, measured),
+                     **scattered_columns(at, stats, band, measured),
                      "model_sun_in_view": float(np.mean(sun)),
                      "model_sky_share": round(float(np.mean(sky)), 4),
                      "depth_m": float(rec.depth_m), "sun_zenith_deg": float(rec.sun_zenith_deg),
                      "wind_m_s": float(rec.wind_m_s),
                      "wind_direction_deg": base.water.wind_direction_deg,
-                     "model_c555_per_m": round(beam_attenuation(_at(base, variant), 555.0), 4),
+                     "model_c555_per_m": round(beam_attenuation(at.config, 555.0), 4),
                      "measured_c555_per_m": float(rec.beam_attenuation_555),
                      "texel_mm": round(1e3 * base.map_window[0] / base.caustics.map_resolution, 2)})
     out = Path(out)
@@ -227,14 +228,6 @@ def _shared(row: dict) -> dict:
     """Of the columns every Darecki row shares (:func:`~.common.band_row`), those of a whole patch's
     map with no long waves and no sky in halves."""
     return {k: row[k] for k in ("model_cv", "model_cv_frame_sd", "model_over_measured", "frames")}
-
-
-def _at(config, variant: dict):
-    """``config`` with the point's chlorophyll (for its c(555))."""
-    from dataclasses import replace
-
-    chlorophyll = variant["optics.chlorophyll_mg_m3"]
-    return replace(config, optics=replace(config.optics, chlorophyll_mg_m3=chlorophyll))
 
 
 def plot(rows: list[dict], path: Path, quick: bool = False) -> None:
