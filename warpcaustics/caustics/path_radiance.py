@@ -184,11 +184,19 @@ class Scattered:
     """The mean light scattered once into a radiance sensor's cone, ∫ L_p dω [W m⁻² nm⁻¹], per band
     (K,): scattered by less than :data:`FORWARD_DEG`, the sun's (``near_sun``) and the sky's
     (``near_sky``), which come from nearly the directions the sensor sees and flicker with them; and
-    scattered by more, both together (``wide``), which come from the whole lit water column."""
+    scattered by more, the sun's (``wide_sun``) and the sky's (``wide_sky``), which come from the
+    whole lit water column (the sun's with the caustics along the line of sight:
+    :func:`line_of_sight_modulation`)."""
 
     near_sun: np.ndarray
     near_sky: np.ndarray
-    wide: np.ndarray
+    wide_sun: np.ndarray
+    wide_sky: np.ndarray
+
+    @property
+    def wide(self) -> np.ndarray:
+        """The light scattered by more than :data:`FORWARD_DEG`, the sun's and the sky's."""
+        return self.wide_sun + self.wide_sky
 
 
 def refracted_beam(scene, k: int) -> tuple[np.ndarray, float]:
@@ -233,14 +241,90 @@ def sensor_path_radiance(scene) -> Scattered:
 
     sky = None if cfg.sky.model is SkyModel.NONE else scene.sky_irradiance(sun)
     sky_type = cie_sky_type(cfg.sky)
-    out = Scattered(*(np.zeros(len(bins.centres_nm)) for _ in range(3)))
-    for k in range(len(out.wide)):
+    out = Scattered(*(np.zeros(len(bins.centres_nm)) for _ in range(4)))
+    for k in range(len(out.wide_sun)):
         n, a, b = float(ior[k]), float(water.absorption_per_m[k]), float(water.scattering_per_m[k])
         down, beam = _beam(to_sun, float(sun[k]), n)
-        out.near_sun[k], out.wide[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b, phase)
+        out.near_sun[k], out.wide_sun[k] = sun_part(axis, f.view_fov_deg, f.depth_m, down, beam, a + b, b,
+                                                    phase)
         if sky is not None:
             def radiance(d, k=k):
                 return sky_radiance(sky_type, d, to_sun, sky[k:k + 1])[..., 0]
-            near, wide = sky_part(axis, f.view_fov_deg, f.depth_m, radiance, n, a + b, b, phase)
-            out.near_sky[k], out.wide[k] = near, out.wide[k] + wide
+            out.near_sky[k], out.wide_sky[k] = sky_part(axis, f.view_fov_deg, f.depth_m, radiance, n, a + b,
+                                                        b, phase)
     return out
+
+
+def _ellipse_response(fx: np.ndarray, fy: np.ndarray, along: np.ndarray, a: float, b: float) -> np.ndarray:
+    """The Fourier transform of a uniform ellipse of unit weight, semi-axis ``a`` along the unit
+    horizontal vector ``along`` and ``b`` across it [m], at spatial frequencies (fx, fy) [1/m]:
+    2 J₁(ρ)/ρ, ρ = 2π √((a f·u)² + (b f·u⊥)²)."""
+    from scipy.special import j1
+
+    f_along = fx * along[0] + fy * along[1]
+    f_across = -fx * along[1] + fy * along[0]
+    rho = 2.0 * math.pi * np.sqrt((a * f_along) ** 2 + (b * f_across) ** 2)
+    small = rho < 1e-6
+    safe = np.where(small, 1.0, rho)
+    return np.where(small, 1.0 - rho**2 / 8.0, 2.0 * j1(safe) / safe)
+
+
+def sun_disk_footprint(to_sun: np.ndarray, angular_diameter_deg: float,
+                       ior: float) -> tuple[np.ndarray, float, float]:
+    """How the sun's disk (angular radius α in the air) spreads a point sun's pattern per metre of
+    depth, to first order: an ellipse with semi-axes α cos θ_a / (n μ³) along the sun's azimuth
+    (Snell's dθ_w/dθ_a = cos θ_a / (n μ), and d(z tan θ_w)/dθ_w = z / μ²) and α / (n μ) across it
+    (the azimuth kept, the horizontal distance z tan θ_w turned), μ = cos θ_w; returns (the unit
+    horizontal vector towards the sun's azimuth, along, across)."""
+    alpha = math.radians(0.5 * angular_diameter_deg)
+    cos_a = float(to_sun[2])
+    mu = math.sqrt(max(1.0 - (1.0 - cos_a**2) / ior**2, 0.0))
+    horizontal = np.asarray(to_sun[:2], np.float64)
+    norm = float(np.linalg.norm(horizontal))
+    unit = horizontal / norm if norm > 1e-12 else np.array([1.0, 0.0])
+    return unit, alpha * cos_a / (ior * mu**3), alpha / (ior * mu)
+
+
+def line_of_sight_modulation(slices: np.ndarray, slice_depths_m: np.ndarray, texel_m: float, *,
+                             depth_m: float, axis: np.ndarray, fov_deg: float, c: float,
+                             thickness_m: np.ndarray | None = None, sun_disk=None) -> np.ndarray:
+    """How the sun's wide-angle scattered light into a radiance sensor at each texel varies with the
+    caustics along its line of sight: F(x) = Σⱼ wⱼ ⟨Eⱼ⟩_cone(x + oⱼ) / Σⱼ wⱼ Ēⱼ, mean 1, so that the
+    sun's part of :func:`sensor_path_radiance`'s ``wide_sun`` becomes wide_sun · F(x).
+
+    ``slices``: (J, M, M) the unscattered sun's irradiance on horizontal planes at ``slice_depths_m``
+    between the surface and the sensor at ``depth_m``, each standing for a layer ``thickness_m``
+    thick (None: midpoints of equal steps, D/J each), periodic maps of the whole patch on texels
+    ``texel_m`` wide (rows along +y). The line of sight from x towards ``axis`` (v_z > 0) crosses
+    depth zⱼ at sⱼ = (D − zⱼ)/v_z, offset oⱼ = sⱼ v_h; its light is attenuated by e^{−c sⱼ} on to
+    the sensor, wⱼ = e^{−c sⱼ} Δzⱼ (each plane's own ∝ E, the phase function at the wide angles
+    taken as constant across the patch). The sensor's cone of ``fov_deg`` reaches an ellipse at each
+    plane (semi-axes sⱼ tan(fov/2)/v_z along the line's azimuth and sⱼ tan(fov/2) across, uniform:
+    equal solid angles); ``sun_disk`` (:func:`sun_disk_footprint`, for slices of a point sun) spreads
+    each plane by the disk's ellipse at its depth. Shifts and ellipses in Fourier space, exact for
+    the periodic maps."""
+    slices = np.asarray(slices, np.float64)
+    count, m = slices.shape[0], slices.shape[-1]
+    thickness = (np.full(count, depth_m / count) if thickness_m is None
+                 else np.asarray(thickness_m, np.float64))
+    freq = np.fft.fftfreq(m, d=texel_m)
+    fx, fy = np.meshgrid(freq, freq)  # [iy, ix]
+    v = np.asarray(axis, np.float64) / np.linalg.norm(axis)
+    horizontal = float(np.hypot(v[0], v[1]))
+    along = v[:2] / horizontal if horizontal > 1e-12 else np.array([1.0, 0.0])
+    tan_half = math.tan(math.radians(0.5 * fov_deg))
+    total = np.zeros((m, m), np.complex128)
+    norm = 0.0
+    for j in range(count):
+        z = float(slice_depths_m[j])
+        s = (depth_m - z) / v[2]
+        w = math.exp(-c * s) * float(thickness[j])
+        offset = s * v[:2]
+        spectrum = np.fft.fft2(slices[j]) * np.exp(2j * math.pi * (fx * offset[0] + fy * offset[1]))
+        spectrum *= _ellipse_response(fx, fy, along, s * tan_half / v[2], s * tan_half)
+        if sun_disk is not None:
+            unit, per_along, per_across = sun_disk
+            spectrum *= _ellipse_response(fx, fy, unit, z * per_along, z * per_across)
+        total += w * spectrum
+        norm += w * float(slices[j].mean())
+    return np.fft.ifft2(total).real / norm if norm > 0.0 else np.ones((m, m))
