@@ -234,3 +234,14 @@ def test_a_uniform_field_gives_no_modulation():
     got = pr.line_of_sight_modulation(slices, np.linspace(0.05, 0.85, 8), 0.01, depth_m=0.9,
                                       axis=view_axis(20.0, 0.0), fov_deg=4.5, c=0.7)
     assert np.allclose(got, 1.0, atol=1e-12)
+
+
+def test_the_modulation_refuses_a_line_of_sight_it_cannot_follow():
+    """A sensor looking down, or a plane below the sensor: a clear error, not a wrong map."""
+    slices = np.ones((2, 8, 8))
+    with pytest.raises(ValueError, match="upward line of sight"):
+        pr.line_of_sight_modulation(slices, np.array([0.2, 0.6]), 0.01, depth_m=0.9,
+                                    axis=np.array([0.0, 0.0, -1.0]), fov_deg=4.5, c=0.5)
+    with pytest.raises(ValueError, match="above the sensor"):
+        pr.line_of_sight_modulation(slices, np.array([0.2, 1.2]), 0.01, depth_m=0.9, axis=UP, fov_deg=4.5,
+                                    c=0.5)

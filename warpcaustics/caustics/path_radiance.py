@@ -310,6 +310,9 @@ def line_of_sight_modulation(slices: np.ndarray, slice_depths_m: np.ndarray, tex
     freq = np.fft.fftfreq(m, d=texel_m)
     fx, fy = np.meshgrid(freq, freq)  # [iy, ix]
     v = np.asarray(axis, np.float64) / np.linalg.norm(axis)
+    if v[2] <= 0.0 or len(slice_depths_m) != count or np.any(np.asarray(slice_depths_m) > depth_m):
+        raise ValueError("line_of_sight_modulation needs an upward line of sight and a depth per plane, "
+                         "each above the sensor")
     horizontal = float(np.hypot(v[0], v[1]))
     along = v[:2] / horizontal if horizontal > 1e-12 else np.array([1.0, 0.0])
     tan_half = math.tan(math.radians(0.5 * fov_deg))
