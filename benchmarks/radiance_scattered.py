@@ -94,7 +94,9 @@ def point_row(panel: str, zenith: float, rec, point: dict, slices: tuple, times,
 
     scene = wc.load_scene(SCENE, {**point, **view(zenith)})
     renderer = wc.Renderer(scene, device=device)
+    began = time.perf_counter()
     results = [renderer.render(t) for t in times]
+    rendered = (time.perf_counter() - began) / len(times)
     total = [r.floor_irradiance[0].astype(np.float64) for r in results]
     sky = [r.sky_floor_irradiance[0].astype(np.float64) for r in results]
     direct = [t - s for t, s in zip(total, sky)]
@@ -113,9 +115,11 @@ def point_row(panel: str, zenith: float, rec, point: dict, slices: tuple, times,
     disk = sun_disk_footprint(scene.sun_direction, cfg.sun.angular_diameter_deg, float(results[0].ior[0]))
     texel = results[0].map_extent_m / total[0].shape[-1]
     maps, depths, thickness = slices
+    began = time.perf_counter()
     modulation = [line_of_sight_modulation(s, depths, texel, depth_m=cfg.floor.depth_m, axis=axis,
                                            fov_deg=cfg.floor.view_fov_deg, c=c, thickness_m=thickness,
                                            sun_disk=disk) for s in maps]
+    gathered = (time.perf_counter() - began) / len(times)
     kept = [gains[0] * d + gains[1] * s for d, s in zip(direct, sky)]
     smooth = [k + background + wide_sun for k in kept]
     structured = [k + background + wide_sun * f for k, f in zip(kept, modulation)]
@@ -130,15 +134,52 @@ def point_row(panel: str, zenith: float, rec, point: dict, slices: tuple, times,
            "sun_share_of_scattered": wide_sun / (wide_sun + wide_sky),
            "scattered_light_cv": pooled_cv(light), "sun_scattered_cv": pooled_cv(modulation),
            "correlation_with_map": float(corr[0, 1]), "slices": len(depths) - 1,
-           "trough_m": float(thickness[0]) - TROUGH_MARGIN_M, "frames": len(times)}
+           "trough_m": float(thickness[0]) - TROUGH_MARGIN_M, "frames": len(times),
+           "radiance_frame_s": rendered, "modulation_s": gathered}
     row["structured_over_measured"] = row["model_cv_scattered_structured"] / measured
     return row
+
+
+def run(quick: bool, device: str, panels: tuple[str, ...] = ("a", "b", "c"),
+        zeniths: tuple[float, ...] = AWAY, slices: int = 16, frames: int = 2, top: str = "mean") -> dict:
+    """Every panel's points (``quick``: panel a at the zenith, small sizes, 4 planes, one frame), and
+    the cost: the planes of a frame against its radiance frame (the baseline), and the gathering."""
+    from benchmarks.radiance import panel_overrides
+    from benchmarks.run import device_record
+
+    if quick:
+        panels, zeniths, slices, frames = ("a",), (0.0,), 4, 1
+    times = tuple(5.0 * i for i in range(frames))
+    rows, costs = [], []
+    for panel in panels:
+        began = time.perf_counter()
+        point, rec = panel_overrides(panel, quick)
+        planes = sun_slices(point, float(rec.depth_m), slices, times, device, top)
+        sliced = (time.perf_counter() - began) / len(times)
+        for zenith in zeniths:
+            row = point_row(panel, zenith, rec, point, planes, times, device)
+            rows.append(row)
+            print(f"{panel} {zenith:+5.0f}°: measured {row['measured_cv']:.3f}, as rendered "
+                  f"{row['model_cv']:.3f}, scattered smooth {row['model_cv_scattered_smooth']:.3f}, "
+                  f"structured {row['model_cv_scattered_structured']:.3f} "
+                  f"(/ measured {row['structured_over_measured']:.2f}); scattered share "
+                  f"{row['scattered_share']:.3f} (the sun's {row['sun_share_of_scattered']:.2f}), its CV "
+                  f"{row['scattered_light_cv']:.3f} (the sun's {row['sun_scattered_cv']:.3f}), "
+                  f"correlation with the map {row['correlation_with_map']:+.2f}", flush=True)
+        frame = float(np.median([r["radiance_frame_s"] for r in rows if r["panel"] == panel]))
+        costs.append({"panel": panel, "planes_per_frame_s": sliced, "radiance_frame_s": frame,
+                      "ratio": sliced / frame})
+        print(f"panel {panel}: {slices} planes below {2.0 * planes[1][0]:.3f} m (--top {top}), "
+              f"{sliced:.1f} s a frame against its radiance frame's {frame:.1f} s: x{sliced / frame:.2f}; "
+              f"gathering them {rows[-1]['modulation_s']:.2f} s", flush=True)
+    return {"benchmark": "radiance_scattered", **device_record(device), "quick": quick, "slices": slices,
+            "frames": frames, "top": top, "rows": rows, "costs": costs}
 
 
 def main(argv: list[str] | None = None) -> int:
     from warpcaustics.cli import _signed_lists
 
-    from benchmarks.radiance import panel_overrides
+    from benchmarks.run import save_record
 
     p = argparse.ArgumentParser(prog="python -m benchmarks.radiance_scattered",
                                 description=__doc__.splitlines()[0])
@@ -156,36 +197,16 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(_signed_lists(sys.argv[1:] if argv is None else list(argv)))  # --view-zeniths -30,0
     if args.slices < 2 or args.frames < 1:
         p.error("--slices must be at least 2 and --frames at least 1")
-    panels = ["a"] if args.quick else [s.strip() for s in args.panels.split(",") if s.strip()]
-    zeniths = [0.0] if args.quick else [float(z) for z in args.view_zeniths.split(",")]
-    times = tuple(5.0 * i for i in range(1 if args.quick else args.frames))
-    slices_count = 4 if args.quick else args.slices
-    rows = []
-    for panel in panels:
-        began = time.perf_counter()
-        point, rec = panel_overrides(panel, args.quick)
-        slices = sun_slices(point, float(rec.depth_m), slices_count, times, args.device, args.top)
-        sliced = time.perf_counter() - began
-        for zenith in zeniths:
-            row = point_row(panel, zenith, rec, point, slices, times, args.device)
-            rows.append(row)
-            print(f"{panel} {zenith:+5.0f}°: measured {row['measured_cv']:.3f}, as rendered "
-                  f"{row['model_cv']:.3f}, scattered smooth {row['model_cv_scattered_smooth']:.3f}, "
-                  f"structured {row['model_cv_scattered_structured']:.3f} "
-                  f"(/ measured {row['structured_over_measured']:.2f}); scattered share "
-                  f"{row['scattered_share']:.3f} (the sun's {row['sun_share_of_scattered']:.2f}), its CV "
-                  f"{row['scattered_light_cv']:.3f} (the sun's {row['sun_scattered_cv']:.3f}), "
-                  f"correlation with the map {row['correlation_with_map']:+.2f}", flush=True)
-        print(f"panel {panel}: {slices_count} slices below {slices[1][0] * 2:.3f} m (--top {args.top}) × "
-              f"{len(times)} frames {sliced:.0f} s, "
-              f"all {time.perf_counter() - began:.0f} s", flush=True)
+    record = run(args.quick, args.device, tuple(s.strip() for s in args.panels.split(",") if s.strip()),
+                 tuple(float(z) for z in args.view_zeniths.split(",")), args.slices, args.frames, args.top)
+    save_record(record, None, "radiance_scattered", args.quick, args.device)
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         with open(args.csv, "w", newline="", encoding="utf-8") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            writer = csv.DictWriter(fh, fieldnames=list(record["rows"][0]))
             writer.writeheader()
             writer.writerows({k: round(v, 5) if isinstance(v, float) and math.isfinite(v) else v
-                              for k, v in r.items()} for r in rows)
+                              for k, v in r.items()} for r in record["rows"])
         print(f"wrote {args.csv}")
     return 0
 

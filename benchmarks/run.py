@@ -244,6 +244,7 @@ CHILD_MODULES = (
     "field_bands",    # the Gernez comparison's six bands against its one
     "spectra",        # the Elfouhaily spectrum against JONSWAP: the ocean's build and step
     "radiance",       # a radiance sensor at every texel against the irradiance map; its sky against numpy
+    "radiance_scattered",  # the caustics along the sensor's lines of sight: its planes against its frame
 )
 """The benchmark modules (``benchmarks/<name>.py``) whose ``run(quick, device)`` main runs in a child
 process each, in this order; their records go into the run's record under their names."""
