@@ -17,8 +17,8 @@ light arrives from in the water (``tests/sky_continuum.py``, written apart from 
 Printed per case: each band's mean and CV over the points, the CV over the continuum's, the red's CV
 over the green's, the correlation with the continuum point by point, and the seconds of each render
 and of the reference (one core). ``--quick``: the ``sea`` scene with the test's 8 × 8 points and
-coarse quadrature, 16 and 64 cones. Figures in docs/validation.md (issue 32's sky, issue 27's
-overcast red); about 25 minutes in full.
+coarse quadrature, 16 and 64 cones; ``--samplings``: other skies than each case's own. Figures in
+docs/validation.md (issue 32's sky, issue 27's overcast red); about 25 minutes in full.
 """
 
 from __future__ import annotations
@@ -38,6 +38,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="the test's scene and points, 16 and 64 cones")
     parser.add_argument("--cases", default="sea,gernez,gernez_low_sun,surface",
                         help="comma-separated of sea, gernez, gernez_low_sun, surface (default all)")
+    parser.add_argument("--samplings", default=None,
+                        help="the skies to render instead of each case's own, comma-separated "
+                             "sampling:directions[:surface_resolution], e.g. cones:128:1024,cones:256:1024")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT / "tests"))
     from sky_continuum import (  # noqa: I001 (the tests' folder, put on the path above)
@@ -67,6 +70,14 @@ def main(argv: list[str] | None = None) -> int:
         "gernez_low_sun": (ROOT / "configs" / "field" / "gernez2009.toml", gernez, 8.0, 512,
                            ["cie_clear_sun_80"], on_coarser),
     }
+    if args.samplings:
+        chosen = []
+        for item in args.samplings.split(","):
+            parts = item.split(":")
+            if len(parts) not in (2, 3) or not all(p.isdigit() for p in parts[1:]):
+                parser.error(f"--samplings: {item!r} is not sampling:directions[:surface_resolution]")
+            chosen.append((parts[0], *map(int, parts[1:])))
+        cases = {name: (*case[:5], chosen) for name, case in cases.items()}
     if "surface" in args.cases.split(","):
         surface_case(gernez)
     points_a_side, quadrature = (8, 96) if args.quick else (16, 160)
