@@ -5,8 +5,9 @@ Darecki et al. (2011)'s Fig. 15 (the field data set ``darecki2011_radiance``) ta
 once into the sensor's 4.5° cone by more than 3° as a uniform background, its mean from
 ``caustics/path_radiance.py`` (``model_cv_scattered_smooth``). Here the sun's part of it keeps the
 caustics it is scattered from: the unscattered sun's irradiance is rendered on ``--slices``
-horizontal planes between the surface and the sensor (a point sun, its disk's blur and the cone's
-added per plane in Fourier space), and each texel's line of sight gathers them
+horizontal planes from just below the deepest trough to the sensor (a point sun, its disk's blur and
+the cone's added per plane in Fourier space; the layer above as its mean, ``--top``), and each
+texel's line of sight gathers them
 (:func:`~warpcaustics.caustics.path_radiance.line_of_sight_modulation`); the sky's part stays a
 background (the sky's light under the waves varies by a few per cent). For each panel and zenith it
 prints the CV as rendered, with the scattered light smooth (as the data set), and with the sun's
@@ -31,9 +32,9 @@ SCENE = ROOT / "configs/field/darecki2011_radiance.toml"
 QUICK = {"water.extent_m": 2.0, "water.resolution": 256, "caustics.map_resolution": 128,
          "sun.disk_samples": 2}
 AWAY = (-30.0, -15.0, 0.0)
-
-
+"""The record's zeniths away from the sun inside Snell's window (the default)."""
 TROUGH_MARGIN_M = 0.01
+"""How far below the frames' deepest trough the shallowest plane lies."""
 
 
 def sun_slices(point: dict, depth_m: float, count: int, times: tuple[float, ...], device: str,
