@@ -85,7 +85,7 @@ def point_row(panel: str, zenith: float, rec, point: dict, slices: tuple, times,
     """Render the sensor at ``zenith`` for each frame, and its CVs with the scattered light smooth and
     structured (the module docstring)."""
     import warpcaustics as wc
-    from warpcaustics.batch.field.darecki2011_radiance import view
+    from warpcaustics.batch.field.darecki2011_radiance import near_gains, view
     from warpcaustics.caustics.path_radiance import (
         line_of_sight_modulation,
         sensor_path_radiance,
@@ -102,14 +102,10 @@ def point_row(panel: str, zenith: float, rec, point: dict, slices: tuple, times,
     sky = [r.sky_floor_irradiance[0].astype(np.float64) for r in results]
     direct = [t - s for t, s in zip(total, sky)]
     scattered = sensor_path_radiance(scene)
-    near_sun, near_sky = float(scattered.near_sun[0]), float(scattered.near_sky[0])
     wide_sun, wide_sky = float(scattered.wide_sun[0]), float(scattered.wide_sky[0])
-    background = wide_sky
-    gains = []
-    for near, part in ((near_sun, direct), (near_sky, sky)):
-        mean = float(np.mean([p.mean() for p in part]))
-        gains.append(1.0 + near / mean if mean > 0.0 else 1.0)
-        background += 0.0 if mean > 0.0 else near
+    *gains, unseen = near_gains(scattered, float(np.mean([d.mean() for d in direct])),
+                                float(np.mean([s.mean() for s in sky])))
+    background = wide_sky + unseen
     cfg = scene.config
     c = float(results[0].attenuation_per_m[0])
     axis = view_axis(cfg.floor.view_zenith_deg, cfg.floor.view_azimuth_deg)

@@ -195,6 +195,17 @@ def run_darecki2011_radiance(
     return paths
 
 
+def near_gains(scattered, direct_mean: float, sky_mean: float) -> tuple[float, float, float]:
+    """How the light scattered by less than a few degrees (``scattered``, band 0) scales the map's
+    direct and sky parts of these means, 1 + near / mean each, and the near light of a part never
+    in view (its mean 0), which is a background too: (sun's gain, sky's gain, that background)."""
+    gains, unseen = [], 0.0
+    for near, mean in ((float(scattered.near_sun[0]), direct_mean), (float(scattered.near_sky[0]), sky_mean)):
+        gains.append(1.0 + near / mean if mean > 0.0 else 1.0)
+        unseen += 0.0 if mean > 0.0 else near
+    return gains[0], gains[1], unseen
+
+
 def scattered_columns(scene, stats: list[dict], band: str, measured: float) -> dict:
     """The light scattered once into the sensor (:func:`~warpcaustics.caustics.path_radiance.
     sensor_path_radiance`), which the rendered map leaves out, from the frames' statistics ``stats``
@@ -208,16 +219,10 @@ def scattered_columns(scene, stats: list[dict], band: str, measured: float) -> d
     scattered = sensor_path_radiance(scene)
     parts = [[(s[group][band]["mean"], s[group][band]["cv"]) for s in stats]
              for group in ("bands", "bands_direct", "bands_sky")]
-    background = float(scattered.wide[0])
-    gains = []
-    for near, frames in ((float(scattered.near_sun[0]), parts[1]), (float(scattered.near_sky[0]), parts[2])):
-        mean = float(np.mean([m for m, _ in frames]))
-        if mean > 0.0:
-            gains.append(1.0 + near / mean)
-        else:  # the part is never in view: its forward light, if any, a background too
-            gains.append(1.0)
-            background += near
-    scaled = with_beam_scaled(*parts, *gains)
+    sun_gain, sky_gain, unseen = near_gains(scattered, float(np.mean([m for m, _ in parts[1]])),
+                                            float(np.mean([m for m, _ in parts[2]])))
+    background = float(scattered.wide[0]) + unseen
+    scaled = with_beam_scaled(*parts, sun_gain, sky_gain)
     mean, cv = pooled_statistics(scaled, [background] * len(scaled))
     return {"model_scattered_share": round(float(scattered.wide[0]) / mean, 4),
             "model_cv_scattered_smooth": round(cv, 4),
