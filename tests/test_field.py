@@ -430,17 +430,17 @@ def test_darecki_command_on_still_water_measures_no_fluctuation(tmp_path):
     flat.write_text(DARECKI.read_text().replace('model = "fft"', 'model = "flat"'))
     out = tmp_path / "o"
     assert main(["field", "darecki2011", str(flat), "--out", str(out), "--quick", "--frames", "1",
-                 "--depths", "9.58,0.5", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves",
+                 "--depths", "0.86,0.5", "--device", "cpu", "--quiet", "--set", "sky.sampling=halves",
                  "--long-waves", "16"]) == 0
     rows = list(csv.DictReader((out / "darecki2011.csv").open()))
     assert all(float(r["model_cv_continuous_sky"]) < 1e-5 for r in rows)  # the sky drawn in halves
     rec = jerlov.darecki2011_irradiance_cv()
     assert [(float(r["depth_m"]), float(r["wavelength_nm"])) for r in rows] == [
-        (d, float(w)) for d in (0.5, 9.58) for w in rec.wavelengths_nm]
+        (d, float(w)) for d in (0.5, 0.86) for w in rec.wavelengths_nm]
     columns = ("model_cv", "model_cv_window", "model_cv_long_waves")
     assert all(float(r[c]) < 1e-5 for r in rows for c in columns)
     assert all(r["measured_cv"] == r["model_over_measured"] == "" for r in rows[:3])  # 0.5 m: not measured
-    assert [float(r["measured_cv"]) for r in rows[3:]] == pytest.approx(rec.cv[-1].tolist(), abs=1e-4)
+    assert [float(r["measured_cv"]) for r in rows[3:]] == pytest.approx(rec.cv[0].tolist(), abs=1e-4)
     assert (out / "darecki2011.png").stat().st_size > 0
 
 
