@@ -160,3 +160,30 @@ def test_the_config_s_45_degree_wind_gives_the_mean_slope_over_azimuths():
     assert sun == pytest.approx(0.5 * (up + cross), rel=1e-9)
     azimuths = np.linspace(0, np.pi, 36, endpoint=False)
     assert sun == pytest.approx(np.mean([along(a) for a in azimuths]), rel=1e-9)
+
+
+def test_the_darecki_commands_frames_are_further_apart_than_the_peak_waves_period():
+    """The Darecki commands' frames, 5 s apart by default, each draw a new realisation of the largest
+    waves: the peak waves' period, 2π/√(g k_p) with k_p from eq. 37 written out here, is 2.6 s at the
+    irradiance record's wind (5.25 m/s) and 2.1-3.0 s at the radiance panels' (3.6-7 m/s) over the
+    configs' 20 km of fetch, as the commands' docstrings say; the module's Ω_c is the same."""
+    import inspect
+    from pathlib import Path
+
+    from warpcaustics.batch.field import darecki2011, darecki2011_radiance
+    from warpcaustics.config.loading import tomllib  # tomli on Python 3.10
+
+    configs = Path(__file__).resolve().parents[1] / "configs" / "field"
+
+    def peak_period(u10, fetch):
+        omega_c = 0.84 * math.tanh((G * fetch / u10**2 / 2.2e4) ** 0.4) ** (-0.75)  # eq. 37
+        assert elf.inverse_wave_age(u10, fetch) == pytest.approx(omega_c, rel=1e-12)
+        return 2.0 * math.pi / math.sqrt(G * G / u10**2 * omega_c**2)
+
+    water = tomllib.loads((configs / "darecki2011.toml").read_text())["water"]
+    assert peak_period(water["wind_speed_m_s"], water["fetch_m"]) == pytest.approx(2.6, abs=0.05)
+    fetch = tomllib.loads((configs / "darecki2011_radiance.toml").read_text())["water"]["fetch_m"]
+    periods = [peak_period(float(darecki2011_radiance.record(p).wind_m_s), fetch) for p in "abc"]
+    assert (min(periods), max(periods)) == pytest.approx((2.1, 3.0), abs=0.05)
+    for run in (darecki2011.run_darecki2011, darecki2011_radiance.run_darecki2011_radiance):
+        assert inspect.signature(run).parameters["frame_interval_s"].default > max(periods)
