@@ -279,8 +279,14 @@ def main(argv: list[str] | None = None) -> int:
 
     steps = {module: _step_rows(module, args.quick, args.device, repeats) for module, _, _, _ in STEPS}
 
-    # Each capability's benchmark against its baseline, each in a child process of its own.
-    children = {module: _in_child("run", args.quick, args.device, module=module) for module in CHILD_MODULES}
+    # Each capability's benchmark against its baseline, each in a child process of its own, with the
+    # wall time each takes (where a quick run's minutes go; nothing asserts it).
+    children, wall_s = {}, {}
+    for module in CHILD_MODULES:
+        t0 = time.perf_counter()
+        children[module] = _in_child("run", args.quick, args.device, module=module)
+        wall_s[module] = round(time.perf_counter() - t0, 1)
+        print(f"{module:12s} took {wall_s[module]:.0f} s (its child process, start to end)", flush=True)
 
     # The sky's cones on the sea's waves cut to a coarser grid (benchmarks/sky_surface.py), in this
     # process: it runs each case in a child of its own (a pool's worker may not start one).
@@ -313,6 +319,7 @@ def main(argv: list[str] | None = None) -> int:
         "steps": steps,
         "bins": bins_rows,
         **children,
+        "children_wall_s": wall_s,
         "sky_surface": sky_surface,
         "sweep": sweeps,
         "memory": memory,
