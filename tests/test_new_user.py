@@ -182,6 +182,18 @@ def test_sweep_progress_names_the_variant_and_summary_cells_are_toml(tmp_path):
     assert report.returncode == 0 and (out / "summary.png").exists(), report.stderr
 
 
+def test_report_labels_the_variants_by_the_keys_that_vary_not_by_the_bands():
+    """A band whose wavelength is not whole (16 bins from 400 nm: 409.375 nm) has a dot in its
+    columns' names (``mean_409.375nm``) as a config key has: the plot's labels are the keys alone
+    (the README's water-types sweep had been labelled by every band's figures)."""
+    from warpcaustics.batch.report import varied_keys
+
+    rows = [{"id": "a", "frame": "0", "floor.depth_m": "2.0", "optics.water_type": water,
+             "mean_409.375nm": mean, "max_409.375nm": peak, "contrast": "0.1"}
+            for water, mean, peak in (("clear_ocean", "1.5", "3.0"), ("coastal_ocean", "1.2", "2.5"))]
+    assert varied_keys(rows) == ["optics.water_type"]
+
+
 def test_the_no_cuda_notice_is_said_once_per_sweep(tmp_path):
     """Two workers, the device left to "auto" on a machine without CUDA: one notice, not one each."""
     import pytest

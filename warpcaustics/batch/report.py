@@ -25,6 +25,17 @@ STAT_AXES = (("floor_w_m2", "floor irradiance\n[W m$^{-2}$]"), ("contrast", "con
 """The statistics ``warpcaustics report`` plots, one panel each, over the sweep's variants."""
 
 
+BAND_COLUMNS = ("mean_", "max_")
+"""Prefixes of the per-band columns (``mean_418.75nm``), which stay in the CSV."""
+
+
+def varied_keys(rows: list[dict]) -> list[str]:
+    """The config keys (dotted names) whose values differ between the summary's ``rows``: the
+    variants' labels. A band's columns hold a dot too where its wavelength is not whole."""
+    return [c for c in rows[0] if "." in c and not c.startswith(BAND_COLUMNS)
+            and any(r[c] != rows[0][c] for r in rows)]
+
+
 def _summary_rows(path: Path) -> list[dict]:
     """The rows of a sweep's ``summary.csv``, or one line saying why it is not one."""
     fix = "rerun the sweep with the same --out to write it again"
@@ -69,7 +80,7 @@ def report_main(out: str) -> int:
     # The varied keys and the headline figures; per-band columns stay in the CSV.
     fixed = {c for c in rows[0] if all(r[c] == rows[0][c] for r in rows)}
     headline = {"id", "frame", "floor_w_m2", "contrast", "render_s"}
-    shown = [c for c in rows[0] if c in headline or (c not in fixed and not c.startswith(("mean_", "max_")))]
+    shown = [c for c in rows[0] if c in headline or (c not in fixed and not c.startswith(BAND_COLUMNS))]
     rows_shown = [{c: _short(r[c]) for c in shown} for r in rows]
     widths = {c: max(len(c), *(len(r[c]) for r in rows_shown)) for c in shown}
     print("  ".join(c.ljust(widths[c]) for c in shown))
@@ -84,7 +95,7 @@ def report_main(out: str) -> int:
         print("(pip install warpcaustics[study] for the plot)")
         return 0
     # The varied config keys (dotted names) label the x axis; the statistics are the panels' y axes.
-    varied = [c for c in rows[0] if "." in c and c not in fixed]
+    varied = varied_keys(rows)
     labels = [", ".join(_short(r[c]) for c in varied) or f"{r['id'][:6]} #{r['frame']}" for r in rows]
     panels = [(c, label) for c, label in STAT_AXES if c in rows[0]]
     fig, axes = plt.subplots(len(panels), 1, sharex=True, squeeze=False,
