@@ -6,6 +6,7 @@ Python) before anything renders. The CLI runs in-process here (``cli.main``)."""
 
 from __future__ import annotations
 
+import json
 import os
 
 import numpy as np
@@ -434,3 +435,79 @@ def test_info_tells_the_device_a_render_would_take(capsys, monkeypatch):
     from warpcaustics.device import resolve_device
 
     assert resolve_device(None, config_value="cpu") == "cpu"
+
+
+# A third fuzz (2026-12-08): folders that cannot be written, writes that fail midway ---------------
+
+UNWRITABLE = "/proc/self"
+"""A folder no one can create a file in, root included (Linux)."""
+
+
+@pytest.mark.skipif(not os.path.isdir(UNWRITABLE), reason="no /proc here")
+@pytest.mark.parametrize("command", [["render", str(CONFIGS / "ocean.toml"), *TINY],
+                                     ["study", str(CONFIGS / "study.toml"), "--device", "cpu"],
+                                     ["compare", str(CONFIGS / "ocean.toml"), *TINY],
+                                     ["sweep", str(CONFIGS / "sweeps" / "water_types.toml"), *TINY],
+                                     ["field", "gernez2009", str(CONFIGS / "field" / "gernez2009.toml"),
+                                      "--quick", "--device", "cpu"]])
+def test_an_out_folder_that_cannot_be_written_is_refused_before_rendering(capsys, command):
+    """An existing --out that cannot be written (read-only, no permission) had given a traceback from
+    the first file written (render's claim, OpenEXR's, the sweep's state, after every render of a
+    study): now one line, before anything renders."""
+    one_line_error(capsys, [*command, "--out", UNWRITABLE], f"--out {UNWRITABLE!r} cannot be written")
+
+
+def test_a_write_that_fails_midway_is_one_line_and_no_finished_run(tmp_path, capsys, monkeypatch):
+    """A full disk as OpenEXR reports it (a RuntimeError, which had escaped as a traceback) fails the
+    render in one line naming the frame and --out, and no run.json marks the folder's files a
+    finished run."""
+    import OpenEXR
+
+    class FullDisk:
+        def __init__(self, *args):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def write(self, name):
+            raise RuntimeError(f"Failed to write pixel data to image file \"{name}\".\n"
+                               "No space left on device")
+
+    monkeypatch.setattr(OpenEXR, "File", FullDisk)
+    out = tmp_path / "r"
+    one_line_error(capsys, ["render", str(CONFIGS / "ocean.toml"), "--out", str(out), *TINY],
+                   "cannot write frame 0 into --out", "No space left on device")
+    assert not (out / "run.json").exists()
+    assert not list(out.glob(".*tmp*")), list(out.iterdir())  # no temporary file left either
+
+
+@pytest.mark.parametrize("files", [[5], [["a"]], ["\u0000"], "frame_0000.exr"])
+def test_an_outputs_list_that_is_not_file_names_is_one_line(tmp_path, capsys, files):
+    """A damaged outputs.json (entries that are not names, a NUL byte, a string for the list) had
+    given a TypeError or ValueError from inside the claim of the folder."""
+    out = tmp_path / "r"
+    out.mkdir()
+    (out / "outputs.json").write_text(json.dumps({"files": files}))
+    one_line_error(capsys, ["render", str(CONFIGS / "ocean.toml"), "--out", str(out), *TINY],
+                   "outputs.json cannot be read")
+
+
+def test_a_sweep_whose_state_cannot_be_written_midway_is_one_line(tmp_path, capsys, monkeypatch):
+    """A write of the sweep's own state that fails as it goes (a disk that fills) had been a
+    traceback from the driver: now one line naming the file and the reason."""
+    import errno
+
+    from warpcaustics.batch import sweep
+
+    def full(out_dir, record):
+        raise OSError(errno.ENOSPC, "No space left on device", str(out_dir / sweep.MANIFEST))
+
+    monkeypatch.setattr(sweep, "_append", full)
+    one = tmp_path / "one.toml"
+    one.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[grid]\n"floor.depth_m" = [1.0]\n')
+    one_line_error(capsys, ["sweep", str(one), "--out", str(tmp_path / "s"), "--quiet", *TINY],
+                   "writing", "manifest.jsonl", "No space left on device", "--out")

@@ -217,13 +217,26 @@ def _field(args: argparse.Namespace) -> int:
 
 
 def _out_folder(text: str) -> Path:
-    """--out as a folder: refused at once if it is empty or a file."""
+    """--out as a folder: refused at once if it is empty, a file, or a folder that cannot be written
+    (read-only, no permission), before anything renders."""
     if not text.strip():
         raise ConfigError("--out is empty; give a folder, e.g. --out out/run")
     out = Path(text)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {text!r} is a file; give a folder")
+    if out.is_dir():
+        _writable(out / f".warpcaustics-probe-{os.getpid()}", text)
     return out
+
+
+def _writable(probe: Path, out: str) -> None:
+    """Create and remove the file ``probe``; one line naming ``--out`` if it cannot be."""
+    try:
+        probe.open("xb").close()
+        probe.unlink()
+    except OSError as exc:
+        raise WarpcausticsError(f"--out {out!r} cannot be written: {exc.strerror or exc}; "
+                                "give a folder you can write to") from None
 
 
 def _make(out: Path) -> Path | None:
@@ -337,12 +350,8 @@ def _preview(args: argparse.Namespace) -> int:
         raise WarpcausticsError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
     if out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a folder; name the .png file to write")
-    probe = out.with_name(f".{out.stem}.probe-{os.getpid()}")
-    try:  # a folder the PNG cannot be written into fails now, not as pyvista's error after the render
-        probe.open("xb").close()
-        probe.unlink()
-    except OSError as exc:
-        raise WarpcausticsError(f"--out {str(out)!r} cannot be written: {exc.strerror or exc}") from None
+    # a folder the PNG cannot be written into fails now, not as pyvista's error after the render
+    _writable(out.with_name(f".{out.stem}.probe-{os.getpid()}"), str(out))
     from warpcaustics.pipeline import check_time
 
     check_time("--time", args.time)
@@ -497,6 +506,12 @@ def main(argv: list[str] | None = None) -> int:
         return _info()
     except WarpcausticsError as exc:
         print(f"warpcaustics: error: {one_line(str(exc))}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    except OSError as exc:  # a write that failed as it went (a full disk): the file and the reason
+        where = f" {str(exc.filename)!r}" if exc.filename else ""
+        print(f"warpcaustics: error: writing{where} failed: {one_line(exc.strerror or str(exc))}; free "
+              "space or give another --out (what was written is not recorded as a finished run)",
+              file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("warpcaustics: interrupted", file=sys.stderr)

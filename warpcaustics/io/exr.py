@@ -3,6 +3,7 @@ Wilkie's (2021) spectral layout."""
 
 from __future__ import annotations
 
+import errno
 from pathlib import Path
 
 import numpy as np
@@ -44,4 +45,7 @@ def write_exr(path: Path, rgb: np.ndarray, spectral: np.ndarray | None, waveleng
         header["emissiveUnits"] = units
     header.update(extra_header)
     with atomic_path(path) as tmp, OpenEXR.File(header, channels) as exr:
-        exr.write(str(tmp))
+        try:
+            exr.write(str(tmp))
+        except RuntimeError as exc:  # OpenEXR's: a full disk, a folder that cannot be written
+            raise OSError(errno.EIO, " ".join(str(exc).split()), str(path)) from None

@@ -56,12 +56,14 @@ def claim(out: Path, force: bool) -> RunManifest:
     if manifest.exists():
         try:
             listed = json.loads(manifest.read_text(encoding="utf-8"))["files"]
+            if not isinstance(listed, list) or not all(isinstance(n, str) and "\0" not in n for n in listed):
+                raise TypeError("not a list of file names")
         except (OSError, ValueError, KeyError, TypeError):
             raise WarpcausticsError(f"--out {str(out)!r}: its {MANIFEST} cannot be read; remove the folder's "
                                     "outputs by hand or give another --out") from None
         for name in listed:
             path = out / name
-            if isinstance(name, str) and path.resolve().parent == out.resolve() and path.is_file():
+            if path.resolve().parent == out.resolve() and path.is_file():
                 path.unlink()
         manifest.unlink()
     elif not force:
