@@ -511,3 +511,30 @@ def test_a_sweep_whose_state_cannot_be_written_midway_is_one_line(tmp_path, caps
     one.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[grid]\n"floor.depth_m" = [1.0]\n')
     one_line_error(capsys, ["sweep", str(one), "--out", str(tmp_path / "s"), "--quiet", *TINY],
                    "writing", "manifest.jsonl", "No space left on device", "--out")
+
+
+def test_compare_s_hint_for_a_scene_with_receivers_is_one_that_works(tmp_path, capsys):
+    """compare's advice for a scene the flux-ratio reference cannot take had left out the receivers,
+    so following it gave the same error again; with the whole advice the comparison runs."""
+    line = one_line_error(capsys, ["compare", str(CONFIGS / "pool_pots.toml"), "--out", str(tmp_path / "a"),
+                                   *TINY, "--methods", "sunmap"], "receivers=[]")
+    fix = line[line.index("--set floor.shape"):].rstrip(")").split()
+    sets = [s.strip("'") for s in fix if s != "--set"]
+    argv = ["compare", str(CONFIGS / "pool_pots.toml"), "--out", str(tmp_path / "b"), *TINY, "--methods",
+            "sunmap", *[a for s in sets for a in ("--set", s)]]
+    assert cli.main(argv) == 0, capsys.readouterr().err
+
+
+def test_compare_keeps_out_of_a_renders_folder_and_drops_its_own_stale_methods(tmp_path, capsys):
+    """compare had written its files among a render's (or a sweep's), and a second comparison with
+    other --methods left the first one's method folders beside its table."""
+    render = tmp_path / "r"
+    assert cli.main(["render", str(CONFIGS / "ocean.toml"), "--out", str(render), *TINY, "--quiet"]) == 0
+    one_line_error(capsys, ["compare", str(CONFIGS / "ocean.toml"), "--out", str(render), *TINY,
+                            "--methods", "sunmap"], "holds a render's or a sweep's results")
+    assert not (render / "compare.csv").exists()
+    out = tmp_path / "c"
+    for methods in ("sunmap", "photons"):
+        assert cli.main(["compare", str(CONFIGS / "ocean.toml"), "--out", str(out), *TINY,
+                         "--methods", methods]) == 0
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["fluxratio", "photons"]

@@ -381,11 +381,13 @@ def _check_animation(args: argparse.Namespace, integration_s: float) -> None:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from warpcaustics.batch.compare import compare_methods, write_comparison
+    from warpcaustics.batch.compare import check_compare_folder, compare_methods, write_comparison
     from warpcaustics.pipeline import check_time
 
     check_time("--time", args.time)
     out = _out_folder(args.out)
+    if out.is_dir():
+        check_compare_folder(out)
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
     if not methods:
         raise ConfigError(f"--methods {args.methods!r} names no method; give some of "

@@ -11,6 +11,7 @@ previews left to right, in the order of the table) and each method's frame in ``
 from __future__ import annotations
 
 import json
+import shutil
 import time
 from pathlib import Path
 
@@ -56,9 +57,9 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
         try:
             scenes[name] = load_scene(config, {**overrides, "caustics.method": name})
         except WarpcausticsError as exc:
-            fix = ("every comparison renders the flux-ratio reference, which needs a flat floor and no "
-                   "camera: --set floor.shape=flat --set camera.enabled=false" if name == "fluxratio" else
-                   f"drop {name!r} from --methods")
+            fix = ("every comparison renders the flux-ratio reference, which needs a flat floor, no "
+                   "receivers and no camera: --set floor.shape=flat --set 'receivers=[]' --set "
+                   "camera.enabled=false" if name == "fluxratio" else f"drop {name!r} from --methods")
             raise WarpcausticsError(f"compare renders this scene with caustics.method = {name!r}, which it "
                                     f"cannot take: {exc} ({fix})") from None
     results = {}
@@ -76,6 +77,17 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
     return {"rows": rows, "results": results}
 
 
+def check_compare_folder(out: Path) -> None:
+    """Refuse an ``out`` that holds a render's or a sweep's results, in one line, before anything
+    renders: compare would mix its files among theirs."""
+    from warpcaustics.io.manifest import MANIFEST, SWEEP_FILES
+
+    held = [name for name in (MANIFEST, "run.json", *SWEEP_FILES) if (out / name).exists()]
+    if held:
+        raise WarpcausticsError(f"--out {str(out)!r} holds a render's or a sweep's results ({held[0]}); "
+                                "give compare a folder of its own")
+
+
 def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Path]:
     """compare.json, compare.csv, compare.png and each method's frame (EXR, PNG, run.json) in
     ``out/<method>/``."""
@@ -86,6 +98,10 @@ def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Pa
     from warpcaustics.optics import colour as colour_out
 
     out.mkdir(parents=True, exist_ok=True)
+    for name in FLOOR_METHODS:  # an earlier comparison's method folders (each holds its run.json) go,
+        folder = out / name    # so that none the new --methods leaves out stands beside its table
+        if (folder / "run.json").is_file() and not folder.is_symlink():
+            shutil.rmtree(folder)
     rows = comparison["rows"]
     paths = {"json": out / "compare.json", "csv": out / "compare.csv", "png": out / "compare.png"}
     images = []
