@@ -156,6 +156,10 @@ def test_saving_and_receivers_of_a_result_fail_in_one_line(scene, tmp_path):
     (tmp_path / "a_file").write_text("")
     with pytest.raises(wc.WarpcausticsError, match="cannot save into"):
         result.save(tmp_path / "a_file")
+    for frame in (-1, 1.5, True):  # -1 had written frame_-001.exr
+        with pytest.raises(wc.WarpcausticsError, match="must be a whole number from 0"):
+            result.save(tmp_path / "f", frame=frame)
+    assert not (tmp_path / "f").exists()
     with pytest.raises(wc.WarpcausticsError, match="needs caustics.method = 'photons' or 'beams'"):
         result.receiver_irradiance(0)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -176,6 +177,9 @@ class RenderResult:
         from warpcaustics.io.frame import save_frame
         from warpcaustics.io.run_json import write_run_json
 
+        if isinstance(frame, bool) or not isinstance(frame, numbers.Integral) or frame < 0:
+            raise WarpcausticsError(f"frame = {frame!r} must be a whole number from 0 (the files' "
+                                    "frame_NNNN names)")
         try:
             paths = save_frame(self, Path(out_dir), frame=frame)
             paths["json"] = write_run_json(Path(out_dir), [self])
