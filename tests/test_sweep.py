@@ -116,6 +116,19 @@ def test_a_failing_task_is_reported_and_the_rest_finish(tmp_path):
     assert len(_csv_rows(tmp_path / "out")) == 4
 
 
+def test_a_base_every_variant_fails_with_is_refused_as_the_sweep_loads(tmp_path):
+    """A base that is no scene (here the sweep file itself) had failed each task with the same error
+    (exit 1, a folder of failures); the same error in every variant is now the sweep's, at once."""
+    path = tmp_path / "s.toml"
+    path.write_text('base = "s.toml"\n[grid]\n"floor.depth_m" = [1.0, 2.0]\n')
+    with pytest.raises(ConfigError, match="every variant of s.toml fails the same way.*unknown key 'base'"):
+        load_sweep(path)
+    bad = tmp_path / "one.toml"  # one variant, bad: nothing would run either
+    bad.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[grid]\n"floor.depth_m" = [-1.0]\n')
+    with pytest.raises(ConfigError, match="floor.depth_m = -1.0 is out of range"):
+        load_sweep(bad)
+
+
 def test_a_bad_device_or_out_folder_is_one_error_before_any_output(tmp_path):
     """An explicit device that cannot be had fails once, before the folder is made (every task had
     failed with it, one line each); an --out that cannot be made is one line, not mkdir's traceback."""

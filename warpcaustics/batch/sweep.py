@@ -225,6 +225,10 @@ def expand_sweep(
                     task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
                 )
             )
+    errors = {task.error for task in tasks}
+    if None not in errors and len(errors) == 1:  # the base or [set], not a variant: nothing would run
+        raise ConfigError(f"every variant of {source.name} fails the same way, with base {base.name}: "
+                          f"{errors.pop()}")
     return Sweep(base, tasks, source, list(grid) + list(zipped))
 
 
