@@ -10,7 +10,8 @@ the whole patch (``patch_windows``, from the coarse map the window's light is co
 timed too, against the statistics without them, on this frame (one band) and on a frame of the
 Darecki profile's set-up (``configs/field/darecki2011.toml`` at 0.86 m, 8 m on 256² cells: a
 0.4 m window of 400² texels, each of its three bands' windows too, on coarse texels the windows'
-edges cross). ``--quick``: the scene on 256² cells (keeps the script running).
+edges cross). ``--quick``: the scene on 256² cells, 4 sky cones, 2 disk directions, the beam spread's walks
+of 16384 photons (keeps the script running).
 """
 
 from __future__ import annotations
@@ -24,7 +25,11 @@ SCENE = ROOT / "configs/field/gernez2009.toml"
 POINT = {**SKY_16_CONES, "sun.elevation_deg": 5.0, "sky.diffuse_fraction": 0.85}
 """An 85° sun at the paper's diffuse share (``jerlov.gernez2009_diffuse_share``)."""
 
-QUICK = {"water.resolution": 256, "caustics.map_resolution": 256}
+QUICK = {"water.resolution": 256, "caustics.map_resolution": 256, "optics.beam_spread_photons": 16384,
+         "sky.directions": 4, "sun.disk_samples": 2}
+"""Small cells and texels, four sky cones, two sun-disk directions and walks of the beam spread a
+sixteenth as long: the 24 light directions' walks and multipliers had taken most of the quick run's
+five minutes."""
 
 DARECKI = ROOT / "configs/field/darecki2011.toml"
 DARECKI_FRAME = {"floor.depth_m": 0.86, "water.extent_m": 8.0, "water.resolution": 256}
@@ -52,7 +57,9 @@ def run(quick: bool, device: str) -> dict:
     repeats = 2 if quick else 3
     scene_overrides = {**POINT, **(QUICK if quick else {})}
     long_overrides = {**POINT, **LONG_WAVES_OVERRIDES, "water.extent_m": LONG_WAVES_EXTENT_M,
-                      "water.shortest_wave_m": 8.0, "caustics.map_extent_m": 0.0}
+                      "water.shortest_wave_m": 8.0, "caustics.map_extent_m": 0.0,
+                      **({key: QUICK[key] for key in ("optics.beam_spread_photons", "sky.directions",
+                                                      "sun.disk_samples")} if quick else {})}
     times = {}
     results = {}
     for name, overrides in (("scene", scene_overrides), ("long_waves", long_overrides)):
@@ -62,7 +69,8 @@ def run(quick: bool, device: str) -> dict:
         times[name] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
         results[name] = (renderer.render(1.0), scene.config.stats)
     with_windows, without = statistics_cost(*results["scene"], repeats)
-    darecki = wc.load_scene(DARECKI, DARECKI_FRAME)
+    darecki = wc.load_scene(DARECKI, {**DARECKI_FRAME, **({key: QUICK[key] for key in (
+        "optics.beam_spread_photons", "sky.directions", "sun.disk_samples")} if quick else {})})
     per_band = statistics_cost(wc.render(darecki, device=device), darecki.config.stats, repeats)
     ratio = times["long_waves"] / times["scene"]
     print(f"scene frame {times['scene']:.2f} s, long waves' frame {times['long_waves']:.2f} s: "

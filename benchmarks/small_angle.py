@@ -1,21 +1,22 @@
 """The small-angle scattering mode against single scattering on the same frame.
 
-``python -m benchmarks.small_angle`` (part of ``python -m benchmarks.run``; ``--quick``: 256² over
-8 m): the field set-up (``configs/field/gernez2009.toml``: a 1024² JONSWAP sea over 32 m, 16 sun-disk
-and 16 sky directions, a 1 m window of 512² texels, 510 nm) rendered with ``optics.scattering =
-"single"`` and ``"small_angle"`` (the scattered light of each pass by the small-angle transfer, its
-mean from a random walk at one photon per cell), warm frames, median of ``repeats``, one core. Prints
-the time of each and their ratio; the record says where the small-angle time goes (the walk, the
-transfer's FFTs, the sky's per-direction read-backs). A third frame, ``small_angle`` with the window
-taken whole as periodic (as before 2026-12-05: no coarse map of the patch), gives the cost of the
-window's large scales from the whole patch (each pass's quads splatted on a coarse map, its FFT
-transfer and the bilinear read at the window's texels). A fourth, ``small_angle`` with
-``optics.beam_spread = "walk"`` (the column's beam spread function from a walk of a pencil beam per
-light direction instead of Wells's closed form), is timed warm like the others — its walks and
-multipliers are kept from the first frame — and its first frame, which walks them, is reported too.
-A fifth, ``small_angle`` with the sky in cones (``sky.sampling = "cones"``: each sky direction's map
-spread over its cell of the sky before its transfer), gives the cones' cost against the point
-directions, warm and first frame (which computes the cells' multipliers).
+``python -m benchmarks.small_angle`` (part of ``python -m benchmarks.run``; ``--quick``: 256² over 8
+m, 4 sky and 2 disk directions, walks of 16384 photons): the field set-up
+(``configs/field/gernez2009.toml``: a 1024² JONSWAP sea over 32 m, 16 sun-disk and 16 sky
+directions, a 1 m window of 512² texels, 510 nm) rendered with ``optics.scattering = "single"`` and
+``"small_angle"`` (the scattered light of each pass by the small-angle transfer, its mean from a
+random walk at one photon per cell), warm frames, median of ``repeats``, one core. Prints the time
+of each and their ratio; the record says where the small-angle time goes (the walk, the transfer's
+FFTs, the sky's per-direction read-backs). A third frame, ``small_angle`` with the window taken
+whole as periodic (as before 2026-12-05: no coarse map of the patch), gives the cost of the window's
+large scales from the whole patch (each pass's quads splatted on a coarse map, its FFT transfer and
+the bilinear read at the window's texels). A fourth, ``small_angle`` with ``optics.beam_spread =
+"walk"`` (the column's beam spread function from a walk of a pencil beam per light direction instead
+of Wells's closed form), is timed warm like the others — its walks and multipliers are kept from the
+first frame — and its first frame, which walks them, is reported too. A fifth, ``small_angle`` with
+the sky in cones (``sky.sampling = "cones"``: each sky direction's map spread over its cell of the
+sky before its transfer), gives the cones' cost against the point directions, warm and first frame
+(which computes the cells' multipliers).
 """
 
 from __future__ import annotations
@@ -27,7 +28,11 @@ from benchmarks.field_budget import BEFORE  # the field set-up as these figures 
 from benchmarks.run import ROOT, device_record, median_time
 
 FULL = {}
-QUICK = {"water.resolution": 256, "water.extent_m": 8.0, "caustics.map_resolution": 256}
+QUICK = {"water.resolution": 256, "water.extent_m": 8.0, "caustics.map_resolution": 256,
+         "optics.beam_spread_photons": 16384, "sky.directions": 4, "sun.disk_samples": 2}
+"""Small cells and texels, four sky directions, two of the sun's disk and walks of the beam spread a
+sixteenth as long: the 32 light directions' walks and multipliers had taken most of the quick run's
+two minutes."""
 
 
 def run(quick: bool, device: str) -> dict:
