@@ -107,12 +107,17 @@ def test_field_frames_past_the_bound_are_refused_at_once(tmp_path, capsys):
 
 def test_a_pool_sweep_too_short_for_its_integration_fails_before_rendering(tmp_path):
     """The render command refuses it up front; a sweep's pool task now fails the same way, without
-    rendering its frames and leaving a checkpoint to repeat them."""
+    rendering its frames and leaving a checkpoint to repeat them; a sweep of that task alone is
+    refused as it loads (nothing of it would run)."""
     path = tmp_path / "sweep.toml"
-    path.write_text(f'base = "{(CONFIGS / "pool.toml").as_posix()}"\n[set]\n"stats.integration_s" = 10.0\n'
-                    '[frames]\ncount = 3\n')
-    (task,) = load_sweep(path).tasks
-    assert task.error is not None and "stats.integration_s = 10 needs frames.count" in task.error
+    base = f'base = "{(CONFIGS / "pool.toml").as_posix()}"\n'
+    path.write_text(base + '[grid]\n"stats.integration_s" = [10.0, 0.0]\n[frames]\ncount = 3\n')
+    short, fine = load_sweep(path).tasks
+    assert short.error is not None and "stats.integration_s = 10 needs frames.count" in short.error
+    assert fine.error is None
+    path.write_text(base + '[set]\n"stats.integration_s" = 10.0\n[frames]\ncount = 3\n')
+    with pytest.raises(wc.ConfigError, match="every variant of sweep.toml fails the same way.*needs frames"):
+        load_sweep(path)
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero here")
@@ -514,7 +519,7 @@ def test_a_sweep_whose_state_cannot_be_written_midway_is_one_line(tmp_path, caps
     one = tmp_path / "one.toml"
     one.write_text(f'base = "{(CONFIGS / "ocean.toml").as_posix()}"\n[grid]\n"floor.depth_m" = [1.0]\n')
     one_line_error(capsys, ["sweep", str(one), "--out", str(tmp_path / "s"), "--quiet", *TINY],
-                   "writing", "manifest.jsonl", "No space left on device", "--out")
+                   "manifest.jsonl': No space left on device", "--out")
 
 
 def test_compare_s_hint_for_a_scene_with_receivers_is_one_that_works(tmp_path, capsys):

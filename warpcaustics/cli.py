@@ -509,10 +509,10 @@ def main(argv: list[str] | None = None) -> int:
     except WarpcausticsError as exc:
         print(f"warpcaustics: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_USER_ERROR
-    except OSError as exc:  # a write that failed as it went (a full disk): the file and the reason
-        where = f" {str(exc.filename)!r}" if exc.filename else ""
-        print(f"warpcaustics: error: writing{where} failed: {one_line(exc.strerror or str(exc))}; free "
-              "space or give another --out (what was written is not recorded as a finished run)",
+    except OSError as exc:  # a file that failed as it went (a disk that filled): which, and why
+        where = f"{str(exc.filename)!r}: " if exc.filename else ""
+        print(f"warpcaustics: error: {one_line(where + (exc.strerror or str(exc)))}; where that is in --out, "
+              "free space there or give another --out (what was written is not marked a finished run)",
               file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
