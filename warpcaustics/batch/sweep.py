@@ -180,7 +180,12 @@ def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
 
     for name, t in (("sweep frames.start_s", times[0]), ("sweep frames' last time", times[-1])):
         check_time(name, t)
-    return expand_sweep(base, fixed, grid, zipped, times, path)
+    sweep = expand_sweep(base, fixed, grid, zipped, times, path)
+    errors = {task.error for task in sweep.tasks}
+    if None not in errors and len(errors) == 1:  # the base or [set], not a variant: nothing would run
+        raise ConfigError(f"every variant of {path.name} fails the same way, with base {base.name}: "
+                          f"{errors.pop()}")
+    return sweep
 
 
 def expand_sweep(
@@ -225,10 +230,6 @@ def expand_sweep(
                     task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
                 )
             )
-    errors = {task.error for task in tasks}
-    if None not in errors and len(errors) == 1:  # the base or [set], not a variant: nothing would run
-        raise ConfigError(f"every variant of {source.name} fails the same way, with base {base.name}: "
-                          f"{errors.pop()}")
     return Sweep(base, tasks, source, list(grid) + list(zipped))
 
 
