@@ -15,18 +15,14 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.field_budget import SKY_16_CONES  # the sky as these figures were measured
+from benchmarks.field_budget import QUICK_LIGHT, SKY_16_CONES  # the sky as the figures were measured
 from benchmarks.run import ROOT, device_record, median_time
 
 SCENE = ROOT / "configs/field/gernez2009.toml"
 POINT = {**SKY_16_CONES, "sun.elevation_deg": 70.0, "sky.diffuse_fraction": 0.21}
 """A 20° sun at the paper's diffuse share (``jerlov.gernez2009_diffuse_share``)."""
 
-QUICK = {"water.resolution": 128, "caustics.map_resolution": 128, "optics.beam_spread_photons": 16384,
-         "sky.directions": 4, "sun.disk_samples": 2}
-"""Small cells and texels, four sky cones, two sun-disk directions and walks of the beam spread a
-sixteenth as long: each light direction's walks and multipliers had taken most of the quick run's
-five minutes."""
+QUICK = {"water.resolution": 128, "caustics.map_resolution": 128, **QUICK_LIGHT}
 
 
 def run(quick: bool, device: str) -> dict:

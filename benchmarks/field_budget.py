@@ -47,6 +47,12 @@ SKY_16_CONES = {"sky.directions": 16, "sky.surface_resolution": 0}
 figures of the benchmarks that take it (cones_attenuation, long_waves, field_bands) were measured;
 the config now has 64 cones on its waves cut to 1024²."""
 
+QUICK_LIGHT = {"optics.beam_spread_photons": 16384, "sky.directions": 4, "sun.disk_samples": 2}
+"""The light of the field benchmarks' ``--quick`` (long_waves, field_bands, small_angle): four sky
+directions, two of the sun's disk and walks of the beam spread a sixteenth as long. Each light
+direction's walks and multipliers had taken most of their quick runs' 2–5 minutes, and the quick
+mode only keeps them running."""
+
 WINDOW_CV = "model_cv_window"
 """The column every row's CV is read from (the window alone); a table written before it existed has
 the same figure in ``model_cv``."""

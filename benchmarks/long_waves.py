@@ -18,18 +18,14 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks.field_budget import SKY_16_CONES  # the sky as these figures were measured
+from benchmarks.field_budget import QUICK_LIGHT, SKY_16_CONES  # the sky as the figures were measured
 from benchmarks.run import ROOT, device_record, median_time
 
 SCENE = ROOT / "configs/field/gernez2009.toml"
 POINT = {**SKY_16_CONES, "sun.elevation_deg": 5.0, "sky.diffuse_fraction": 0.85}
 """An 85° sun at the paper's diffuse share (``jerlov.gernez2009_diffuse_share``)."""
 
-QUICK = {"water.resolution": 256, "caustics.map_resolution": 256, "optics.beam_spread_photons": 16384,
-         "sky.directions": 4, "sun.disk_samples": 2}
-"""Small cells and texels, four sky cones, two sun-disk directions and walks of the beam spread a
-sixteenth as long: the 24 light directions' walks and multipliers had taken most of the quick run's
-five minutes."""
+QUICK = {"water.resolution": 256, "caustics.map_resolution": 256, **QUICK_LIGHT}
 
 DARECKI = ROOT / "configs/field/darecki2011.toml"
 DARECKI_FRAME = {"floor.depth_m": 0.86, "water.extent_m": 8.0, "water.resolution": 256}
@@ -58,8 +54,7 @@ def run(quick: bool, device: str) -> dict:
     scene_overrides = {**POINT, **(QUICK if quick else {})}
     long_overrides = {**POINT, **LONG_WAVES_OVERRIDES, "water.extent_m": LONG_WAVES_EXTENT_M,
                       "water.shortest_wave_m": 8.0, "caustics.map_extent_m": 0.0,
-                      **({key: QUICK[key] for key in ("optics.beam_spread_photons", "sky.directions",
-                                                      "sun.disk_samples")} if quick else {})}
+                      **(QUICK_LIGHT if quick else {})}
     times = {}
     results = {}
     for name, overrides in (("scene", scene_overrides), ("long_waves", long_overrides)):
@@ -69,8 +64,7 @@ def run(quick: bool, device: str) -> dict:
         times[name] = median_time(lambda r=renderer: r.render(0.5), repeats, device)
         results[name] = (renderer.render(1.0), scene.config.stats)
     with_windows, without = statistics_cost(*results["scene"], repeats)
-    darecki = wc.load_scene(DARECKI, {**DARECKI_FRAME, **({key: QUICK[key] for key in (
-        "optics.beam_spread_photons", "sky.directions", "sun.disk_samples")} if quick else {})})
+    darecki = wc.load_scene(DARECKI, {**DARECKI_FRAME, **(QUICK_LIGHT if quick else {})})
     per_band = statistics_cost(wc.render(darecki, device=device), darecki.config.stats, repeats)
     ratio = times["long_waves"] / times["scene"]
     print(f"scene frame {times['scene']:.2f} s, long waves' frame {times['long_waves']:.2f} s: "

@@ -24,15 +24,11 @@ from __future__ import annotations
 import sys
 import time
 
-from benchmarks.field_budget import BEFORE  # the field set-up as these figures were measured
+from benchmarks.field_budget import BEFORE, QUICK_LIGHT  # BEFORE: the set-up as these figures were measured
 from benchmarks.run import ROOT, device_record, median_time
 
 FULL = {}
-QUICK = {"water.resolution": 256, "water.extent_m": 8.0, "caustics.map_resolution": 256,
-         "optics.beam_spread_photons": 16384, "sky.directions": 4, "sun.disk_samples": 2}
-"""Small cells and texels, four sky directions, two of the sun's disk and walks of the beam spread a
-sixteenth as long: the 32 light directions' walks and multipliers had taken most of the quick run's
-two minutes."""
+QUICK = {"water.resolution": 256, "water.extent_m": 8.0, "caustics.map_resolution": 256, **QUICK_LIGHT}
 
 
 def run(quick: bool, device: str) -> dict:
