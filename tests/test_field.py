@@ -448,6 +448,10 @@ def test_darecki_bad_input_is_one_line(tmp_path, capsys):
     for depth in (0.0, -1.0, math.nan):
         with pytest.raises(ConfigError, match=f"--depths: {depth:g} must be a depth above 0"):
             field.run_darecki2011(DARECKI, tmp_path / "o", depths=(depth,), quick=True)
+    # a depth the scene refuses names the flag that asked for it, not only the key it sets
+    with pytest.raises(ConfigError, match=r"--depths 1e\+09: the scene cannot take it \(floor.depth_m = "):
+        field.run_darecki2011(DARECKI, tmp_path / "o", depths=(1e9,), quick=True)
+    assert not (tmp_path / "o").exists()
     with pytest.raises(ConfigError, match=r"optics.wavelengths = \[443.0, 532.0, 670.0\]"):
         field.run_darecki2011(DARECKI, tmp_path / "o", overrides={"optics.wavelengths": [510.0]}, quick=True)
     with pytest.raises(ConfigError, match="stats.per_band = true"):

@@ -69,17 +69,22 @@ def check_overrides(overrides: dict | None, point_keys: tuple[str, ...], choose:
 
 
 def render_points(scene_path: Path, fixed: dict, variants: list[dict], times: tuple[float, ...],
-                  out: str | Path, *, workers: int, device: str | None, quiet: bool, force: bool):
+                  out: str | Path, *, workers: int, device: str | None, quiet: bool, force: bool,
+                  chosen_by: tuple[str, str] | None = None):
     """Render every variant (a dict of overrides on top of ``fixed``) at ``times`` as one sweep
-    into ``out``; returns the sweep. A variant the scene cannot take fails before anything renders;
-    failed tasks raise after the rest have run (rerun the same command to finish them)."""
+    into ``out``; returns the sweep. A variant the scene cannot take fails before anything renders
+    (naming the flag, where ``chosen_by`` = (config key, the command's flag that chose its values)
+    says which); failed tasks raise after the rest have run (rerun the same command to finish them)."""
     from warpcaustics.batch.sweep import expand_sweep, format_report, run_sweep
 
     zipped = {k: [o[k] for o in variants] for k in variants[0]}
     sweep = expand_sweep(scene_path, fixed, {}, zipped, times, scene_path)
-    bad = next((t.error for t in sweep.tasks if t.error is not None), None)
+    bad = next((t for t in sweep.tasks if t.error is not None), None)
     if bad is not None:
-        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad}")
+        key, flag = chosen_by or (None, None)
+        if key in bad.overrides and bad.error.startswith(f"{key} "):  # the flag's own value is refused
+            raise ConfigError(f"{flag} {bad.overrides[key]:g}: the scene cannot take it ({bad.error})")
+        raise ConfigError(f"{scene_path.name} cannot take the comparison's conditions: {bad.error}")
     report = run_sweep(sweep, out, workers=workers, device=device, quiet=quiet, force=force)
     if not quiet:
         print(format_report(report))

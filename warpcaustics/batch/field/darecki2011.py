@@ -159,7 +159,7 @@ def render_record(scene: str | Path, out: str | Path, rec, key: str, have: np.nd
     long_fixed = long_waves_overrides(base.config, fixed, long_waves_m, quick, scene_path)
     variants = [{key: v} for v in chosen]
     sweep = render_points(scene_path, fixed, variants, times, out, workers=workers, device=device,
-                          quiet=quiet, force=force)
+                          quiet=quiet, force=force, chosen_by=(key, flag[0]))
     long_out = Path(out) / LONG_WAVES_FOLDER
     long = None if long_fixed is None else render_points(
         scene_path, long_fixed, variants, times, long_out, workers=workers, device=device, quiet=quiet,
