@@ -131,7 +131,8 @@ def test_window_statistics_use_its_texels():
         ({"caustics.map_extent_m": 20.0}, "exceeds water.extent_m"),
         ({"caustics.map_extent_m": 10.0}, "more than half"),
         ({"caustics.map_center_m": [1.0, 1.0]}, "caustics.map_extent_m is 0"),
-        ({"caustics.map_extent_m": 1.0, "caustics.method": "beams"}, "fluxratio"),
+        ({"caustics.map_extent_m": 1.0, "caustics.method": "beams"},  # both fixes offered
+         r"set caustics.method = \"fluxratio\", or caustics.map_extent_m = 0"),
         ({"caustics.map_extent_m": 1.0, "caustics.map_center_m": [1.0]}, "caustics.map_center_m"),
         ({"caustics.map_extent_m": 1.0, "stats.probes": [{"x_m": 3.0, "y_m": 0.0}]}, r"stats.probes\[0\]"),
     ],

@@ -105,7 +105,7 @@ def _check_map_window(cfg: Config) -> None:
     if c.method is not CausticsMethod.FLUXRATIO:
         raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} (a floor-map window) works with "
                           f"caustics.method = \"fluxratio\" only (the method is {c.method.value!r}); set "
-                          "caustics.map_extent_m = 0")
+                          "caustics.method = \"fluxratio\", or caustics.map_extent_m = 0 for the whole patch")
     half = 0.5 * cfg.water.extent_m
     if c.map_extent_m > cfg.water.extent_m:
         raise ConfigError(f"caustics.map_extent_m = {c.map_extent_m:g} exceeds water.extent_m = "
