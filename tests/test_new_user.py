@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 import warpcaustics as wc
 from warpcaustics.config.loading import tomllib  # tomli on Python 3.10
 
@@ -81,6 +83,19 @@ def test_config_prints_the_resolved_configuration_as_toml(tmp_path):
     assert again == wc.load_scene(CONFIGS / "pool_pots.toml", {"sun.elevation_deg": 33.0}).config
     one_line_error(run_cli("config", str(CONFIGS / "ocean.toml"), "--set", "water.extnt_m=3"),
                    "water.extnt_m", "water.extent_m")
+
+
+def test_the_printed_config_loads_from_another_folder(tmp_path):
+    """A file the config names relative to its own folder (lens.toml's ``water.file = "lens.npy"``)
+    is printed as an absolute path: the printed config, saved elsewhere, is the same scene."""
+    proc = run_cli("config", str(CONFIGS / "lens.toml"))
+    assert proc.returncode == 0, proc.stderr
+    assert tomllib.loads(proc.stdout)["water"]["file"] == str(CONFIGS.resolve() / "lens.npy")
+    printed = tmp_path / "printed.toml"
+    printed.write_text(proc.stdout)
+    again, original = wc.load_scene(printed), wc.load_scene(CONFIGS / "lens.toml")
+    assert np.array_equal(again.heights, original.heights)
+    assert again.config.water.file == str(CONFIGS.resolve() / "lens.npy")
 
 
 # No stale outputs --------------------------------------------------------------------------------

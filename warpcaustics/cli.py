@@ -113,7 +113,8 @@ def _parser() -> argparse.ArgumentParser:
 
     cf = sub.add_parser("config", help="print a scene's resolved configuration (a dry run)",
                         description="Validate CONFIG with its --set overrides and print every key with "
-                                    "its value as TOML; nothing is rendered or written.")
+                                    "its value as TOML (the files it names as absolute paths, so it "
+                                    "loads from any folder); nothing is rendered or written.")
     cf.add_argument("config", metavar="CONFIG", help="TOML scene file, e.g. configs/ocean.toml")
     _set_arg(cf)
 
@@ -271,8 +272,24 @@ def _config(args: argparse.Namespace) -> int:
     from warpcaustics.scene import load_scene
 
     scene = load_scene(args.config, _overrides(args))
-    print(dumps_toml(config_to_dict(scene.config)), end="")
+    print(dumps_toml(_absolute_files(config_to_dict(scene.config), scene.base_dir)), end="")
     return 0
+
+
+def _absolute_files(table, base_dir: Path):
+    """``table`` with the files its keys name (``file``, ``albedo_file``, a receiver's ``mesh`` that
+    is no built-in shape) as absolute paths: a relative one starts at the config file's folder, so
+    the printed config loads from anywhere."""
+    from warpcaustics.scene.receivers import PRIMITIVES
+
+    if isinstance(table, list):
+        return [_absolute_files(item, base_dir) for item in table]
+    if not isinstance(table, dict):
+        return table
+    names_file = {"file", "albedo_file"}
+    return {key: str(base_dir / value)
+            if isinstance(value, str) and (key in names_file or key == "mesh" and value not in PRIMITIVES)
+            else _absolute_files(value, base_dir) for key, value in table.items()}
 
 
 def _render(args: argparse.Namespace) -> int:
