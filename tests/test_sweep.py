@@ -143,6 +143,47 @@ def test_a_bad_device_or_out_folder_is_one_error_before_any_output(tmp_path):
         run_sweep(sweep, tmp_path / "afile" / "out", workers=1, device="cpu", quiet=True)
 
 
+def test_more_workers_than_the_host_memory_holds_are_refused_before_any_output(tmp_path, monkeypatch):
+    """Eight tasks on eight workers with 1 GiB free: each worker's process (400 MiB) and scene would
+    not fit eight times over; refused in one line naming --workers and how many fit, before the
+    folder is made. Two workers fit and run; the tasks carry what pipeline.scene_bytes says."""
+    import warpcaustics.device as devices
+    from warpcaustics.batch.executors import WORKER_PROCESS_BYTES
+    from warpcaustics.errors import WarpcausticsError
+    from warpcaustics.pipeline import host_bytes, scene_bytes
+    from warpcaustics.scene import load_scene
+
+    sweep = load_sweep(_sweep(tmp_path))
+    task = sweep.tasks[0]
+    scene = load_scene(CONFIGS / "ocean.toml", task.overrides)
+    assert task.memory == (scene_bytes(scene, "cuda"), scene_bytes(scene, "cpu"), host_bytes(scene))
+    each = WORKER_PROCESS_BYTES + max(t.memory[1] + t.memory[2] for t in sweep.tasks)
+    monkeypatch.setattr(devices, "host_available_bytes", lambda: 2**30)
+    fit = 2**30 // each
+    with pytest.raises(WarpcausticsError, match=rf"^--workers 8: 8 renders at once need about "
+                                                rf"[0-9.]+ GiB of host memory but 1.0 GiB is free; "
+                                                rf"use --workers {fit} or fewer$"):
+        run_sweep(sweep, tmp_path / "out", workers=8, device="cpu", quiet=True)
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(WarpcausticsError, match="8 renders at once"):  # more workers than tasks: 8
+        run_sweep(sweep, tmp_path / "out", workers=1000, device="cpu", quiet=True)
+    report = run_sweep(load_sweep(_sweep(tmp_path, types='"pure"')), tmp_path / "out", workers=fit,
+                       device="cpu", quiet=True)
+    assert report.done == 4 and not report.failed
+
+
+def test_a_dead_worker_says_to_use_fewer_workers():
+    """A worker killed under memory pressure breaks the pool: each task it took fails with the
+    pool's words, which name no cause; the line says what to do."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    from warpcaustics.batch.sweep import _error_line
+
+    line = _error_line(BrokenProcessPool("A process in the process pool was terminated abruptly while "
+                                         "the future was running or pending."))
+    assert line.startswith("BrokenProcessPool: a worker process died") and "fewer --workers" in line
+
+
 def test_sweep_frame_times_past_the_renderers_range_are_refused(tmp_path):
     """A sweep's [frames] whose times overflow (or a start that is no number) are refused as the sweep
     loads, not by every task."""

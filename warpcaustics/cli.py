@@ -21,6 +21,8 @@ costs 0.7 s (scipy) at every start of the command (tests/test_field.py checks th
 
 EXIT_USER_ERROR = 2
 
+WORKERS_HELP = "worker processes (default 1; refused where that many renders at once do not fit in memory)"
+
 
 def _device_arg(p: argparse.ArgumentParser, default: str = "") -> None:
     p.add_argument("--device", metavar="DEVICE", help=f"cpu, cuda, cuda:N or auto{default}")
@@ -71,7 +73,7 @@ def _parser() -> argparse.ArgumentParser:
                                     "DIR/manifest.jsonl and DIR/summary.csv.")
     sw.add_argument("sweep", metavar="SWEEP", help="sweep TOML, e.g. configs/sweeps/water_types.toml")
     sw.add_argument("--out", required=True, metavar="DIR", help="output folder (reused to resume)")
-    sw.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
+    sw.add_argument("--workers", type=int, default=1, metavar="N", help=WORKERS_HELP)
     sw.add_argument("--executor", default="local", choices=["local", "ray"],
                     help="local (a process pool, default) or ray (pip install 'warpcaustics[ray]')")
     sw.add_argument("--address", metavar="ADDR",
@@ -161,7 +163,7 @@ def _field_parser(sub) -> None:
                     help="seconds between a point's frames (default: gernez2009(_bands) 2, the darecki2011 "
                          "data sets 5); "
                          "frames further apart than the waves' periods are independent samples")
-    fd.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes (default 1)")
+    fd.add_argument("--workers", type=int, default=1, metavar="N", help=WORKERS_HELP)
     _device_arg(fd)
     _set_arg(fd, ", on every point (a row of the error budget)")
     fd.add_argument("--quick", action="store_true",

@@ -44,6 +44,35 @@ def die_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
+WORKER_PROCESS_BYTES = 400 * 2**20
+"""A worker process's own host memory beside its scene's [bytes]: Python with Warp's CPU runtime,
+numpy and the writers imported; a two-worker sweep of 32² renders peaked at 360 MB resident a
+worker (``ru_maxrss`` of the children, docs/benchmarks.md)."""
+
+
+def check_workers_fit(todo: list[Task], workers: int, device: str | None) -> None:
+    """Refuse, in one line before anything is written, ``workers`` processes whose renders at once
+    (as many as there are tasks ``todo``, each the largest) would not fit in the free host memory,
+    or on ``device``'s if it is a GPU that they share; a single render keeps the Renderer's own check."""
+    from warpcaustics import device as devices
+
+    at_once = min(workers, len(todo))
+    if at_once < 2 or device is None:  # None: the tasks name devices of their own
+        return
+    gib = 2.0**30
+    on_gpu = device.startswith("cuda")
+    host = WORKER_PROCESS_BYTES + max(t.memory[2] + (0 if on_gpu else t.memory[1]) for t in todo)
+    needs = [(host, devices.host_available_bytes(), "host memory")]
+    if on_gpu:
+        needs.append((max(t.memory[0] for t in todo), devices.free_bytes(device), f"memory on {device}"))
+    for each, free, what in needs:
+        if free is not None and at_once * each > free:
+            fit = max(1, int(free // each))
+            raise WarpcausticsError(
+                f"--workers {workers}: {at_once} renders at once need about {at_once * each / gib:.1f} GiB "
+                f"of {what} but {free / gib:.1f} GiB is free; use --workers {fit} or fewer")
+
+
 def run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device: str | None, finish) -> None:
     import multiprocessing
 

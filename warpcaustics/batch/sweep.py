@@ -48,7 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from warpcaustics import __version__
-from warpcaustics.batch.executors import run_locally, run_on_ray
+from warpcaustics.batch.executors import check_workers_fit, run_locally, run_on_ray
 from warpcaustics.batch.worker import task_tmp_dir
 from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.config.loading import check_key
@@ -77,6 +77,10 @@ class Task:
     """A pool animation: its frames step on from each other, with a checkpoint after each."""
     config: dict | None = None
     """The resolved configuration the id hashes (recorded in the manifest)."""
+    memory: tuple[int, int, int] = (0, 0, 0)
+    """What one render of it needs [bytes]: device memory on CUDA, on the CPU, and host memory for
+    the read-back (``pipeline.scene_bytes``, ``pipeline.host_bytes``); the pool's check of
+    ``--workers`` renders at once (:func:`~warpcaustics.batch.executors.check_workers_fit`)."""
 
 
 @dataclass
@@ -200,6 +204,7 @@ def expand_sweep(
     applied after ``fixed``, each variant validated, and one task per frame time (a whole animation
     for the stateful pools). Also used by commands that build their sweep in code
     (``warpcaustics field``)."""
+    from warpcaustics.pipeline import host_bytes, scene_bytes
     from warpcaustics.scene import load_scene
 
     read_toml(base)  # a missing or unreadable base fails the whole sweep (exit 2), not each task
@@ -224,12 +229,10 @@ def expand_sweep(
             tasks.append(Task(task_id(resolved, times), overrides, times, 0, short, stateful, resolved))
             continue
         groups = [times] if stateful else [(t,) for t in times]
+        memory = (scene_bytes(scene, "cuda"), scene_bytes(scene, "cpu"), host_bytes(scene))
         for i, group in enumerate(groups):
-            tasks.append(
-                Task(
-                    task_id(resolved, group), overrides, group, 0 if stateful else i, None, stateful, resolved
-                )
-            )
+            tasks.append(Task(task_id(resolved, group), overrides, group, 0 if stateful else i, None,
+                              stateful, resolved, memory))
     return Sweep(base, tasks, source, list(grid) + list(zipped))
 
 
@@ -436,6 +439,8 @@ def run_sweep(
         elif len(configured) == 1 and any(t.error is None and t.id not in finished for t in sweep.tasks):
             # the config's device (or $WARPCAUSTICS_DEVICE), said once; a finished sweep needs none
             device = resolve_device(None, config_value=configured.pop())
+        check_workers_fit([t for t in sweep.tasks if t.error is None and t.id not in finished], workers,
+                          device)
     if out.exists() and not out.is_dir():
         raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
     try:
@@ -509,9 +514,14 @@ def run_sweep(
 
 def _error_line(error: BaseException) -> str:
     """One line for a failed task; Ray's wrapped errors are unwrapped to their cause."""
+    from concurrent.futures.process import BrokenProcessPool
+
     cause = getattr(error, "cause", None)
     if isinstance(cause, BaseException):
         error = cause
+    if isinstance(error, BrokenProcessPool):  # the pool's own words say nothing of why
+        return ("BrokenProcessPool: a worker process died (killed, most often for lack of memory); rerun "
+                "the same command with fewer --workers to finish the rest")
     text = str(error).strip()
     return f"{type(error).__name__}: {text.splitlines()[0] if text else ''}"
 
