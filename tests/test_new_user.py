@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import warpcaustics as wc
 from warpcaustics.config.loading import tomllib  # tomli on Python 3.10
@@ -83,6 +84,19 @@ def test_config_prints_the_resolved_configuration_as_toml(tmp_path):
     assert again == wc.load_scene(CONFIGS / "pool_pots.toml", {"sun.elevation_deg": 33.0}).config
     one_line_error(run_cli("config", str(CONFIGS / "ocean.toml"), "--set", "water.extnt_m=3"),
                    "water.extnt_m", "water.extent_m")
+
+
+@pytest.mark.parametrize(("argv", "names"), [
+    (("render", "configs/ocean.toml", "--out", "o", "--frames", "1e3"), ("--frames", "'1e3'",
+                                                                         "warpcaustics render --help")),
+    (("rendr",), ("invalid choice: 'rendr'", "warpcaustics --help")),
+    ((), ("COMMAND", "warpcaustics --help")),
+    (("field", "gernez2009"), ("SCENE, --out", "warpcaustics field --help")),
+])
+def test_a_command_line_argparse_refuses_is_one_line(argv, names):
+    """A flag's value of the wrong type, a misspelt command, a missing argument: argparse's usage
+    (up to five lines) no longer comes before the error; the line points to --help instead."""
+    one_line_error(run_cli(*argv), *names)
 
 
 def test_the_printed_config_loads_from_another_folder(tmp_path):

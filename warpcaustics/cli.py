@@ -37,8 +37,16 @@ def _time_arg(p: argparse.ArgumentParser, what: str = "simulation time [s]") -> 
     p.add_argument("--time", type=float, default=0.0, metavar="SECONDS", help=what)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser with its errors in one line, as every other bad input's (argparse prints its
+    usage, up to five lines, before the error); the line points to ``--help`` for the usage."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message}; see {self.prog} --help\n")
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="warpcaustics",
         description="Sunlight under moving water: caustics on the sea floor with NVIDIA Warp.")
     p.add_argument("--version", action="version", version=f"warpcaustics {__version__}")
