@@ -16,7 +16,10 @@ of Wells's closed form), is timed warm like the others — its walks and multipl
 first frame — and its first frame, which walks them, is reported too. A fifth, ``small_angle`` with
 the sky in cones (``sky.sampling = "cones"``: each sky direction's map spread over its cell of the
 sky before its transfer), gives the cones' cost against the point directions, warm and first frame
-(which computes the cells' multipliers).
+(which computes the cells' multipliers). Last, the phase function's spread table (the Hankel
+transform behind the transfer, computed once a process): computed, against read back from the
+cache on disk that keeps it between processes (``warpcaustics/io/table_cache.py``, a folder of its
+own here).
 """
 
 from __future__ import annotations
@@ -78,8 +81,39 @@ def run(quick: bool, device: str) -> dict:
           f"{first['walked_spread']:.1f} s against {first['small_angle']:.1f} s) | sky in cones "
           f"{times['sky_cones']:.2f} s (×{row['sky_cones_ratio']:.2f} of point directions; first frame "
           f"{first['sky_cones']:.1f} s)", flush=True)
+    row["spread_table"] = spread_table_cost(scene.config.optics)
     return {"benchmark": "small_angle_scattering", **device_record(device), "repeats": repeats,
             "results": [row]}
+
+
+def spread_table_cost(optics) -> dict:
+    """Seconds to compute the configured phase function's spread table and to read it from the cache."""
+    import os
+    import tempfile
+
+    from warpcaustics.io.table_cache import CACHE_ENV
+    from warpcaustics.optics.phase import phase_quadrature
+    from warpcaustics.optics.small_angle import spread_from_phase
+
+    quadrature = phase_quadrature(optics.phase_function, optics.hg_g, optics.petzold_station.value)
+    before = os.environ.get(CACHE_ENV)
+    with tempfile.TemporaryDirectory() as folder:
+        os.environ[CACHE_ENV] = folder
+        try:
+            start = time.perf_counter()
+            spread_from_phase(*quadrature)  # computed and written
+            computed = time.perf_counter() - start
+            start = time.perf_counter()
+            spread_from_phase(*quadrature)
+            read = time.perf_counter() - start
+        finally:
+            if before is None:
+                os.environ.pop(CACHE_ENV)
+            else:
+                os.environ[CACHE_ENV] = before
+    print(f"small_angle  the spread table ({optics.phase_function.value}): computed {computed:.2f} s | from "
+          f"the cache {read * 1e3:.1f} ms | ×{computed / read:.0f}", flush=True)
+    return {"computed_s": round(computed, 3), "cached_s": round(read, 5), "ratio": round(computed / read, 1)}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -52,14 +52,22 @@ def phase_hankel(theta: np.ndarray, weight: np.ndarray, nu: np.ndarray) -> np.nd
 
 def spread_from_phase(theta: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(x, G(x)) on the table's nodes for a phase function given by a quadrature (θ, w): p̃ by
-    :func:`phase_hankel`, its running integral by trapezoids, G(0) = 1."""
+    :func:`phase_hankel`, its running integral by trapezoids, G(0) = 1. Kept on disk between
+    processes (:mod:`warpcaustics.io.table_cache`: about 4 s of Bessel functions a phase function)."""
+    from warpcaustics.io.table_cache import cached_table, table_key
+
     x = np.concatenate([[0.0], np.geomspace(1e-3, 1e7, SPREAD_NODES)])
-    pt = phase_hankel(theta, weight, x)
-    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (pt[1:] + pt[:-1]) * np.diff(x))])
-    g = np.empty_like(x)
-    g[0] = 1.0
-    g[1:] = cumulative[1:] / x[1:]
-    return x, g
+
+    def compute() -> np.ndarray:
+        pt = phase_hankel(theta, weight, x)
+        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (pt[1:] + pt[:-1]) * np.diff(x))])
+        g = np.empty_like(x)
+        g[0] = 1.0
+        g[1:] = cumulative[1:] / x[1:]
+        return g
+
+    key = table_key(theta, weight, x, phase_hankel, spread_from_phase)
+    return x, cached_table("spread", key, compute, x.shape)
 
 
 @functools.cache
