@@ -4,10 +4,11 @@ Some tables cost seconds to compute and are the same in every process that needs
 function's Hankel transform behind the small-angle transfer (``optics/small_angle.py``) takes about
 4 s of float64 Bessel functions, once per phase function in each process, so each worker of a sweep
 and each field comparison's pool paid it again. Here a table is kept as a ``.npy`` file named by a
-SHA-256 of everything it is computed from: the package version, the inputs' bytes and the source
-of the functions that compute it, so that a changed input or a changed formula is a new file and a
-stale table is never read. A file that cannot be read as the table (damaged, of another shape) is
-computed again and replaced; a folder that cannot be written only means no cache.
+SHA-256 of everything it is computed from: the package version, the inputs' bytes, the source of
+the functions that compute it and the versions of the libraries they call, so that a changed input,
+formula or library is a new file and a stale table is not read. A file that cannot be read as the
+table (damaged, of another shape) is computed again and replaced; a folder that cannot be written
+only means no cache.
 
 The folder: ``$WARPCAUSTICS_CACHE`` (``off`` for none), else ``$XDG_CACHE_HOME/warpcaustics``, else
 ``~/.cache/warpcaustics``. The files are small (16 kB a table) and safe to delete.
@@ -35,7 +36,12 @@ def cache_folder() -> Path | None:
     value = os.environ.get(CACHE_ENV)
     if value is not None:
         return None if value.strip().lower() in ("", "0", "off") else Path(value)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    base = os.environ.get("XDG_CACHE_HOME")
+    if not base:
+        try:
+            base = str(Path.home() / ".cache")
+        except (RuntimeError, KeyError):  # no home folder to be found: no cache
+            return None
     return Path(base) / "warpcaustics"
 
 

@@ -66,7 +66,9 @@ def spread_from_phase(theta: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray
         g[1:] = cumulative[1:] / x[1:]
         return g
 
-    key = table_key(theta, weight, x, phase_hankel, spread_from_phase)
+    import scipy
+
+    key = table_key(theta, weight, x, phase_hankel, spread_from_phase, f"scipy {scipy.__version__}")
     return x, cached_table("spread", key, compute, x.shape)
 
 
