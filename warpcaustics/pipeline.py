@@ -7,7 +7,6 @@ holds no per-method logic (``warpcaustics/caustics/stage.py`` has the interface)
 
 from __future__ import annotations
 
-import math
 import numbers
 from contextlib import contextmanager
 
@@ -109,9 +108,29 @@ def check_time(name: str, time_s: float) -> None:
     ``name`` (a flag or an argument)."""
     if not isinstance(time_s, numbers.Real) or isinstance(time_s, bool):
         raise ConfigError(f"{name} = {time_s!r} must be a number of seconds, e.g. 0.0")
-    if not (math.isfinite(time_s) and abs(time_s) <= MAX_TIME_S):
-        raise ConfigError(f"{name} = {time_s} must be a finite number of seconds within "
+    if not (abs(time_s) <= MAX_TIME_S):  # NaN and inf too; an integer past float's range compares
+        from warpcaustics.config.fields import _describe
+
+        raise ConfigError(f"{name} = {_describe(time_s)} must be a finite number of seconds within "
                           f"±{MAX_TIME_S:g}")
+
+
+def check_scene_config(scene: Scene) -> None:
+    """A Scene built by hand (``Scene(config)``, or a config changed with ``dataclasses.replace``)
+    skips load_scene's validation: its config is validated again here (a round trip through the
+    checks, a few ms), so that a value load_scene refuses (a zero resolution had crashed the process
+    inside a kernel) is the same one line here."""
+    from warpcaustics.config import Config, config_to_dict
+    from warpcaustics.config.loading import config_from_dict
+
+    if not isinstance(scene.config, Config):
+        raise ConfigError(f"Scene(config) takes a Config; got {type(scene.config).__name__} "
+                          f"{scene.config!r:.60}: build scenes with warpcaustics.load_scene(path)")
+    try:
+        config_from_dict(config_to_dict(scene.config))
+    except ConfigError as exc:
+        raise ConfigError(f"the scene's config is not valid: {exc} (build scenes with "
+                          "warpcaustics.load_scene(path), which checks every key)") from None
 
 
 class Renderer:
@@ -126,6 +145,7 @@ class Renderer:
         if not isinstance(scene, Scene):
             raise ConfigError(f"a render takes a Scene from warpcaustics.load_scene(path); got "
                               f"{type(scene).__name__} {scene!r:.60}")
+        check_scene_config(scene)
         cfg = scene.config
         self.scene = scene
         self.device = devices.resolve_device(device, config_value=cfg.device.value)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numbers
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -125,7 +126,15 @@ class RenderResult:
         if self.face_flux_w_nm is None:
             raise ConfigError(f"receiver irradiance needs caustics.method = 'photons' or 'beams' (this "
                               f"render's is {self.method!r})")
-        sel = self.face_receiver == receiver
+        ids = sorted(int(i) for i in np.unique(self.face_receiver))
+        if isinstance(receiver, (bool, np.bool_)) or not isinstance(receiver, numbers.Integral) \
+                or int(receiver) not in ids:
+            from warpcaustics.config.fields import _describe
+
+            names = ", ".join(f"{i} ({'walls' if i == 1 else f'receivers[{i - 2}]'})" for i in ids) or "none"
+            raise WarpcausticsError(f"receiver = {_describe(receiver)} is not a receiver id of this render; "
+                                    f"its ids: {names}")
+        sel = self.face_receiver == int(receiver)
         return self.face_flux_w_nm[sel] / self.face_area_m2[sel, None]
 
     @property
@@ -175,14 +184,19 @@ class RenderResult:
         Each file is written to a temporary name and renamed; run.json comes last.
         """
         from warpcaustics.io.frame import save_frame
-        from warpcaustics.io.run_json import write_run_json
+        from warpcaustics.io.run_json import frame_entry, write_run_json
 
         if isinstance(frame, bool) or not isinstance(frame, numbers.Integral) or frame < 0:
             raise WarpcausticsError(f"frame = {frame!r} must be a whole number from 0 (the files' "
                                     "frame_NNNN names)")
+        if not isinstance(out_dir, (str, os.PathLike)) or isinstance(out_dir, bytes) or "\0" in str(out_dir) \
+                or out_dir == "":
+            raise WarpcausticsError(f"out_dir = {out_dir!r:.60} must be a folder's path (a str or a Path)")
+        frame = int(frame)
         try:
             paths = save_frame(self, Path(out_dir), frame=frame)
-            paths["json"] = write_run_json(Path(out_dir), [self])
+            # run.json names this frame's own files (frame_0005.*), not frame 0's
+            paths["json"] = write_run_json(Path(out_dir), [self], frames=[frame_entry(frame, self)])
         except OSError as exc:
             raise WarpcausticsError(f"cannot save into {str(out_dir)!r}: {exc.strerror or exc}; give a "
                                     "folder that can be made and written") from None

@@ -44,9 +44,14 @@ def compare_methods(config: str | Path | None, overrides: dict, time_s: float, d
     """Render the scene of ``config`` + ``overrides`` at ``time_s`` with each method (each variant
     validated like any config); returns ``{"rows": [...], "results": {method: RenderResult}}``,
     rows holding the correlation and relative L1 vs the flux-ratio map and the render time."""
+    from warpcaustics.batch.arguments import names_argument, overrides_argument, path_argument
     from warpcaustics.pipeline import Renderer
     from warpcaustics.scene import load_scene
 
+    if config is not None:
+        config = path_argument("compare_methods", "config", config, "a scene's .toml file")
+    overrides = overrides_argument("compare_methods", overrides)
+    methods = names_argument("--methods", methods, FLOOR_METHODS)
     unknown = [m for m in methods if m not in FLOOR_METHODS]
     if unknown:
         raise WarpcausticsError(f"--methods: {', '.join(unknown)} is not a floor-caustics method; choose "
@@ -88,16 +93,22 @@ def check_compare_folder(out: Path) -> None:
                                 "give compare a folder of its own")
 
 
-def write_comparison(out: Path, comparison: dict, time_s: float) -> dict[str, Path]:
+def write_comparison(out: str | Path, comparison: dict, time_s: float) -> dict[str, Path]:
     """compare.json, compare.csv, compare.png and each method's frame (EXR, PNG, run.json) in
     ``out/<method>/``."""
+    from warpcaustics.batch.arguments import output_folder, path_argument
     from warpcaustics.io.files import write_csv
     from warpcaustics.io.frame import save_frame
     from warpcaustics.io.png import write_png
     from warpcaustics.io.run_json import write_run_json
     from warpcaustics.optics import colour as colour_out
+    from warpcaustics.pipeline import check_time
 
-    out.mkdir(parents=True, exist_ok=True)
+    if not (isinstance(comparison, dict) and {"rows", "results"} <= set(comparison)):
+        raise WarpcausticsError(f"write_comparison() takes what compare_methods() returns; got "
+                                f"{type(comparison).__name__} {comparison!r:.60}")
+    check_time("time_s", time_s)
+    out = output_folder("out", path_argument("write_comparison", "out", out, "the output folder"))
     for name in FLOOR_METHODS:  # an earlier comparison's method folders (each holds its run.json) go,
         folder = out / name    # so that none the new --methods leaves out stands beside its table
         if (folder / "run.json").is_file() and not folder.is_symlink():

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.batch.arguments import output_folder, overrides_argument, path_argument
 from warpcaustics.config import WaterType, read_toml
 from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError
@@ -57,7 +58,8 @@ def _flatten(table: dict, prefix: str = "") -> dict:
 def load_study(path: str | Path, overrides: dict | None = None) -> StudyConfig:
     """Read a study TOML; errors are one line naming the key. ``overrides`` (the command line's
     ``--set``) join the study's [overrides]."""
-    path = Path(path)
+    path = path_argument("load_study", "path", path, "a study's .toml file")
+    overrides = overrides_argument("load_study", overrides)
     table = read_toml(path)
     for key in table:
         if key not in STUDY_KEYS:
@@ -109,10 +111,14 @@ def floor_colour_hex(spectrum: np.ndarray, bins) -> str:
     return "#" + "".join(f"{int(round(v * 255)):02x}" for v in encoded)
 
 
-def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> dict[str, Path]:
+def run_study(study: StudyConfig, out_dir: str | Path, device: str | None = None) -> dict[str, Path]:
     """Render every combination; write study.csv, kd.csv and the plot. Returns the paths."""
     import warpcaustics as wc
 
+    if not isinstance(study, StudyConfig):
+        raise ConfigError(f"run_study() takes a study from load_study(path); got {type(study).__name__} "
+                          f"{study!r:.60}")
+    out_dir = output_folder("out_dir", path_argument("run_study", "out_dir", out_dir, "the output folder"))
     rows, spectra_by = [], {}
     for water_type, elevation, depth in itertools.product(study.water_types, study.sun_elevations_deg,
                                                            study.depths_m):
@@ -129,7 +135,6 @@ def run_study(study: StudyConfig, out_dir: Path, device: str | None = None) -> d
                                           else float("nan")),  # no light reaches this floor
                      "floor_colour_srgb": floor_colour_hex(mean, bins),
                      **{f"E_{w:.1f}nm": float(e) for w, e in zip(result.wavelengths_nm, mean)}})
-    out_dir.mkdir(parents=True, exist_ok=True)
     paths = {"study": out_dir / "study.csv", "kd": out_dir / "kd.csv",
              "plot": out_dir / "irradiance_vs_depth.png"}
     write_csv(paths["study"], rows)

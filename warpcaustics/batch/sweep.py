@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from warpcaustics import __version__
+from warpcaustics.batch.arguments import overrides_argument, path_argument, workers_argument
 from warpcaustics.batch.executors import check_workers_fit, run_locally, run_on_ray
 from warpcaustics.batch.worker import task_tmp_dir
 from warpcaustics.config import config_to_dict, read_toml
@@ -132,7 +133,8 @@ FRAME_KEYS = ("count", "fps", "start_s")
 def load_sweep(path: str | Path, overrides: dict | None = None) -> Sweep:
     """Read a sweep TOML and expand it into tasks; every key and variant is validated before
     anything runs. ``overrides`` (the command line's ``--set``) join the sweep's [set]."""
-    path = Path(path)
+    path = path_argument("load_sweep", "path", path, "a sweep's .toml file")
+    overrides = overrides_argument("load_sweep", overrides)
     table = read_toml(path)
     unknown = set(table) - {"base", "set", "grid", "zip", "frames"}
     if unknown:
@@ -424,11 +426,13 @@ def run_sweep(
     (``executor = "local"``, ``workers`` processes) or on Ray (``"ray"``: the cluster at ``address``,
     or a local instance of ``workers`` CPUs started and stopped here). Workers write the task
     folders; the driver alone keeps the manifest."""
+    if not isinstance(sweep, Sweep):
+        raise ConfigError(f"run_sweep() takes a sweep from load_sweep(path); got {type(sweep).__name__} "
+                          f"{sweep!r:.60}")
     if executor not in ("local", "ray"):
         raise WarpcausticsError(f"--executor {executor!r} is not allowed; allowed: local, ray")
-    if workers < 1:
-        raise WarpcausticsError(f"--workers = {workers} must be at least 1")
-    out = Path(out_dir)
+    workers = workers_argument(workers)
+    out = path_argument("run_sweep", "out_dir", out_dir, "the output folder")
     finished = _finished_ids(out, sweep)
     if executor == "local":  # checked once here, before anything is written
         from warpcaustics.device import resolve_device

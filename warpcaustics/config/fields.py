@@ -117,7 +117,11 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
     elif tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected a number")
-        value = float(value)
+        try:
+            value = float(value)
+        except OverflowError:  # an integer past float's range
+            raise ConfigError(f"{key} = {_describe(value)} is beyond a float's range (±1.8e308); expected "
+                              "a finite number") from None
         if not math.isfinite(value):
             raise ConfigError(f"{key} = {value} is not finite; expected a finite number")
     elif tp is str:
@@ -126,12 +130,13 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
         return value
     lo, hi, lo_open = meta.get("range", (None, None, False))
     least = meta.get("zero_or_at_least")
+    shown = _describe(value)  # a 400-digit integer is not echoed whole
     if least is not None and 0 < value < least:
-        raise ConfigError(f"{key} = {value} is out of range; allowed: 0 or {least:g} <= value <= {hi}")
+        raise ConfigError(f"{key} = {shown} is out of range; allowed: 0 or {least:g} <= value <= {hi}")
     if lo is not None and (value < lo or (lo_open and value == lo)):
-        raise ConfigError(f"{key} = {value} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
+        raise ConfigError(f"{key} = {shown} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
     if hi is not None and value > hi:
-        raise ConfigError(f"{key} = {value} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
+        raise ConfigError(f"{key} = {shown} is out of range; allowed: {_range_text(lo, hi, lo_open)}")
     return value
 
 

@@ -4,6 +4,7 @@ statistics pooled over them."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import numbers
@@ -11,9 +12,29 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.batch.arguments import overrides_argument, path_argument, workers_argument
 from warpcaustics.batch.stats import continuous_sky_cv
 from warpcaustics.config.loading import dotted_keys
 from warpcaustics.errors import ConfigError, WarpcausticsError
+
+
+def checked_arguments(run):
+    """A field data set's function with the arguments they all take checked first, each a one-line
+    error naming it (from Python a wrong type had surfaced from pathlib, or only after every variant
+    had loaded): SCENE and ``out`` (paths), ``overrides`` (a dict of dotted keys), ``workers``."""
+    name = run.__name__
+
+    @functools.wraps(run)
+    def checked(scene, out, **kwargs):
+        scene = path_argument(name, "scene", scene, "a scene's .toml file")
+        out = path_argument(name, "out", out, "the output folder")
+        if "overrides" in kwargs:
+            kwargs["overrides"] = overrides_argument(name, kwargs["overrides"])
+        if "workers" in kwargs:
+            kwargs["workers"] = workers_argument(kwargs["workers"])
+        return run(scene, out, **kwargs)
+
+    return checked
 
 
 def _is_number(value, kind: type = numbers.Real) -> bool:

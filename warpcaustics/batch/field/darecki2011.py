@@ -30,6 +30,7 @@ from warpcaustics.batch.field.common import (
     band_statistics,
     check_frames,
     check_overrides,
+    checked_arguments,
     long_waves_overrides,
     render_points,
     select_measured,
@@ -85,6 +86,7 @@ def check_scene(config, rec) -> None:
                           "independent frames of a wind sea: use water.model = 'fft'")
 
 
+@checked_arguments
 def run_darecki2011(
     scene: str | Path,
     out: str | Path,

@@ -35,6 +35,7 @@ from warpcaustics.batch.field.common import (
     band_row,
     check_frames,
     check_overrides,
+    checked_arguments,
     frame_statistics_of,
     pooled_statistics,
     render_points,
@@ -127,6 +128,7 @@ def check_scene(config, rec) -> None:
                           "texels: caustics.map_resolution)")
 
 
+@checked_arguments
 def run_darecki2011_radiance(
     scene: str | Path,
     out: str | Path,

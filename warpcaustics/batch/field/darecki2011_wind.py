@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from warpcaustics.batch.field.common import band_row
+from warpcaustics.batch.field.common import band_row, checked_arguments
 from warpcaustics.batch.field.darecki2011 import PLOT_NEEDS, beam_attenuation, render_record
 from warpcaustics.io.files import atomic_path, pyplot, write_csv
 
@@ -34,6 +34,7 @@ def record():
     return jerlov.darecki2011_spectral_cv()
 
 
+@checked_arguments
 def run_darecki2011_wind(
     scene: str | Path,
     out: str | Path,

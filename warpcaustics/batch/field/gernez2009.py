@@ -35,10 +35,12 @@ from pathlib import Path
 
 import numpy as np
 
+from warpcaustics.batch.arguments import names_argument
 from warpcaustics.batch.field.common import (
     LONG_WAVES_FOLDER,
     check_frames,
     check_overrides,
+    checked_arguments,
     continuous_sky,
     frame_statistics_of,
     long_waves_overrides,
@@ -236,6 +238,7 @@ def direct_transmission(sun_zenith_deg: float, depth_m: float, ior: float, scatt
     return math.exp(-scattering_per_m * depth_m / math.sqrt(1.0 - sin_w * sin_w))
 
 
+@checked_arguments
 def run_gernez2009(
     scene: str | Path,
     out: str | Path,
@@ -262,6 +265,7 @@ def run_gernez2009(
     alone."""
     from warpcaustics.scene import load_scene
 
+    series = names_argument("--series", series, SERIES)
     unknown = set(series) - set(SERIES)
     if not series or unknown:
         raise ConfigError(f"--series {','.join(series)!r} must name some of: {', '.join(SERIES)}")

@@ -34,6 +34,7 @@ from warpcaustics.batch.field.common import (
     LONG_WAVES_FOLDER,
     check_frames,
     check_overrides,
+    checked_arguments,
     continuous_sky,
     frame_statistics_of,
     long_waves_overrides,
@@ -85,6 +86,7 @@ def sky_shares(scene) -> np.ndarray:
     return sky / (sky + beam)
 
 
+@checked_arguments
 def run_gernez2009_bands(
     scene: str | Path,
     out: str | Path,
