@@ -178,3 +178,22 @@ def test_gernez_series_as_a_bare_string_is_refused():
     """``series="zenith"`` had been read as its letters ("--series 'z,e,n,i,t,h'")."""
     with pytest.raises(wc.ConfigError, match=r"--series = 'zenith' must be a list of names, e.g. \('zen"):
         field.run_gernez2009(CONFIGS / "field" / "gernez2009.toml", "o", series="zenith", quick=True)
+
+
+def test_the_smaller_findings(tmp_path):
+    """An empty device name had meant auto, an empty scene path the working folder ('.'), and a file
+    key given as a pathlib.Path had been refused (load_scene takes Paths for its own file);
+    --long-waves quoted a string as if it were a number."""
+    scene = wc.load_scene(CONFIGS / "flat.toml", TINY)
+    for name in ("", "  "):
+        with pytest.raises(wc.DeviceError, match=r"device = '\s*' must be a name: auto, cpu, cuda or cuda:N"):
+            wc.render(scene, device=name)
+    with pytest.raises(wc.ConfigError, match=r"load_scene\(\) takes the path of a .toml file .*got str ''"):
+        wc.load_scene("")
+    np.save(tmp_path / "h.npy", np.zeros((16, 16), np.float32))
+    from_path = wc.load_scene(None, {"water.model": "heightfield", "water.file": tmp_path / "h.npy",
+                                     "water.resolution": 16})
+    assert from_path.config.water.file == str(tmp_path / "h.npy") and from_path.heights.shape == (16, 16)
+    with pytest.raises(wc.ConfigError, match=r"--long-waves = '128' must be a side in metres"):
+        field.run_gernez2009(CONFIGS / "field" / "gernez2009.toml", tmp_path / "o", long_waves_m="128",
+                             quick=True)

@@ -54,7 +54,7 @@ def resolve_device(requested: str | None, *, config_value: str = "auto") -> str:
     ``auto`` means CUDA when available, else the CPU with a one-line notice on stderr; an explicit
     ``cuda`` (or ``cuda:N``) where there is none is an error.
     """
-    if requested is not None and not isinstance(requested, str):
+    if requested is not None and (not isinstance(requested, str) or not requested.strip()):
         raise DeviceError(f"device = {requested!r} must be a name: auto, cpu, cuda or cuda:N")
     from_env = (os.environ.get(DEVICE_ENV) or "").strip() or None  # set but blank: not set
     choice = requested or from_env or config_value or "auto"

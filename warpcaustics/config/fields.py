@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import enum
 import math
+import os
 import typing
 from typing import Any
 
@@ -125,6 +126,8 @@ def _convert(key: str, value: Any, tp: Any, meta: dict) -> Any:
         if not math.isfinite(value):
             raise ConfigError(f"{key} = {value} is not finite; expected a finite number")
     elif tp is str:
+        if isinstance(value, os.PathLike) and isinstance(os.fspath(value), str):
+            return os.fspath(value)  # a file key given as a pathlib.Path, as load_scene's own path may be
         if not isinstance(value, str):
             raise ConfigError(f"{key} = {_describe(value)} has the wrong type; expected a string")
         return value

@@ -197,7 +197,7 @@ def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None 
     ``load_scene(None, {...})`` builds a scene from the defaults and the overrides alone.
     Raises :class:`warpcaustics.errors.ConfigError` with a one-line message on any bad input.
     """
-    if path is not None and not isinstance(path, (str, os.PathLike)):
+    if path is not None and (not isinstance(path, (str, os.PathLike)) or path == ""):
         raise ConfigError(f"load_scene() takes the path of a .toml file (a str or a Path) or None; got "
                           f"{type(path).__name__} {path!r:.60}")
     if overrides is not None and not isinstance(overrides, Mapping):

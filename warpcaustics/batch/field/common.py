@@ -230,7 +230,7 @@ def long_waves_overrides(config, fixed: dict, extent_m: float, quick: bool, scen
     from warpcaustics.scene import load_scene
 
     if not (_is_number(extent_m) and math.isfinite(extent_m) and extent_m >= 0.0):
-        raise ConfigError(f"--long-waves = {extent_m} must be a side in metres (e.g. 128), or 0 for the "
+        raise ConfigError(f"--long-waves = {extent_m!r} must be a side in metres (e.g. 128), or 0 for the "
                           "scene's waves alone")
     if extent_m == 0.0:
         return None
