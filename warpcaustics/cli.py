@@ -290,16 +290,14 @@ def _absolute_files(table, base_dir: Path):
     """``table`` with the files its keys name (``file``, ``albedo_file``, a receiver's ``mesh`` that
     is no built-in shape) as absolute paths: a relative one starts at the config file's folder, so
     the printed config loads from anywhere."""
-    from warpcaustics.scene.receivers import PRIMITIVES
+    from warpcaustics.scene import is_file_key
 
     if isinstance(table, list):
         return [_absolute_files(item, base_dir) for item in table]
     if not isinstance(table, dict):
         return table
-    names_file = {"file", "albedo_file"}
-    return {key: str(base_dir / value)
-            if isinstance(value, str) and (key in names_file or key == "mesh" and value not in PRIMITIVES)
-            else _absolute_files(value, base_dir) for key, value in table.items()}
+    return {key: str(base_dir / value) if is_file_key(key, value) else _absolute_files(value, base_dir)
+            for key, value in table.items()}
 
 
 def _render(args: argparse.Namespace) -> int:
@@ -310,44 +308,47 @@ def _render(args: argparse.Namespace) -> int:
     _check_animation(args, scene.config.stats.integration_s)
     out = _out_folder(args.out)
 
+    from warpcaustics.io.files import folder_lock
     from warpcaustics.io.frame import save_frame
     from warpcaustics.io.run_json import write_run_json
     from warpcaustics.pipeline import Renderer
 
     renderer = Renderer(scene, args.device)  # device and memory checks before any output
     made = _make(out)
-    results = []
-    from warpcaustics.batch.sweep import Progress
-    from warpcaustics.io.manifest import claim
+    with folder_lock(out):  # a second run into the same folder is refused, not interleaved
+        results = []
+        from warpcaustics.batch.progress import Progress
+        from warpcaustics.io.manifest import claim
 
-    manifest = claim(out, args.force)  # the earlier run's files go; unrecorded outputs are refused
-    # run.json marks a complete run: an earlier run's must not stand beside this run's frames
-    (out / "run.json").unlink(missing_ok=True)
-    progress = Progress(args.frames, args.quiet, unit="frame")
-    try:
-        for frame in range(args.frames):
-            t0 = time.perf_counter()
-            result = renderer.render(args.time + frame / args.fps)
-            try:
-                with renderer.memory_errors():
-                    manifest.add(save_frame(result, out, frame=frame).values())
-            except OSError as exc:
-                raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
-                                        f"{exc.strerror or exc}") from None
-            results.append(result)
-            progress.step(f"frame {frame:04d}  t = {result.time_s:.3f} s  {time.perf_counter() - t0:.2f} s  "
-                          f"on {result.device}  -> {out / f'frame_{frame:04d}.exr'}")
-    except BaseException:
-        if made is not None and not results:  # failed before its first frame: what this run made goes
-            shutil.rmtree(made, ignore_errors=True)
-        raise
-    finally:
-        progress.close()
-    write_run_json(out, results)
-    manifest.add([out / "run.json"])
-    if not args.quiet:
-        print(f"wrote {args.frames} frame(s) and run.json to {out}")
-    return 0
+        manifest = claim(out, args.force)  # the earlier run's files go; unrecorded outputs are refused
+        # run.json marks a complete run: an earlier run's must not stand beside this run's frames
+        (out / "run.json").unlink(missing_ok=True)
+        progress = Progress(args.frames, args.quiet, unit="frame")
+        try:
+            for frame in range(args.frames):
+                t0 = time.perf_counter()
+                result = renderer.render(args.time + frame / args.fps)
+                try:
+                    with renderer.memory_errors():
+                        manifest.add(save_frame(result, out, frame=frame).values())
+                except OSError as exc:
+                    raise WarpcausticsError(f"cannot write frame {frame} into --out {str(out)!r}: "
+                                            f"{exc.strerror or exc}") from None
+                results.append(result)
+                progress.step(f"frame {frame:04d}  t = {result.time_s:.3f} s  "
+                              f"{time.perf_counter() - t0:.2f} s  on {result.device}  -> "
+                              f"{out / f'frame_{frame:04d}.exr'}")
+        except BaseException:
+            if made is not None and not results:  # failed before its first frame: what this run made goes
+                shutil.rmtree(made, ignore_errors=True)
+            raise
+        finally:
+            progress.close()
+        write_run_json(out, results)
+        manifest.add([out / "run.json"])
+        if not args.quiet:
+            print(f"wrote {args.frames} frame(s) and run.json to {out}")
+        return 0
 
 
 def _study(args: argparse.Namespace) -> int:
@@ -502,7 +503,26 @@ def _signed_lists(argv: list[str]) -> list[str]:
     return out
 
 
+def _os_error_line(exc: OSError, out: str | None) -> str:
+    """The file that failed and why; the advice about --out only where the file is in it (a full disk
+    there), not for a file elsewhere (too many open files, no temporary folder)."""
+    where = f"{str(exc.filename)!r}: " if exc.filename else ""
+    line = one_line(where + (exc.strerror or str(exc)))
+    try:
+        failed = Path(os.fsdecode(exc.filename)).resolve() if exc.filename and out else None
+        inside = failed is not None and Path(out).resolve() in failed.parents
+    except (OSError, ValueError, TypeError):
+        inside = False
+    if inside:
+        return (f"{line}; free space in --out or give another --out (what was written is not marked a "
+                "finished run)")
+    return line
+
+
 def main(argv: list[str] | None = None) -> int:
+    for name in ("stdout", "stderr"):  # started with the stream closed (`>&-`): what it says goes nowhere
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
     args = _parser().parse_args(_signed_lists(sys.argv[1:] if argv is None else list(argv)))
     try:
         if args.command in ("sweep", "field"):  # render, study and compare check theirs as they use it
@@ -536,11 +556,13 @@ def main(argv: list[str] | None = None) -> int:
     except WarpcausticsError as exc:
         print(f"warpcaustics: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_USER_ERROR
+    except BrokenPipeError:  # what it printed was piped to a reader that stopped (`| head -1`): not an error
+        from warpcaustics.batch.progress import stdout_to_devnull
+
+        stdout_to_devnull()
+        return 0
     except OSError as exc:  # a file that failed as it went (a disk that filled): which, and why
-        where = f"{str(exc.filename)!r}: " if exc.filename else ""
-        print(f"warpcaustics: error: {one_line(where + (exc.strerror or str(exc)))}; where that is in --out, "
-              "free space there or give another --out (what was written is not marked a finished run)",
-              file=sys.stderr)
+        print(f"warpcaustics: error: {_os_error_line(exc, getattr(args, 'out', None))}", file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("warpcaustics: interrupted", file=sys.stderr)

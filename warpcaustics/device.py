@@ -17,14 +17,20 @@ _notice_given = False
 def _warp():
     import warp as wp
 
-    if os.environ.get("WARPCAUSTICS_VERBOSE"):
-        wp.init()
-        return wp
-    # Warp's info lines (init banner, module loads) drown our one-line messages, and on a machine
-    # without a GPU its native library prints a driver warning on every start; our own notice
-    # (see resolve_device) says the same once. Anything else it prints is passed on.
-    wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
-    _init_filtering_stderr(wp)  # later calls are cheap: wp.init() runs once
+    try:
+        if os.environ.get("WARPCAUSTICS_VERBOSE"):
+            wp.init()
+            return wp
+        # Warp's info lines (init banner, module loads) drown our one-line messages, and on a machine
+        # without a GPU its native library prints a driver warning on every start; our own notice
+        # (see resolve_device) says the same once. Anything else it prints is passed on.
+        wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
+        _init_filtering_stderr(wp)  # later calls are cheap: wp.init() runs once
+    except OSError as exc:  # its kernel cache (under $HOME unless WARP_CACHE_PATH) cannot be made
+        where = f"{str(exc.filename)!r}: " if exc.filename else ""
+        raise DeviceError(f"Warp cannot start: {where}{exc.strerror or exc}; its kernel cache must be "
+                          "writable: set WARP_CACHE_PATH to a folder you can write to (or make HOME "
+                          "writable)") from None
     return wp
 
 

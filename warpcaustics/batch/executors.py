@@ -23,9 +23,13 @@ if TYPE_CHECKING:
 
 def die_with_parent(parent_pid: int) -> None:
     """Worker initializer: end this process when the driver goes (Linux parent-death signal, plus
-    a thread that checks the parent every half second elsewhere)."""
+    a thread that checks the parent every half second elsewhere). Ctrl-C, which a terminal sends to
+    the whole process group, is the driver's to handle: a worker that took it as its task's error
+    went on to the next task in its queue."""
     import signal
     import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     try:
         import ctypes
@@ -87,16 +91,29 @@ def run_locally(sweep: Sweep, todo: list[Task], out: Path, workers: int, device:
         max_workers=workers, mp_context=context, initializer=die_with_parent, initargs=(os.getpid(),)
     ) as pool:
         pending = {pool.submit(run_task, str(sweep.base), task, str(out), device): task for task in todo}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                task = pending.pop(future)
-                try:
-                    outcome = future.result()
-                except Exception as exc:
-                    finish(task, None, exc)
-                else:
-                    finish(task, outcome, None)
+        try:
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    task = pending.pop(future)
+                    try:
+                        outcome = future.result()
+                    except Exception as exc:
+                        finish(task, None, exc)
+                    else:
+                        finish(task, outcome, None)
+        except BaseException:  # Ctrl-C: stop now, not after every queued task (a rerun resumes)
+            stop_workers(pool)
+            raise
+
+
+def stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers mid-task: their half-written task folders are
+    temporary ones, which the next run removes."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # shutdown forgets them
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
 
 
 def run_on_ray(

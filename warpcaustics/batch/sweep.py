@@ -35,6 +35,7 @@ This module reads and expands sweeps and drives them; ``batch/worker.py`` render
 from __future__ import annotations
 
 import difflib
+import functools
 import hashlib
 import itertools
 import json
@@ -50,11 +51,12 @@ from typing import Any
 from warpcaustics import __version__
 from warpcaustics.batch.arguments import overrides_argument, path_argument, workers_argument
 from warpcaustics.batch.executors import check_workers_fit, run_locally, run_on_ray
+from warpcaustics.batch.progress import Progress
 from warpcaustics.batch.worker import task_tmp_dir
 from warpcaustics.config import config_to_dict, read_toml
 from warpcaustics.config.loading import check_key
 from warpcaustics.errors import ConfigError, WarpcausticsError
-from warpcaustics.io.files import atomic_path, write_csv, write_json
+from warpcaustics.io.files import atomic_path, folder_lock, write_csv, write_json
 from warpcaustics.io.manifest import MANIFEST as RUN_MANIFEST
 from warpcaustics.io.manifest import SWEEP_MANIFEST as MANIFEST
 from warpcaustics.io.manifest import SWEEP_RECORD
@@ -232,8 +234,9 @@ def expand_sweep(
             continue
         groups = [times] if stateful else [(t,) for t in times]
         memory = (scene_bytes(scene, "cuda"), scene_bytes(scene, "cpu"), host_bytes(scene))
+        inputs = input_digests(resolved, scene.base_dir)
         for i, group in enumerate(groups):
-            tasks.append(Task(task_id(resolved, group), overrides, group, 0 if stateful else i, None,
+            tasks.append(Task(task_id(resolved, group, inputs), overrides, group, 0 if stateful else i, None,
                               stateful, resolved, memory))
     return Sweep(base, tasks, source, list(grid) + list(zipped))
 
@@ -253,12 +256,36 @@ def _too_short_to_integrate(integration_s: float, times: tuple[float, ...]) -> s
             "integration_s")
 
 
-def task_id(resolved_config: dict, times_s: tuple[float, ...]) -> str:
-    """Stable id: SHA-256 of the resolved config, the frame times and the package version."""
-    text = json.dumps(
-        {"config": resolved_config, "times_s": times_s, "version": __version__}, sort_keys=True, default=str
-    )
+def task_id(resolved_config: dict, times_s: tuple[float, ...], inputs: dict[str, str] | None = None) -> str:
+    """Stable id: SHA-256 of the resolved config, the frame times and the package version, and of the
+    contents of the files the config names (``inputs``: key → digest, :func:`input_digests`), so that
+    a file changed under the same name is a new task, not a finished one."""
+    record = {"config": resolved_config, "times_s": times_s, "version": __version__}
+    if inputs:  # a config without files keeps the id it had
+        record["inputs"] = inputs
+    text = json.dumps(record, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def input_digests(resolved_config: dict, base_dir: Path) -> dict[str, str]:
+    """SHA-256 of each file the config names (key → hex digest); a file is read once per sweep while its
+    size and modification time stay the same."""
+    from warpcaustics.scene import named_files
+
+    digests = {}
+    for key, path in named_files(resolved_config, base_dir).items():
+        stat = path.stat()
+        digests[key] = _file_digest(str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    return digests
+
+
+@functools.lru_cache(maxsize=256)
+def _file_digest(path: str, size: int, mtime_ns: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -302,7 +329,8 @@ def _claim(out: Path, sweep: Sweep, force: bool) -> None:
                                 "give another --out, or --force to add the sweep beside them")
     if theirs not in (None, mine) and not force:
         raise WarpcausticsError(f"--out {str(out)!r} holds the results of another sweep (other keys, values, "
-                                "frames or version); give another --out, or --force to add this one to it")
+                                "frames, version, or files the configs name whose contents changed); give "
+                                "another --out, or --force to add this one to it")
     if theirs is None or force or not record.exists():
         write_json(record, {"hash": mine, "version": __version__, "source": str(sweep.source)})
 
@@ -381,36 +409,6 @@ class SweepReport:
     seconds: float = 0.0
 
 
-class Progress:
-    """Progress of many tasks or frames: a tqdm bar with throughput and ETA on a terminal, one plain
-    line per step otherwise (logs, CI), nothing when quiet."""
-
-    def __init__(self, total: int, quiet: bool, unit: str = "task"):
-        self.total, self.quiet, self.count, self.t0 = total, quiet, 0, time.perf_counter()
-        self.bar = None
-        if not quiet and sys.stdout.isatty():
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=total, unit=unit, dynamic_ncols=True)
-
-    def step(self, text: str) -> None:
-        self.count += 1
-        if self.quiet:
-            return
-        if self.bar is not None:
-            self.bar.set_postfix_str(text[:60], refresh=False)
-            self.bar.update(1)
-            return
-        elapsed = time.perf_counter() - self.t0
-        rate = self.count / elapsed if elapsed > 0 else 0.0
-        eta = (self.total - self.count) / rate if rate > 0 else 0.0
-        print(f"[{self.count}/{self.total}] {text}  ({rate * 60:.1f}/min, ETA {eta:.0f} s)", flush=True)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
 def run_sweep(
     sweep: Sweep,
     out_dir: str | Path,
@@ -451,69 +449,70 @@ def run_sweep(
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
-    _claim(out, sweep, force)
-    for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
-        shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
-    report = SweepReport()
-    todo = []
-    for task in sweep.tasks:
-        if task.error is not None:
+    with folder_lock(out):  # a second run into the same folder is refused, not interleaved
+        _claim(out, sweep, force)
+        for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
+            shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
+        report = SweepReport()
+        todo = []
+        for task in sweep.tasks:
+            if task.error is not None:
+                _append(
+                    out,
+                    {
+                        "id": task.id,
+                        "version": __version__,
+                        "overrides": task.overrides,
+                        "state": "failed",
+                        "error": task.error,
+                    },
+                )
+                report.failed.append((task.id, task.error))
+                continue
+            if task.id in finished:
+                report.skipped += 1
+            else:
+                todo.append(task)
+        t0 = time.perf_counter()
+        progress = Progress(len(todo), quiet)
+
+        def finish(task: Task, outcome: dict | None, error: BaseException | None) -> None:
+            record = {
+                "id": task.id,
+                "version": __version__,
+                "config": task.config,
+                "overrides": task.overrides,
+                "times_s": list(task.times_s),
+            }
+            if error is not None:  # a failing task is recorded and the sweep goes on
+                message = _error_line(error)
+                _append(out, {**record, "state": "failed", "error": message})
+                report.failed.append((task.id, message))
+                progress.step(f"FAILED {task.id} ({_varied(sweep, task)}): {message}")
+                return
             _append(
                 out,
                 {
-                    "id": task.id,
-                    "version": __version__,
-                    "overrides": task.overrides,
-                    "state": "failed",
-                    "error": task.error,
+                    **record,
+                    "state": "done",
+                    "seconds": outcome["seconds"],
+                    "device": outcome["device"],
+                    "rows": outcome["rows"],
                 },
             )
-            report.failed.append((task.id, task.error))
-            continue
-        if task.id in finished:
-            report.skipped += 1
-        else:
-            todo.append(task)
-    t0 = time.perf_counter()
-    progress = Progress(len(todo), quiet)
+            report.done += 1
+            progress.step(f"done {task.id} ({_varied(sweep, task)}) in {outcome['seconds']:.1f} s")
 
-    def finish(task: Task, outcome: dict | None, error: BaseException | None) -> None:
-        record = {
-            "id": task.id,
-            "version": __version__,
-            "config": task.config,
-            "overrides": task.overrides,
-            "times_s": list(task.times_s),
-        }
-        if error is not None:  # a failing task is recorded and the sweep goes on
-            message = _error_line(error)
-            _append(out, {**record, "state": "failed", "error": message})
-            report.failed.append((task.id, message))
-            progress.step(f"FAILED {task.id} ({_varied(sweep, task)}): {message}")
-            return
-        _append(
-            out,
-            {
-                **record,
-                "state": "done",
-                "seconds": outcome["seconds"],
-                "device": outcome["device"],
-                "rows": outcome["rows"],
-            },
-        )
-        report.done += 1
-        progress.step(f"done {task.id} ({_varied(sweep, task)}) in {outcome['seconds']:.1f} s")
-
-    try:
-        if executor == "ray":
-            run_on_ray(sweep, todo, out, workers, device, address, finish)
-        else:
-            run_locally(sweep, todo, out, workers, device, finish)
-    finally:
-        progress.close()
-    report.seconds = time.perf_counter() - t0
-    write_summary(out, sweep)
-    return report
+        try:
+            if executor == "ray":
+                run_on_ray(sweep, todo, out, workers, device, address, finish)
+            else:
+                run_locally(sweep, todo, out, workers, device, finish)
+        finally:
+            progress.close()
+        report.seconds = time.perf_counter() - t0
+        write_summary(out, sweep)
+        return report
 
 
 def _error_line(error: BaseException) -> str:

@@ -14,6 +14,38 @@ import numpy as np
 
 from warpcaustics import __version__
 
+LOCK_FILE = ".warpcaustics.lock"
+"""The file in an output folder whose advisory lock a command holds while it writes there."""
+
+
+@contextmanager
+def folder_lock(out: Path):
+    """Hold an advisory lock on ``out`` (``out/.warpcaustics.lock``, ``flock``; released when the
+    command ends, however it ends) while a command writes there: a second run into the same folder
+    at the same time is refused in one line, where it had deleted the first run's files as its own
+    earlier outputs (a render) or rendered the same tasks into the same temporary folders (a sweep).
+    Where the folder takes no lock file or the system no ``flock``, nothing is locked."""
+    from warpcaustics.errors import WarpcausticsError
+
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        yield
+        return
+    try:
+        handle = open(out / LOCK_FILE, "a+b")
+    except OSError:  # a read-only folder: the writes that follow say so themselves
+        yield
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise WarpcausticsError(f"--out {str(out)!r} is being written by another warpcaustics run; wait "
+                                    "for it to end, or give another --out") from None
+        except OSError:  # a file system without locks (some network mounts)
+            pass
+        yield
 
 def input_file(key: str, name: str, base_dir: Path | None, what: str) -> Path:
     """The file a config key names (a relative path starts at ``base_dir``, the config file's

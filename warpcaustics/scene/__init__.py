@@ -191,6 +191,31 @@ def _check_spectral_data(cfg: Config, base_dir: Path) -> None:
     spectra.water_optics(cfg.optics, bins)
 
 
+def is_file_key(key: str, value) -> bool:
+    """Whether a resolved config's ``key`` (its last part) holds the name of a file: ``file``,
+    ``albedo_file``, a receiver's ``mesh`` that is not a built-in shape."""
+    from warpcaustics.scene.receivers import PRIMITIVES
+
+    return isinstance(value, str) and (key in ("file", "albedo_file")
+                                       or key == "mesh" and value not in PRIMITIVES)
+
+
+def named_files(table, base_dir: Path, prefix: str = "") -> dict[str, Path]:
+    """The files a resolved config (``config_to_dict``) names: dotted key (``receivers[0].mesh``) →
+    path, a relative one from ``base_dir`` (the config file's folder)."""
+    found: dict[str, Path] = {}
+    if isinstance(table, list):
+        for i, item in enumerate(table):
+            found.update(named_files(item, base_dir, f"{prefix.rstrip('.')}[{i}]."))
+    elif isinstance(table, dict):
+        for key, value in table.items():
+            if is_file_key(key, value):
+                found[prefix + key] = base_dir / value
+            else:
+                found.update(named_files(value, base_dir, f"{prefix}{key}."))
+    return found
+
+
 def load_scene(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Scene:
     """Read and validate a TOML scene; ``overrides`` maps dotted keys to values.
 
