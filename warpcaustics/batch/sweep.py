@@ -49,7 +49,7 @@ from pathlib import Path
 from typing import Any
 
 from warpcaustics import __version__
-from warpcaustics.batch.arguments import overrides_argument, path_argument, workers_argument
+from warpcaustics.batch.arguments import output_folder, overrides_argument, path_argument, workers_argument
 from warpcaustics.batch.executors import check_workers_fit, run_locally, run_on_ray
 from warpcaustics.batch.progress import Progress
 from warpcaustics.batch.worker import task_tmp_dir
@@ -443,12 +443,7 @@ def run_sweep(
             device = resolve_device(None, config_value=configured.pop())
         check_workers_fit([t for t in sweep.tasks if t.error is None and t.id not in finished], workers,
                           device)
-    if out.exists() and not out.is_dir():
-        raise WarpcausticsError(f"--out {str(out)!r} is a file; give a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
+    output_folder("--out", out)
     with folder_lock(out):  # a second run into the same folder is refused, not interleaved
         _claim(out, sweep, force)
         for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
