@@ -47,6 +47,7 @@ def folder_lock(out: Path):
             pass
         yield
 
+
 def input_file(key: str, name: str, base_dir: Path | None, what: str) -> Path:
     """The file a config key names (a relative path starts at ``base_dir``, the config file's
     folder), checked to exist; otherwise a one-line ConfigError naming ``key``: a missing file, a
