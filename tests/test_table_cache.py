@@ -2,6 +2,8 @@
 one computed, bit for bit; a changed input or formula is another file; a damaged file is computed
 again; a folder that cannot be written, or the cache turned off, only means no cache."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -69,6 +71,8 @@ def test_no_folder_to_write_or_the_cache_off_still_gives_the_table(tmp_path, mon
             assert np.array_equal(cached_table("t", table_key(table), compute, table.shape), table)
         assert len(calls) == 2
     assert cache_folder() is None
+    monkeypatch.setenv(CACHE_ENV, "~/tables")  # as a shell would not expand it inside quotes
+    assert cache_folder() == Path.home() / "tables"
     monkeypatch.delenv(CACHE_ENV)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert cache_folder() == tmp_path / "xdg" / "warpcaustics"

@@ -35,7 +35,7 @@ def cache_folder() -> Path | None:
     """Where the tables are kept, or None where the cache is off."""
     value = os.environ.get(CACHE_ENV)
     if value is not None:
-        return None if value.strip().lower() in ("", "0", "off") else Path(value)
+        return None if value.strip().lower() in ("", "0", "off") else Path(value).expanduser()
     base = os.environ.get("XDG_CACHE_HOME")
     if not base:
         try:
