@@ -14,17 +14,14 @@ import numpy as np
 
 from warpcaustics import __version__
 
-LOCK_FILE = ".warpcaustics.lock"
-"""The file in an output folder whose advisory lock a command holds while it writes there."""
-
 
 @contextmanager
 def folder_lock(out: Path):
-    """Hold an advisory lock on ``out`` (``out/.warpcaustics.lock``, ``flock``; released when the
-    command ends, however it ends) while a command writes there: a second run into the same folder
-    at the same time is refused in one line, where it had deleted the first run's files as its own
-    earlier outputs (a render) or rendered the same tasks into the same temporary folders (a sweep).
-    Where the folder takes no lock file or the system no ``flock``, nothing is locked."""
+    """Hold an advisory lock on the folder ``out`` itself (``flock`` on the open folder: no file is
+    made; released when the command ends, however it ends) while a command writes there: a second run
+    into the same folder at the same time is refused in one line, where it had deleted the first run's
+    files as its own earlier outputs (a render) or rendered the same tasks into the same temporary
+    folders (a sweep). Where the system or the file system has no ``flock``, nothing is locked."""
     from warpcaustics.errors import WarpcausticsError
 
     try:
@@ -33,11 +30,11 @@ def folder_lock(out: Path):
         yield
         return
     try:
-        handle = open(out / LOCK_FILE, "a+b")
-    except OSError:  # a read-only folder: the writes that follow say so themselves
+        handle = os.open(out, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:  # not a folder one can open: the writes that follow say why themselves
         yield
         return
-    with handle:
+    try:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -46,6 +43,8 @@ def folder_lock(out: Path):
         except OSError:  # a file system without locks (some network mounts)
             pass
         yield
+    finally:
+        os.close(handle)
 
 
 def input_file(key: str, name: str, base_dir: Path | None, what: str) -> Path:
