@@ -67,7 +67,10 @@ def test_ctrl_c_stops_a_sweep_s_workers_at_once_and_a_rerun_finishes(tmp_path):
     out = tmp_path / "out"
     command = [sys.executable, "-m", "warpcaustics", "sweep", str(sweep), "--out", str(out), "--workers", "2",
                "--device", "cpu", "--quiet"]
-    proc = subprocess.Popen(command, start_new_session=True, stderr=subprocess.PIPE, text=True)
+    # as from a terminal: SIGINT at its default (a pytest-xdist worker ignores it, and an ignored
+    # signal stays ignored in its children, so Python would install no KeyboardInterrupt for it)
+    proc = subprocess.Popen(command, start_new_session=True, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
     while not (out.is_dir() and any(p.name.endswith(".tmp") for p in out.iterdir())):  # a task under way
         assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()[-2000:]
