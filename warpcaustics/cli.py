@@ -253,11 +253,10 @@ def _writable(probe: Path, out: str) -> None:
 def _make(out: Path) -> Path | None:
     """Make the folder ``out`` (one line if it cannot be made); the first folder this made (None: it
     was there), which a command that fails removes."""
+    from warpcaustics.batch.arguments import output_folder
+
     made = next((f for f in reversed([out, *out.parents]) if not f.exists()), None)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise WarpcausticsError(f"--out {str(out)!r} cannot be created: {exc.strerror}") from None
+    output_folder("--out", out)
     return made
 
 

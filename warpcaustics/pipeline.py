@@ -7,6 +7,7 @@ holds no per-method logic (``warpcaustics/caustics/stage.py`` has the interface)
 
 from __future__ import annotations
 
+import functools
 import numbers
 from contextlib import contextmanager
 
@@ -120,17 +121,30 @@ def check_scene_config(scene: Scene) -> None:
     skips load_scene's validation: its config is validated again here (a round trip through the
     checks, a few ms), so that a value load_scene refuses (a zero resolution had crashed the process
     inside a kernel) is the same one line here."""
-    from warpcaustics.config import Config, config_to_dict
-    from warpcaustics.config.loading import config_from_dict
+    from warpcaustics.config import Config
 
     if not isinstance(scene.config, Config):
         raise ConfigError(f"Scene(config) takes a Config; got {type(scene.config).__name__} "
                           f"{scene.config!r:.60}: build scenes with warpcaustics.load_scene(path)")
     try:
-        config_from_dict(config_to_dict(scene.config))
+        try:
+            _validated(scene.config)
+        except TypeError:  # a field set by hand to a list: not hashable, so checked without the cache
+            _validated.__wrapped__(scene.config)
     except ConfigError as exc:
         raise ConfigError(f"the scene's config is not valid: {exc} (build scenes with "
                           "warpcaustics.load_scene(path), which checks every key)") from None
+
+
+@functools.lru_cache(maxsize=64)
+def _validated(cfg) -> bool:
+    """``cfg`` through the checks once per process (a frozen Config is hashable: a config equal to one
+    checked before is valid), so that every frame's Renderer does not pay the round trip again."""
+    from warpcaustics.config import config_to_dict
+    from warpcaustics.config.loading import config_from_dict
+
+    config_from_dict(config_to_dict(cfg))
+    return True
 
 
 class Renderer:

@@ -432,42 +432,35 @@ def run_sweep(
     workers = workers_argument(workers)
     out = path_argument("run_sweep", "out_dir", out_dir, "the output folder")
     finished = _finished_ids(out, sweep)
+    todo = [t for t in sweep.tasks if t.error is None and t.id not in finished]
     if executor == "local":  # checked once here, before anything is written
         from warpcaustics.device import resolve_device
 
         configured = {t.config.get("device", "auto") for t in sweep.tasks if t.config}
         if device is not None:
             device = resolve_device(device)
-        elif len(configured) == 1 and any(t.error is None and t.id not in finished for t in sweep.tasks):
+        elif len(configured) == 1 and todo:
             # the config's device (or $WARPCAUSTICS_DEVICE), said once; a finished sweep needs none
             device = resolve_device(None, config_value=configured.pop())
-        check_workers_fit([t for t in sweep.tasks if t.error is None and t.id not in finished], workers,
-                          device)
+        check_workers_fit(todo, workers, device)
     output_folder("--out", out)
     with folder_lock(out):  # a second run into the same folder is refused, not interleaved
         _claim(out, sweep, force)
         for task in sweep.tasks:  # a killed run's half-written tasks: by this sweep's own task ids only
             shutil.rmtree(task_tmp_dir(out, task.id), ignore_errors=True)
-        report = SweepReport()
-        todo = []
-        for task in sweep.tasks:
-            if task.error is not None:
-                _append(
-                    out,
-                    {
-                        "id": task.id,
-                        "version": __version__,
-                        "overrides": task.overrides,
-                        "state": "failed",
-                        "error": task.error,
-                    },
-                )
-                report.failed.append((task.id, task.error))
-                continue
-            if task.id in finished:
-                report.skipped += 1
-            else:
-                todo.append(task)
+        report = SweepReport(skipped=sum(t.error is None and t.id in finished for t in sweep.tasks))
+        for task in (t for t in sweep.tasks if t.error is not None):
+            _append(
+                out,
+                {
+                    "id": task.id,
+                    "version": __version__,
+                    "overrides": task.overrides,
+                    "state": "failed",
+                    "error": task.error,
+                },
+            )
+            report.failed.append((task.id, task.error))
         t0 = time.perf_counter()
         progress = Progress(len(todo), quiet)
 
